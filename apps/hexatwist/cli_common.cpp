@@ -1,0 +1,137 @@
+#include "cli_common.hpp"
+
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "json.hpp"
+
+namespace hexatwist::cli {
+
+namespace {
+
+// Text typed by the user as it may appear inside a one-line message: control characters escaped.
+std::string printable(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f)
+      out += fmt::format("\\x{:02x}", u);
+    else
+      out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+void add_model_options(CLI::App& app, ModelOptions& opts) {
+  app.add_option("--config", opts.config,
+                 "Platform YAML file (see configs/); default: the embedded seed platform, lead 10 mm");
+}
+
+std::string model_source(const ModelOptions& opts) {
+  return opts.config.empty() ? std::string("embedded seed platform") : opts.config;
+}
+
+Model load_model_from(const ModelOptions& opts) {
+  try {
+    if (opts.config.empty()) return default_model();
+    std::error_code ec;
+    if (std::filesystem::is_directory(opts.config, ec))
+      throw ExitError(kExitBadInput, fmt::format("--config: '{}' is a directory, expected a YAML file",
+                                                 printable(opts.config)));
+    errno = 0;
+    std::ifstream in(opts.config, std::ios::binary);
+    if (!in)
+      throw ExitError(kExitBadInput, fmt::format("--config: cannot read config file '{}': {}", printable(opts.config),
+                                                 errno != 0 ? std::strerror(errno) : "cannot open"));
+    std::ostringstream text;
+    text << in.rdbuf();
+    return load_model(text.str(), opts.config);
+  } catch (const Error& e) {
+    throw ExitError(kExitBadInput, e.what());
+  }
+}
+
+std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option,
+                                  const std::string& what) {
+  std::vector<double> values;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = text.find(',', start);
+    std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    // Allow spaces around numbers ("0.1, 0, 0").
+    const auto first = item.find_first_not_of(" \t");
+    const auto last = item.find_last_not_of(" \t");
+    item = first == std::string::npos ? std::string() : item.substr(first, last - first + 1);
+    double v = 0.0;
+    const char* b = item.data();
+    const char* e = item.data() + item.size();
+    if (item.size() > 1 && *b == '+' && b[1] != '-' && b[1] != '+') ++b;  // from_chars takes no '+'
+    const auto [ptr, ec] = std::from_chars(b, e, v);
+    if (ec == std::errc::result_out_of_range && ptr == e)
+      throw ExitError(kExitBadInput, fmt::format("{}: value {} ('{}') is out of range; expected {}", option,
+                                                 values.size() + 1, printable(item), what));
+    if (item.empty() || ec != std::errc() || ptr != e)
+      throw ExitError(kExitBadInput, fmt::format("{}: value {} ('{}') is not a number; expected {}", option,
+                                                 values.size() + 1, printable(item), what));
+    if (!std::isfinite(v))
+      throw ExitError(kExitBadInput, fmt::format("{}: value {} ('{}') is not finite; expected {}", option,
+                                                 values.size() + 1, item, what));
+    values.push_back(v);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (values.size() != count)
+    throw ExitError(kExitBadInput, fmt::format("{}: expected {} comma-separated numbers ({}), got {}", option, count,
+                                               what, values.size()));
+  return values;
+}
+
+Pose parse_pose_m_deg(const std::string& text, const std::string& option) {
+  const auto v = parse_numbers(text, 6, option, "x,y,z [m], roll,pitch,yaw [deg]");
+  Pose p;
+  p.position = Vector3d(v[0], v[1], v[2]);
+  p.rpy = Vector3d(deg2rad(v[3]), deg2rad(v[4]), deg2rad(v[5]));
+  return p;
+}
+
+std::string describe_limit(const LimitReport& r) {
+  if (r.status == Status::Ok) return "ok";
+  const std::string leg = r.leg >= 0 ? fmt::format("leg {}: ", r.leg + 1) : std::string();
+  switch (r.status) {
+    case Status::StrokeBelowMin:
+      return fmt::format("{}length {:.6f} m is below the minimum {:.6f} m (limits.length_min)", leg, r.value, r.bound);
+    case Status::StrokeAboveMax:
+      return fmt::format("{}length {:.6f} m is above the maximum {:.6f} m (limits.length_max)", leg, r.value, r.bound);
+    case Status::BendBase:
+    case Status::BendPlatform:
+      return fmt::format("{}{} U-joint bends {:.3f} deg, above the limit {:.3f} deg (limits.bend_max_deg)", leg,
+                         r.status == Status::BendBase ? "base" : "platform", rad2deg(r.value), rad2deg(r.bound));
+    case Status::SingularBase:
+    case Status::SingularPlatform:
+      return fmt::format("{}leg is {:.3f} deg from the {} U-joint's fixed axis, inside the singularity margin {:.3f} deg",
+                         leg, rad2deg(r.value), r.status == Status::SingularBase ? "base" : "platform", rad2deg(r.bound));
+    default:
+      return leg + std::string(describe(r.status));
+  }
+}
+
+void write_limit_json(JsonWriter& json, const LimitReport& r) {
+  if (r.status == Status::Ok) {
+    json.null();
+    return;
+  }
+  json.begin_object().field("status", to_string(r.status));
+  if (r.leg >= 0) json.field("leg", r.leg + 1).field("value", r.value).field("bound", r.bound);
+  json.field("message", describe_limit(r)).end_object();
+}
+
+}  // namespace hexatwist::cli

@@ -1,0 +1,71 @@
+// Shared pieces of the hexatwist command-line tool: exit codes, input parsing, model loading.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "hexatwist/hexatwist.hpp"
+
+namespace hexatwist::cli {
+
+/// Exit codes of the tool.
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitBadInput = 2,    ///< malformed input, bad configuration, unreadable file
+  kExitOutOfLimit = 3,  ///< a pose outside a limit, or a forward-kinematics failure
+};
+
+/// A failure the tool reports as one line on stderr with its exit code.
+class ExitError : public std::runtime_error {
+ public:
+  ExitError(int code, const std::string& message) : std::runtime_error(message), code_(code) {}
+  int code() const noexcept { return code_; }
+
+ private:
+  int code_;
+};
+
+/// Options every command that needs a platform shares.
+struct ModelOptions {
+  std::string config;  ///< YAML file; empty = embedded seed platform
+};
+
+/// Adds --config to a subcommand.
+void add_model_options(CLI::App& app, ModelOptions& opts);
+
+/// Loads the model named by --config (or the embedded default); errors become ExitError(2).
+Model load_model_from(const ModelOptions& opts);
+
+/// Name of the platform source for messages.
+std::string model_source(const ModelOptions& opts);
+
+/// Parses exactly `count` comma-separated finite numbers given to option `option`; `what`
+/// describes them for the error message.
+std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option,
+                                  const std::string& what);
+
+/// Parses "x,y,z,roll,pitch,yaw" in m and degrees into a pose [m, rad].
+Pose parse_pose_m_deg(const std::string& text, const std::string& option);
+
+/// "leg 3: length 2.5012 m above the maximum 2.45 m": one line for a limit report.
+std::string describe_limit(const LimitReport& report);
+
+/// Writes a JSON object for a limit report (or null if none).
+class JsonWriter;
+void write_limit_json(JsonWriter& json, const LimitReport& report);
+
+/// Registers a subcommand; `run` is called when it was chosen and returns the exit code.
+struct Command {
+  CLI::App* app;
+  std::function<int()> run;
+};
+Command make_ik_command(CLI::App& root);
+Command make_fk_command(CLI::App& root);
+Command make_config_command(CLI::App& root);
+
+}  // namespace hexatwist::cli

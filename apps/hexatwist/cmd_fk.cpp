@@ -1,0 +1,90 @@
+// hexatwist fk: the pose for six leg lengths (geometric, or motor-side with the twist included).
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <memory>
+
+#include "cli_common.hpp"
+#include "json.hpp"
+
+namespace hexatwist::cli {
+namespace {
+
+struct FkOptionsCli {
+  ModelOptions model;
+  std::string lengths;
+  std::string guess = "0,0,0,0,0,0";
+  bool motor = false;
+  bool json = false;
+  int max_iterations = FkOptions{}.max_iterations;
+};
+
+int run_fk(const FkOptionsCli& o) {
+  const Model model = load_model_from(o.model);
+  const auto v = parse_numbers(o.lengths, 6, "--lengths", "six leg lengths L1..L6 [m]");
+  Vector6d lengths;
+  for (int i = 0; i < kLegs; ++i) lengths[i] = v[static_cast<std::size_t>(i)];
+  const Pose guess = parse_pose_m_deg(o.guess, "--guess");
+  const LengthKind kind = o.motor ? LengthKind::Motor : LengthKind::Geometric;
+  FkOptions fo;
+  fo.max_iterations = o.max_iterations;
+  auto result = std::make_unique<FkResult>();
+  const Status status = forward_kinematics(model, lengths, kind, placement_from_pose(guess), *result, fo);
+  LimitReport limit;
+  Status final_status = status;
+  if (status == Status::Ok) final_status = check_limits(model, result->legs, limit);
+  const Vector6d q = result->pose.to_vector();
+  const char* kind_name = o.motor ? "motor" : "geometric";
+
+  if (o.json) {
+    JsonWriter j;
+    j.begin_object().field("status", to_string(final_status)).field("lengths_kind", kind_name);
+    j.key("pose");
+    status == Status::Ok ? j.vector(q) : j.null();
+    j.field("iterations", result->iterations).field("residual", result->residual);
+    j.key("limit");
+    write_limit_json(j, limit);
+    j.end_object();
+    std::fputs(j.str().c_str(), stdout);
+  } else {
+    std::string out = fmt::format("hexatwist fk on {} ({} lengths{})\n", model_source(o.model), kind_name,
+                                  o.motor ? ", twist included" : "");
+    if (status == Status::Ok)
+      out += fmt::format("pose: x={:.9f} y={:.9f} z={:.9f} m, roll={:.9f} pitch={:.9f} yaw={:.9f} deg\n", q[0], q[1],
+                         q[2], rad2deg(q[3]), rad2deg(q[4]), rad2deg(q[5]));
+    out += fmt::format("iterations: {}, residual: {:.3g} m\n", result->iterations, result->residual);
+    out += fmt::format("status: {}\n", final_status == Status::Ok ? std::string("ok") : std::string(to_string(final_status)));
+    std::fputs(out.c_str(), stdout);
+  }
+  if (status != Status::Ok) {
+    std::fprintf(stderr, "hexatwist: forward kinematics failed: %s (%s) after %d iterations, residual %.3g m\n",
+                 std::string(to_string(status)).c_str(), std::string(describe(status)).c_str(), result->iterations,
+                 result->residual);
+    return kExitOutOfLimit;
+  }
+  if (final_status != Status::Ok) {
+    std::fprintf(stderr, "hexatwist: pose outside a limit: %s\n", describe_limit(limit).c_str());
+    return kExitOutOfLimit;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Command make_fk_command(CLI::App& root) {
+  auto opts = std::make_shared<FkOptionsCli>();
+  CLI::App* app = root.add_subcommand("fk", "Forward kinematics: the platform pose for six leg lengths");
+  app->add_option("--lengths", opts->lengths, "Six leg lengths L1,..,L6 in m")->required();
+  app->add_flag("--motor", opts->motor,
+                "The lengths are motor-side (encoder) lengths: solve with the twist included, giving the actual pose");
+  app->add_option("--guess", opts->guess, "Initial pose x,y,z [m], roll,pitch,yaw [deg]; default home")
+      ->capture_default_str();
+  app->add_option("--max-iterations", opts->max_iterations, "Newton iterations before giving up")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
+  add_model_options(*app, opts->model);
+  app->add_flag("--json", opts->json, "Machine-readable output (SI units: m, rad)");
+  return {app, [opts] { return run_fk(*opts); }};
+}
+
+}  // namespace hexatwist::cli

@@ -1,0 +1,102 @@
+// hexatwist ik: leg lengths, twist, length error and both motor commands for one pose.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "cli_common.hpp"
+#include "json.hpp"
+
+namespace hexatwist::cli {
+namespace {
+
+struct IkOptions {
+  ModelOptions model;
+  std::string pose = "0,0,0,0,0,0";
+  bool json = false;
+};
+
+// Prints a rounding-level value as 0 rather than -0.0000.
+double tidy(double v) { return std::abs(v) < 1e-12 ? 0.0 : v; }
+
+int run_ik(const IkOptions& o) {
+  const Model model = load_model_from(o.model);
+  const Pose pose = parse_pose_m_deg(o.pose, "--pose");
+  auto report = std::make_unique<CommandReport>();
+  const Status status = compute_commands(model, pose, *report);
+  if (status == Status::NonFiniteInput) throw ExitError(kExitBadInput, "--pose: non-finite value");
+  const bool ok = status == Status::Ok;
+  // The twist (and the length error) exist wherever no U-joint is singular, also outside the
+  // other limits; compute_commands leaves them unspecified otherwise.
+  LegState legs_check;
+  Vector6d twist_check;
+  const bool have_twist = inverse_kinematics(model, pose, legs_check) == Status::Ok &&
+                          twist(model, legs_check, twist_check) == Status::Ok;
+  Vector6d bend_base, bend_platform, theta;
+  bend_angles(model, report->legs, bend_base, bend_platform);
+  const bool have_abs = twist_absolute(model, report->legs, theta) == Status::Ok;
+
+  if (o.json) {
+    JsonWriter j;
+    j.begin_object().field("status", to_string(status)).field("model", model.spec().name);
+    j.key("pose").vector(pose.to_vector());
+    j.key("limit");
+    write_limit_json(j, report->limit);
+    j.key("legs").begin_array();
+    for (int i = 0; i < kLegs; ++i) {
+      j.begin_object().field("leg", i + 1).field("length", report->legs.length[i]);
+      j.key("twist");
+      have_twist ? j.value(report->twist[i]) : j.null();
+      j.key("twist_absolute");
+      (have_abs && !std::isnan(model.leg(i).theta_home)) ? j.value(theta[i]) : j.null();
+      j.key("length_error");
+      have_twist ? j.value(report->length_error[i]) : j.null();
+      // A command outside a limit is never emitted.
+      j.key("command_conventional");
+      ok ? j.value(report->conventional[i]) : j.null();
+      j.key("command_compensated");
+      ok ? j.value(report->compensated[i]) : j.null();
+      j.field("bend_base", bend_base[i]).field("bend_platform", bend_platform[i]).end_object();
+    }
+    j.end_array().end_object();
+    std::fputs(j.str().c_str(), stdout);
+  } else {
+    std::string out = fmt::format("hexatwist ik on {}: {}\n", model_source(o.model), model.spec().name);
+    out += fmt::format("pose: x={:.6g} y={:.6g} z={:.6g} m, roll={:.6g} pitch={:.6g} yaw={:.6g} deg\n",
+                       pose.position.x(), pose.position.y(), pose.position.z(), rad2deg(pose.rpy[0]),
+                       rad2deg(pose.rpy[1]), rad2deg(pose.rpy[2]));
+    out += "leg  length[m]  twist[deg]  length_error[mm]  command_conv[m]  command_comp[m]  bend_base[deg]  bend_platform[deg]\n";
+    for (int i = 0; i < kLegs; ++i) {
+      const std::string tw = have_twist ? fmt::format("{:10.4f}", rad2deg(tidy(report->twist[i]))) : fmt::format("{:>10}", "-");
+      const std::string le = have_twist ? fmt::format("{:16.4f}", 1e3 * tidy(report->length_error[i])) : fmt::format("{:>16}", "-");
+      const std::string cc = ok ? fmt::format("{:15.6f}", report->conventional[i]) : fmt::format("{:>15}", "-");
+      const std::string cp = ok ? fmt::format("{:15.6f}", report->compensated[i]) : fmt::format("{:>15}", "-");
+      out += fmt::format("{:>3}  {:9.6f}  {}  {}  {}  {}  {:14.3f}  {:18.3f}\n", i + 1, report->legs.length[i], tw, le, cc,
+                         cp, rad2deg(bend_base[i]), rad2deg(bend_platform[i]));
+    }
+    out += fmt::format("status: {}\n", ok ? "ok" : std::string(to_string(status)) + ": " + describe_limit(report->limit));
+    std::fputs(out.c_str(), stdout);
+  }
+  if (!ok) {
+    std::fprintf(stderr, "hexatwist: pose outside a limit: %s\n", describe_limit(report->limit).c_str());
+    return kExitOutOfLimit;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Command make_ik_command(CLI::App& root) {
+  auto opts = std::make_shared<IkOptions>();
+  CLI::App* app = root.add_subcommand(
+      "ik", "Inverse kinematics: per leg length, twist (passive rotation), length error, motor commands");
+  app->add_option("--pose", opts->pose,
+                  "Pose relative to home: x,y,z in m and roll,pitch,yaw in degrees, e.g. --pose=0.1,0,0.2,0,0,15")
+      ->capture_default_str();
+  add_model_options(*app, opts->model);
+  app->add_flag("--json", opts->json, "Machine-readable output (SI units: m, rad)");
+  return {app, [opts] { return run_ik(*opts); }};
+}
+
+}  // namespace hexatwist::cli

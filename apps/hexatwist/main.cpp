@@ -1,0 +1,74 @@
+// hexatwist: twist-aware kinematics of lead-screw Stewart platforms, from the command line.
+// This directory is the only code of the project that reads files and writes to the terminal.
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <string_view>
+
+#include "cli_common.hpp"
+
+namespace {
+
+// Every failure is one line on stderr: control characters in a message (a newline in a value
+// the user typed, or in a library message) are escaped.
+void print_error(std::string_view prefix, std::string_view message) {
+  std::string line(prefix);
+  for (const char c : message) {
+    const auto u = static_cast<unsigned char>(c);
+    line += (u < 0x20 || u == 0x7f) ? fmt::format("\\x{:02x}", u) : std::string(1, c);
+  }
+  std::fprintf(stderr, "%s\n", line.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace hexatwist::cli;
+  CLI::App app{
+      "hexatwist: twist-aware kinematics of lead-screw Stewart platforms.\n"
+      "Poses are typed as x,y,z [m] and roll,pitch,yaw [deg] (R = Rz*Ry*Rx); all JSON output is SI (m, rad).\n"
+      "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit or forward-kinematics failure."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
+  const std::vector<Command> commands{make_ik_command(app), make_fk_command(app), make_config_command(app)};
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // CLI11 reports an unknown subcommand as "a subcommand is required": name it instead. The
+    // root takes no option with a value, so the first word that is not an option is the command.
+    bool chosen = false;
+    for (const Command& c : commands) chosen = chosen || c.app->parsed();
+    for (int k = 1; k < argc && !chosen; ++k) {
+      const std::string_view word = argv[k];
+      if (word.starts_with("-")) continue;
+      for (const Command& c : commands) chosen = chosen || c.app->get_name() == word;
+      if (chosen) break;
+      print_error("hexatwist: error: ", fmt::format("unknown subcommand '{}'; expected ik, fk or config (see --help)", word));
+      return kExitBadInput;
+    }
+    print_error("hexatwist: error: ", fmt::format("{} (see --help)", e.what()));
+    return kExitBadInput;
+  }
+  try {
+    for (const Command& c : commands)
+      if (c.app->parsed()) return c.run();
+  } catch (const ExitError& e) {
+    print_error("hexatwist: error: ", e.what());
+    return e.code();
+  } catch (const hexatwist::Error& e) {
+    print_error("hexatwist: error: ", e.what());
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    print_error("hexatwist: internal error: ", e.what());
+    return 1;
+  }
+  return kExitBadInput;
+}

@@ -1,0 +1,24 @@
+// Platform configuration in YAML: parse text into a Model. Reading files is the caller's job.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "hexatwist/model.hpp"
+
+namespace hexatwist {
+
+/// The seed platform (configs/seed.yaml, embedded at build time) as YAML text.
+std::string_view seed_config_yaml() noexcept;
+
+/// Parses a YAML platform configuration. `source` names the text in error messages (a file name).
+/// Throws hexatwist::Error with a single line "source:line:column: field 'x.y': what was expected".
+ModelSpec parse_model_spec(std::string_view yaml_text, std::string_view source);
+
+/// parse_model_spec followed by Model validation (errors are prefixed with `source`).
+Model load_model(std::string_view yaml_text, std::string_view source);
+
+/// The embedded default: the seed platform with a 10 mm lead.
+Model default_model();
+
+}  // namespace hexatwist

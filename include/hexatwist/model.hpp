@@ -1,0 +1,131 @@
+// The immutable, validated description of a six-leg U-P-U lead-screw Stewart platform.
+#pragma once
+
+#include <string>
+
+#include "hexatwist/types.hpp"
+
+namespace hexatwist {
+
+/// Hand of the lead screw's thread.
+enum class ThreadSense { Right, Left };
+
+/// Which end of the leg carries the motor that turns the screw.
+enum class DrivenSide { Base, Platform };
+
+/// One leg as given by the user (unvalidated).
+struct LegSpec {
+  Vector3d base_B = Vector3d::Zero();         ///< base U-joint centre, A2 [m, B]
+  Vector3d platform_P = Vector3d::Zero();     ///< platform U-joint centre, A1 [m, P]
+  Vector3d axis_base_B = Vector3d::Zero();    ///< base U-joint fixed axis ja, Eq. (6) [-, B]
+  Vector3d axis_platform_P = Vector3d::Zero();///< platform U-joint fixed axis jd, Eq. (6) [-, P]
+  double lead = 0.0;                          ///< screw lead, travel per revolution [m]
+  ThreadSense thread = ThreadSense::Right;    ///< thread hand
+  DrivenSide driven = DrivenSide::Base;       ///< side whose motor turns the screw
+};
+
+/// Motion limits (unvalidated).
+struct LimitSpec {
+  double length_min = 0.0;          ///< shortest leg [m]
+  double length_max = 0.0;          ///< longest leg [m]
+  double bend_max = 0.0;            ///< largest U-joint bend away from its home direction [rad]
+  double singularity_margin = 0.0;  ///< smallest angle between a leg and a fixed U-joint axis [rad]
+};
+
+/// Everything a Model is built from. Frames: B is the base frame; P is the platform frame, equal
+/// to B translated by `home_height` along z at home.
+struct ModelSpec {
+  std::string name;                        ///< free text shown by the CLI
+  PerLeg<LegSpec> legs;                    ///< the six legs
+  double home_height = 0.0;                ///< height of P's origin above B's origin at home [m]
+  LimitSpec limits;                        ///< motion limits
+  Vector3d observation_P = Vector3d::Zero();///< observation point "A" [m, P]
+  Vector3d pivot_P = Vector3d::Zero();     ///< point about which pose rotations act [m, P]
+};
+
+/// A leg with everything that depends only on the geometry precomputed.
+struct Leg {
+  Vector3d base_B;           ///< base U-joint centre [m, B]
+  Vector3d platform_P;       ///< platform U-joint centre [m, P]
+  Vector3d arm_P;            ///< platform joint relative to the pivot, platform_P - pivot_P [m, P]
+  Vector3d axis_base_B;      ///< unit fixed base axis ja [-, B]
+  Vector3d axis_platform_P;  ///< unit fixed platform axis jd [-, P]
+  Vector3d s_home_B;         ///< unit leg axis at home, base to platform [-, B]
+  double length_home;        ///< leg length at home [m]
+  double theta_home;         ///< absolute twist angle jb -> je at home [rad]; NaN if lead is 0
+  double cos_theta_home;     ///< cos(theta_home)
+  double sin_theta_home;     ///< sin(theta_home)
+  double lead;               ///< screw lead [m]
+  double twist_sign;         ///< +1 right-hand thread driven at the base; each flip negates
+  double twist_gain;         ///< twist_sign * lead / 2pi: real minus motor-side length per rad [m/rad]
+  ThreadSense thread;        ///< thread hand
+  DrivenSide driven;         ///< driven side
+};
+
+/// The legs' precomputed geometry with one leg per row, for code vectorised over legs.
+struct LegGeometry {
+  LegVectors base_B;           ///< base U-joint centres [m, B]
+  LegVectors arm_P;            ///< platform joints relative to the pivot [m, P]
+  LegVectors axis_base_B;      ///< unit fixed base axes ja; zero rows for legs without axes [-, B]
+  LegVectors axis_platform_P;  ///< unit fixed platform axes jd; zero rows for legs without axes [-, P]
+  LegVectors s_home_B;         ///< unit leg axes at home [-, B]
+  Vector6d cos_theta_home;     ///< cos of the absolute twist at home (1 without axes)
+  Vector6d sin_theta_home;     ///< sin of the absolute twist at home (0 without axes)
+  Vector6d twist_gain;         ///< real minus motor-side length per rad of twist [m/rad]
+  Vector6d has_axes;           ///< 1 for legs whose U-joint axes are given, else 0
+};
+
+/// Immutable, validated platform model. Construction throws hexatwist::Error naming the leg and
+/// field at fault; every other function of the library takes a `const Model&` and never throws.
+class Model {
+ public:
+  /// Validates `spec` and precomputes the home configuration.
+  explicit Model(const ModelSpec& spec);
+
+  /// The specification this model was built from (axes as given, not normalised).
+  const ModelSpec& spec() const noexcept { return spec_; }
+  /// Leg `i` (0-based).
+  const Leg& leg(int i) const noexcept { return legs_[static_cast<std::size_t>(i)]; }
+  /// All legs.
+  const PerLeg<Leg>& legs() const noexcept { return legs_; }
+  /// Position of the pivot at home, (0,0,home_height) + pivot_P [m, B].
+  const Vector3d& pivot_home_B() const noexcept { return pivot_home_B_; }
+  /// True if any leg has a non-zero lead (the twist term matters).
+  bool has_twist() const noexcept { return has_twist_; }
+  /// Leg lengths at home [m].
+  const Vector6d& length_home() const noexcept { return length_home_; }
+  /// The legs one per row (the same numbers as leg(i), laid out for vectorised code).
+  const LegGeometry& geometry() const noexcept { return geometry_; }
+  /// cos(bend_max), precomputed for the limit check.
+  double cos_bend_max() const noexcept { return cos_bend_max_; }
+  /// cos(singularity_margin)^2, precomputed for the limit check.
+  double cos2_singularity_margin() const noexcept { return cos2_singularity_margin_; }
+
+ private:
+  ModelSpec spec_;
+  PerLeg<Leg> legs_;
+  LegGeometry geometry_;
+  Vector3d pivot_home_B_;
+  Vector6d length_home_;
+  double cos_bend_max_ = 1.0;
+  double cos2_singularity_margin_ = 1.0;
+  bool has_twist_ = false;
+};
+
+/// Joint positions and axes of a "symmetric" platform: the seed's parameters, Eq. (6), joints in
+/// pairs with tangential fixed axes (layout in docs/theory.md).
+struct SymmetricSpec {
+  double Ra = 0.0;  ///< platform joint-pair radius [m]
+  double Rb = 0.0;  ///< base joint-pair radius [m]
+  double da = 0.0;  ///< distance between the two platform joints of a pair [m]
+  double db = 0.0;  ///< distance between the two base joints of a pair [m]
+  double H = 0.0;   ///< height of the platform joint plane above the base joint plane at home [m]
+  std::array<double, 3> base_pair_angles{deg2rad(60), deg2rad(-60), deg2rad(180)};  ///< pairs (1,6),(2,3),(4,5) [rad]
+  std::array<double, 3> platform_pair_angles{0.0, deg2rad(240), deg2rad(120)};    ///< pairs (1,2),(3,4),(5,6) [rad]
+};
+
+/// Leg geometry (positions and fixed axes) of a symmetric platform; lead, thread and driven side
+/// are left at their defaults for the caller to set.
+PerLeg<LegSpec> symmetric_legs(const SymmetricSpec& s);
+
+}  // namespace hexatwist

@@ -1,0 +1,34 @@
+// Outcome codes of the numerical functions (the real-time path never throws).
+#pragma once
+
+#include <string_view>
+
+namespace hexatwist {
+
+/// Result of a numerical call. `Ok` is the only success; every other value names what failed.
+enum class Status : int {
+  Ok = 0,
+  NonFiniteInput,    ///< a pose, length or guess holds NaN or inf
+  StrokeBelowMin,    ///< a leg is shorter than its minimum length
+  StrokeAboveMax,    ///< a leg is longer than its maximum length
+  BendBase,          ///< the base U-joint bends further than the bend limit
+  BendPlatform,      ///< the platform U-joint bends further than the bend limit
+  SingularBase,      ///< the leg is (nearly) parallel to the base U-joint's fixed axis
+  SingularPlatform,  ///< the leg is (nearly) parallel to the platform U-joint's fixed axis
+  NoConvergence,     ///< forward kinematics did not reach its tolerance
+  SingularJacobian,  ///< forward kinematics met a singular platform Jacobian
+};
+
+/// True for the statuses that mean "this pose is outside a limit".
+constexpr bool is_limit(Status s) noexcept {
+  return s == Status::StrokeBelowMin || s == Status::StrokeAboveMax || s == Status::BendBase ||
+         s == Status::BendPlatform || s == Status::SingularBase || s == Status::SingularPlatform;
+}
+
+/// Stable snake_case name of a status, as written in JSON (`"stroke_above_max"`).
+std::string_view to_string(Status s) noexcept;
+
+/// One-sentence description of a status for people.
+std::string_view describe(Status s) noexcept;
+
+}  // namespace hexatwist

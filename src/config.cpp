@@ -1,0 +1,420 @@
+#include "hexatwist/config.hpp"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstring>
+#include <initializer_list>
+#include <map>
+#include <vector>
+
+#include "hexatwist/error.hpp"
+
+namespace hexatwist {
+namespace {
+
+// Text from the document or a file name as it may appear inside a one-line message: control
+// characters escaped, and (if `max` is set) cut at a character boundary after `max` bytes.
+std::string one_line(std::string_view s, std::size_t max = std::string_view::npos) {
+  std::size_t n = std::min(s.size(), max);
+  while (n < s.size() && n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;  // UTF-8 continuation
+  std::string out;
+  for (const char c : s.substr(0, n)) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\n') out += "\\n";
+    else if (c == '\r') out += "\\r";
+    else if (c == '\t') out += "\\t";
+    else if (u < 0x20 || u == 0x7f) out += fmt::format("\\x{:02x}", u);
+    else out += c;
+  }
+  if (n < s.size()) out += "...";
+  return out;
+}
+
+// A document value quoted for a message.
+std::string quoted(const YAML::Node& n) { return "'" + one_line(n.Scalar(), 40) + "'"; }
+
+// "a list", "a mapping", ... for messages about a value of the wrong kind.
+const char* kind(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Sequence: return "a list";
+    case YAML::NodeType::Map: return "a mapping";
+    case YAML::NodeType::Null: return "nothing";
+    default: return "a scalar";
+  }
+}
+
+// A place in the document: the node (undefined if its key is absent), its dotted path for
+// messages, and the mark of the key that introduces it (of the enclosing block if absent).
+// Never assign a Field: assigning a yaml-cpp node copies content, and throws for an absent one.
+struct Field {
+  YAML::Node node;
+  std::string path;
+  YAML::Mark key;
+
+  bool present() const { return node.IsDefined(); }
+  // Where to point for an error about the value: a scalar's own position, else its key's
+  // (yaml-cpp marks an empty value at the next key and a block collection at its first entry).
+  YAML::Mark at() const { return present() && node.IsScalar() ? node.Mark() : key; }
+};
+
+// Where a value that the Model validates came from, to turn a Model error into a located one.
+struct Loc {
+  std::string path;
+  YAML::Mark mark;
+};
+using Locations = std::map<std::string, Loc>;
+
+Loc loc(const Field& f) { return {f.path, f.at()}; }
+
+// Reads one YAML document; every error names source:line:column and the dotted field path.
+class Reader {
+ public:
+  explicit Reader(std::string_view source) : source_(one_line(source)) {}
+
+  [[noreturn]] void fail(const YAML::Mark& at, const std::string& field, const std::string& msg) const {
+    throw Error(fmt::format("{}: field '{}': {}", where(at), field, msg));
+  }
+
+  std::string where(const YAML::Mark& m) const {
+    if (m.is_null()) return source_;
+    return fmt::format("{}:{}:{}", source_, m.line + 1, m.column + 1);
+  }
+
+  // The value under `key` of the mapping `parent` (absent or not).
+  static Field child(const Field& parent, const char* key) {
+    const YAML::Node& map = parent.node;
+    YAML::Mark mark = parent.key;
+    for (const auto& kv : map)
+      if (kv.first.IsScalar() && kv.first.Scalar() == key) {
+        mark = kv.first.Mark();
+        break;
+      }
+    return Field{map[key], join(parent.path, key), mark};
+  }
+
+  // Entry `i` of the list `seq`.
+  static Field item(const Field& seq, std::size_t i, std::string path) {
+    const YAML::Node n = seq.node[i];
+    return Field{n, std::move(path), n.IsNull() ? seq.key : n.Mark()};
+  }
+
+  void require(const Field& f, std::string_view what) const {
+    if (!f.present()) fail(f.key, f.path, fmt::format("missing; expected {}", what));
+  }
+
+  void require_map(const Field& f, std::string_view what) const {
+    require(f, what);
+    if (!f.node.IsMap()) fail(f.at(), f.path, fmt::format("expected a mapping ({}), got {}", what, kind(f.node)));
+  }
+
+  // Rejects keys outside `allowed` (typos must not pass silently) and keys given twice (yaml-cpp
+  // would silently keep the first).
+  void only_keys(const Field& map, std::initializer_list<const char*> allowed) const {
+    std::map<std::string, int> seen;
+    for (const auto& kv : map.node) {
+      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string();
+      const std::string shown = kv.first.IsScalar() ? one_line(key, 40) : std::string("<") + kind(kv.first) + ">";
+      bool ok = false;
+      for (const char* a : allowed) ok = ok || key == a;
+      if (!ok) {
+        std::string list;
+        for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+        fail(kv.first.Mark(), join(map.path, shown), fmt::format("unknown key; expected one of: {}", list));
+      }
+      if (const auto [it, fresh] = seen.emplace(key, kv.first.Mark().line + 1); !fresh)
+        fail(kv.first.Mark(), join(map.path, key), fmt::format("given twice (first on line {})", it->second));
+    }
+  }
+
+  double number(const Field& f, std::string_view what) const {
+    require(f, what);
+    if (f.node.IsNull()) fail(f.at(), f.path, fmt::format("no value; expected a number ({})", what));
+    if (!f.node.IsScalar()) fail(f.at(), f.path, fmt::format("expected a number ({}), got {}", what, kind(f.node)));
+    double v = 0.0;
+    if (!YAML::convert<double>::decode(f.node, v))
+      fail(f.at(), f.path, fmt::format("expected a number ({}), got {}", what, quoted(f.node)));
+    if (!std::isfinite(v))
+      fail(f.at(), f.path, fmt::format("expected a finite number ({}), got {}", what, quoted(f.node)));
+    return v;
+  }
+
+  double number_or(const Field& f, std::string_view what, double fallback) const {
+    return f.present() ? number(f, what) : fallback;
+  }
+
+  Vector3d vec3(const Field& f, std::string_view what) const {
+    require(f, what);
+    if (!f.node.IsSequence() || f.node.size() != 3)
+      fail(f.at(), f.path,
+           fmt::format("expected a list of three numbers [x, y, z] ({}), got {}", what,
+                       f.node.IsSequence() ? fmt::format("{} numbers", f.node.size()) : std::string(kind(f.node))));
+    Vector3d v;
+    for (std::size_t i = 0; i < 3; ++i)
+      v[static_cast<Eigen::Index>(i)] = number(item(f, i, fmt::format("{}[{}]", f.path, i)), what);
+    return v;
+  }
+
+  std::string word(const Field& f, std::string_view what, std::initializer_list<const char*> choices) const {
+    std::string list;
+    for (const char* c : choices) list += (list.empty() ? "" : " or ") + std::string(c);
+    require(f, fmt::format("{} ({})", list, what));
+    if (!f.node.IsScalar()) fail(f.at(), f.path, fmt::format("expected {} ({}), got {}", list, what, kind(f.node)));
+    for (const char* c : choices)
+      if (f.node.Scalar() == c) return c;
+    fail(f.at(), f.path, fmt::format("expected {} ({}), got {}", list, what, quoted(f.node)));
+  }
+
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+
+ private:
+  std::string source_;
+};
+
+struct Screw {
+  double lead = 0.0;
+  ThreadSense thread = ThreadSense::Right;
+  DrivenSide driven = DrivenSide::Base;
+  bool thread_given = false;  // thread / driven_side were written (here or in `screw`)
+  bool driven_given = false;
+  Loc lead_at;                // where the lead came from
+};
+
+constexpr const char* kThreadWhat = "thread hand; needed when lead > 0";
+constexpr const char* kDrivenWhat = "side whose motor turns the screw; needed when lead > 0";
+
+// Reads lead / thread / driven_side from `n` (the `screw` block or a leg), on top of `s`. The
+// `screw` block (top) must give a lead, and a thread and driven side when that lead is > 0.
+Screw read_screw(const Reader& r, const Field& n, Screw s, bool top) {
+  const Field lead = Reader::child(n, "lead");
+  if (top || lead.present()) {
+    s.lead = r.number(lead, "screw travel per revolution [m], >= 0; 0 = no twist");
+    if (s.lead < 0.0) r.fail(lead.at(), lead.path, fmt::format("expected >= 0 m, got {}", s.lead));
+    s.lead_at = loc(lead);
+  }
+  const bool need_sense = top && s.lead > 0.0;
+  const Field thread = Reader::child(n, "thread");
+  if (need_sense || thread.present()) {
+    s.thread = r.word(thread, kThreadWhat, {"right", "left"}) == "right" ? ThreadSense::Right : ThreadSense::Left;
+    s.thread_given = true;
+  }
+  const Field driven = Reader::child(n, "driven_side");
+  if (need_sense || driven.present()) {
+    s.driven = r.word(driven, kDrivenWhat, {"base", "platform"}) == "base" ? DrivenSide::Base : DrivenSide::Platform;
+    s.driven_given = true;
+  }
+  // A leg with its own lead > 0 needs a thread and driven side, its own or the screw block's.
+  if (!top && s.lead > 0.0) {
+    if (!s.thread_given) r.require(thread, fmt::format("right or left ({}; or set screw.thread)", kThreadWhat));
+    if (!s.driven_given) r.require(driven, fmt::format("base or platform ({}; or set screw.driven_side)", kDrivenWhat));
+  }
+  return s;
+}
+
+ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& locs) {
+  const Reader r(source);
+  std::vector<YAML::Node> docs;
+  try {
+    docs = YAML::LoadAll(std::string(yaml_text));
+  } catch (const YAML::Exception& e) {
+    throw Error(fmt::format("{}: YAML syntax error: {}", r.where(e.mark), one_line(e.msg)));
+  }
+  if (docs.size() > 1)
+    throw Error(fmt::format("{}: expected one YAML document, found {} (remove the extra '---')",
+                            r.where(docs[1].Mark()), docs.size()));
+  const YAML::Node root = docs.empty() ? YAML::Node() : docs[0];
+  if (root.IsNull())
+    throw Error(fmt::format("{}:1:1: empty document; expected a mapping with 'symmetric' or 'legs', 'screw' and 'limits'",
+                            one_line(source)));
+  if (!root.IsMap())
+    throw Error(fmt::format("{}: expected a mapping with 'symmetric' or 'legs', 'screw' and 'limits' at top level, got {}",
+                            r.where(root.Mark()), kind(root)));
+  const Field top{root, "", root.Mark()};
+  r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "limits", "observation_point", "pivot"});
+
+  ModelSpec spec;
+  const Field name = Reader::child(top, "name");
+  if (name.present() && !name.node.IsScalar() && !name.node.IsNull())
+    r.fail(name.at(), name.path, fmt::format("expected text, got {}", kind(name.node)));
+  spec.name = name.present() && name.node.IsScalar() ? name.node.Scalar() : std::string(source);
+
+  const Field screw_f = Reader::child(top, "screw");
+  r.require_map(screw_f, "lead, thread, driven_side");
+  r.only_keys(screw_f, {"lead", "thread", "driven_side"});
+  const Screw screw = read_screw(r, screw_f, Screw{}, true);
+
+  const Field sym = Reader::child(top, "symmetric");
+  const Field legs = Reader::child(top, "legs");
+  constexpr const char* kOneOf = "give exactly one of 'symmetric' (Ra, Rb, da, db, H) or 'legs' (six explicit legs)";
+  if (sym.present() && legs.present()) {
+    const bool legs_later = legs.key.line > sym.key.line;
+    const Field& second = legs_later ? legs : sym;
+    const Field& first = legs_later ? sym : legs;
+    r.fail(second.key, second.path, fmt::format("not allowed together with '{}' (line {}); {}", first.path,
+                                                first.key.line + 1, kOneOf));
+  }
+  if (!sym.present() && !legs.present()) throw Error(fmt::format("{}: {}; found neither", r.where(top.key), kOneOf));
+
+  if (sym.present()) {
+    r.require_map(sym, "Ra, Rb, da, db, H");
+    r.only_keys(sym, {"Ra", "Rb", "da", "db", "H", "base_pair_angles_deg", "platform_pair_angles_deg"});
+    if (const Field hh = Reader::child(top, "home_height"); hh.present())
+      r.fail(hh.key, hh.path, "not allowed with 'symmetric' (use symmetric.H)");
+    auto length = [&](const char* key, const char* what, bool zero_ok) {
+      const Field f = Reader::child(sym, key);
+      const double v = r.number(f, what);
+      if (zero_ok ? v < 0.0 : v <= 0.0) r.fail(f.at(), f.path, fmt::format("expected {} 0 m, got {}", zero_ok ? ">=" : ">", v));
+      return v;
+    };
+    SymmetricSpec ss;
+    ss.Ra = length("Ra", "platform joint-pair radius [m]", false);
+    ss.Rb = length("Rb", "base joint-pair radius [m]", false);
+    ss.da = length("da", "platform joint spacing in a pair [m]", true);
+    ss.db = length("db", "base joint spacing in a pair [m]", true);
+    ss.H = length("H", "home height of the platform joints above the base joints [m]", false);
+    auto angles = [&](const char* key, std::array<double, 3>& out) {
+      const Field f = Reader::child(sym, key);
+      if (!f.present()) return;
+      const Vector3d a = r.vec3(f, "three pair-centre angles [deg]");
+      for (int i = 0; i < 3; ++i) out[static_cast<std::size_t>(i)] = deg2rad(a[i]);
+    };
+    angles("base_pair_angles_deg", ss.base_pair_angles);
+    angles("platform_pair_angles_deg", ss.platform_pair_angles);
+    spec.legs = symmetric_legs(ss);
+    spec.home_height = ss.H;
+    spec.observation_P = Vector3d(ss.Ra, 0.0, 0.0);
+    for (LegSpec& leg : spec.legs) {
+      leg.lead = screw.lead;
+      leg.thread = screw.thread;
+      leg.driven = screw.driven;
+    }
+    // The legs are derived from the whole block: their errors point at it.
+    locs["legs"] = Loc{"symmetric", sym.key};
+    locs["home_height"] = loc(Reader::child(sym, "H"));
+  } else {
+    const Field hh = Reader::child(top, "home_height");
+    spec.home_height = r.number(hh, "height of the platform frame above the base frame at home [m]");
+    locs["home_height"] = loc(hh);
+    if (!legs.node.IsSequence() || legs.node.size() != kLegs)
+      r.fail(legs.key, legs.path,
+             fmt::format("expected a list of exactly 6 legs, got {}",
+                         legs.node.IsSequence() ? fmt::format("{}", legs.node.size()) : std::string(kind(legs.node))));
+    locs["legs"] = Loc{"legs", legs.key};
+    double farthest = -1.0;
+    for (int i = 0; i < kLegs; ++i) {
+      const Field n = Reader::item(legs, static_cast<std::size_t>(i), fmt::format("legs[{}] (leg {})", i, i + 1));
+      if (!n.node.IsMap())
+        r.fail(n.at(), n.path, fmt::format("expected a mapping with base, platform, base_axis, platform_axis, got {}",
+                                           kind(n.node)));
+      r.only_keys(n, {"base", "platform", "base_axis", "platform_axis", "lead", "thread", "driven_side"});
+      const std::string who = fmt::format("leg {}", i + 1);
+      locs[who] = Loc{n.path, n.key};
+      LegSpec& leg = spec.legs[static_cast<std::size_t>(i)];
+      const Field base = Reader::child(n, "base");
+      leg.base_B = r.vec3(base, "base joint [m, base frame]");
+      locs[who + ": base"] = loc(base);
+      const Field platform = Reader::child(n, "platform");
+      leg.platform_P = r.vec3(platform, "platform joint [m, platform frame]");
+      locs[who + ": platform"] = loc(platform);
+      const Screw ls = read_screw(r, n, screw, false);
+      leg.lead = ls.lead;
+      leg.thread = ls.thread;
+      leg.driven = ls.driven;
+      locs[who + ": lead"] = ls.lead_at;
+      const bool need_axes = leg.lead > 0.0;
+      const Field base_axis = Reader::child(n, "base_axis");
+      if (need_axes || base_axis.present()) {
+        leg.axis_base_B = r.vec3(base_axis, "base U-joint fixed axis, base frame; needed when lead > 0");
+        locs[who + ": base_axis"] = loc(base_axis);
+      }
+      const Field platform_axis = Reader::child(n, "platform_axis");
+      if (need_axes || platform_axis.present()) {
+        leg.axis_platform_P = r.vec3(platform_axis, "platform U-joint fixed axis, platform frame; needed when lead > 0");
+        locs[who + ": platform_axis"] = loc(platform_axis);
+      }
+      // Default observation point: the platform joint farthest from the platform centre.
+      const double rho = leg.platform_P.head<2>().norm();
+      if (rho > farthest) {
+        farthest = rho;
+        spec.observation_P = leg.platform_P;
+      }
+    }
+  }
+
+  const Field lim = Reader::child(top, "limits");
+  r.require_map(lim, "length_min, length_max [m]");
+  r.only_keys(lim, {"length_min", "length_max", "bend_max_deg", "singularity_margin_deg"});
+  const Field lmin = Reader::child(lim, "length_min"), lmax = Reader::child(lim, "length_max");
+  const Field bend = Reader::child(lim, "bend_max_deg"), margin = Reader::child(lim, "singularity_margin_deg");
+  spec.limits.length_min = r.number(lmin, "shortest leg [m]");
+  spec.limits.length_max = r.number(lmax, "longest leg [m]");
+  spec.limits.bend_max = deg2rad(r.number_or(bend, "largest U-joint bend [deg]", 30.0));
+  spec.limits.singularity_margin = deg2rad(r.number_or(margin, "smallest leg-to-axis angle [deg]", 5.0));
+  locs["limits.length_min"] = loc(lmin);
+  locs["limits.length_max"] = loc(lmax);
+  locs["limits.bend_max"] = loc(bend);
+  locs["limits.singularity_margin"] = loc(margin);
+
+  const Field obs = Reader::child(top, "observation_point"), pivot = Reader::child(top, "pivot");
+  if (obs.present()) spec.observation_P = r.vec3(obs, "[m, platform frame]");
+  if (pivot.present()) spec.pivot_P = r.vec3(pivot, "[m, platform frame]");
+  locs["observation_point"] = loc(obs);
+  locs["pivot"] = loc(pivot);
+  return spec;
+}
+
+// Turns a Model error into a located one. Model messages are "field: what", with field one of
+// home_height, limits.<x>, observation_point, pivot, legs, "leg N" or "leg N: <sub>" (see
+// src/model.cpp); the field is replaced by the place in the document it came from.
+std::string locate(const Reader& r, const Locations& locs, std::string_view source, std::string_view msg) {
+  const std::size_t colon = msg.find(": ");
+  if (colon == std::string_view::npos) return fmt::format("{}: {}", one_line(source), msg);
+  std::string field(msg.substr(0, colon));
+  std::string_view what = msg.substr(colon + 2);
+  std::string sub;
+  const bool leg_field = field.starts_with("leg ");
+  if (leg_field)
+    for (const char* s : {"base_axis", "platform_axis", "base", "platform", "lead"}) {
+      const std::size_t n = std::strlen(s);
+      if (what.starts_with(s) && what.substr(n).starts_with(": ")) {
+        sub = s;
+        what = what.substr(n + 2);
+        break;
+      }
+    }
+  const auto found = [&](const std::string& key) { return locs.find(key); };
+  if (auto it = found(sub.empty() ? field : field + ": " + sub); it != locs.end())
+    return fmt::format("{}: field '{}': {}", r.where(it->second.mark), it->second.path, what);
+  if (leg_field) {
+    if (auto it = found(field); it != locs.end())
+      return fmt::format("{}: field '{}': {}", r.where(it->second.mark), Reader::join(it->second.path, sub), what);
+    // A derived (symmetric) leg: point at the block and keep the leg in the message.
+    if (auto it = found("legs"); it != locs.end())
+      return fmt::format("{}: field '{}': {}", r.where(it->second.mark), it->second.path, msg);
+  }
+  return fmt::format("{}: {}", one_line(source), msg);
+}
+
+}  // namespace
+
+ModelSpec parse_model_spec(std::string_view yaml_text, std::string_view source) {
+  Locations locs;
+  return parse(yaml_text, source, locs);
+}
+
+Model load_model(std::string_view yaml_text, std::string_view source) {
+  Locations locs;
+  const ModelSpec spec = parse(yaml_text, source, locs);
+  try {
+    return Model(spec);
+  } catch (const Error& e) {
+    throw Error(locate(Reader(source), locs, source, e.what()));
+  }
+}
+
+Model default_model() { return load_model(seed_config_yaml(), "seed platform (embedded configs/seed.yaml)"); }
+
+}  // namespace hexatwist

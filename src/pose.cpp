@@ -1,0 +1,74 @@
+#include "hexatwist/pose.hpp"
+
+#include <cmath>
+
+#include "fast_math.hpp"
+
+namespace hexatwist {
+
+Pose Pose::from_vector(const Vector6d& q) noexcept {
+  Pose p;
+  p.position = q.head<3>();
+  p.rpy = q.tail<3>();
+  return p;
+}
+
+Vector6d Pose::to_vector() const noexcept {
+  Vector6d q;
+  q << position, rpy;
+  return q;
+}
+
+bool Pose::is_finite() const noexcept {
+  // x * 0 is 0 for finite x and NaN otherwise: one test for all six components.
+  return (position.array() * 0.0).sum() + (rpy.array() * 0.0).sum() == 0.0;
+}
+
+Matrix3d rotation_from_rpy(const Vector3d& rpy) noexcept {
+  // Eq. (3): R = Rz(q6) Ry(q5) Rx(q4), written out to avoid three matrix products.
+  Vector3d sn, cs;
+  detail::sin_cos(rpy, sn, cs);
+  const double c4 = cs[0], s4 = sn[0], c5 = cs[1], s5 = sn[1], c6 = cs[2], s6 = sn[2];
+  Matrix3d R;
+  R << c5 * c6, s4 * s5 * c6 - c4 * s6, c4 * s5 * c6 + s4 * s6,  //
+      c5 * s6, s4 * s5 * s6 + c4 * c6, c4 * s5 * s6 - s4 * c6,   //
+      -s5, s4 * c5, c4 * c5;
+  return R;
+}
+
+Vector3d rpy_from_rotation(const Matrix3d& R) noexcept {
+  const double pitch = std::atan2(-R(2, 0), std::hypot(R(0, 0), R(1, 0)));
+  const double roll = std::atan2(R(2, 1), R(2, 2));
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  return {roll, pitch, yaw};
+}
+
+Matrix3d exp_so3(const Vector3d& w) noexcept {
+  const double a2 = w.squaredNorm();
+  Matrix3d W;
+  W << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+  double A, B;  // R = I + A W + B W^2
+  if (a2 < 1e-12) {
+    // Taylor series: error below 1e-25 for |w| < 1e-6.
+    A = 1.0 - a2 / 6.0;
+    B = 0.5 - a2 / 24.0;
+  } else {
+    const double a = std::sqrt(a2);
+    A = std::sin(a) / a;
+    B = (1.0 - std::cos(a)) / a2;
+  }
+  return Matrix3d::Identity() + A * W + B * (W * W);
+}
+
+Placement placement_from_pose(const Pose& pose) noexcept {
+  return Placement{pose.position, rotation_from_rpy(pose.rpy)};
+}
+
+Pose pose_from_placement(const Placement& x) noexcept {
+  Pose p;
+  p.position = x.t;
+  p.rpy = rpy_from_rotation(x.R_BP);
+  return p;
+}
+
+}  // namespace hexatwist

@@ -1,0 +1,37 @@
+#include "hexatwist/status.hpp"
+
+namespace hexatwist {
+
+std::string_view to_string(Status s) noexcept {
+  switch (s) {
+    case Status::Ok: return "ok";
+    case Status::NonFiniteInput: return "non_finite_input";
+    case Status::StrokeBelowMin: return "stroke_below_min";
+    case Status::StrokeAboveMax: return "stroke_above_max";
+    case Status::BendBase: return "bend_base";
+    case Status::BendPlatform: return "bend_platform";
+    case Status::SingularBase: return "singular_base";
+    case Status::SingularPlatform: return "singular_platform";
+    case Status::NoConvergence: return "no_convergence";
+    case Status::SingularJacobian: return "singular_jacobian";
+  }
+  return "unknown";
+}
+
+std::string_view describe(Status s) noexcept {
+  switch (s) {
+    case Status::Ok: return "ok";
+    case Status::NonFiniteInput: return "input holds NaN or inf";
+    case Status::StrokeBelowMin: return "leg shorter than its minimum length";
+    case Status::StrokeAboveMax: return "leg longer than its maximum length";
+    case Status::BendBase: return "base U-joint bent past its limit";
+    case Status::BendPlatform: return "platform U-joint bent past its limit";
+    case Status::SingularBase: return "leg too close to the base U-joint's fixed axis (singular joint)";
+    case Status::SingularPlatform: return "leg too close to the platform U-joint's fixed axis (singular joint)";
+    case Status::NoConvergence: return "forward kinematics did not converge";
+    case Status::SingularJacobian: return "forward kinematics met a singular platform Jacobian";
+  }
+  return "unknown status";
+}
+
+}  // namespace hexatwist

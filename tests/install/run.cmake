@@ -1,0 +1,20 @@
+# Installs the build tree into a scratch prefix, then configures, builds and runs an outside
+# project that uses find_package(hexatwist). Run by ctest (tests/CMakeLists.txt).
+file(REMOVE_RECURSE "${WORK_DIR}")
+function(step)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "failed (${rc}): ${ARGN}\n${out}\n${err}")
+  endif()
+  set(step_output "${out}" PARENT_SCOPE)
+endfunction()
+step(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix")
+step(${CMAKE_COMMAND} -S "${SOURCE_DIR}" -B "${WORK_DIR}/build" -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=Release
+     "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix")
+step(${CMAKE_COMMAND} --build "${WORK_DIR}/build")
+step("${WORK_DIR}/build/consumer")
+message(STATUS "consumer: ${step_output}")
+step("${WORK_DIR}/prefix/bin/hexatwist" ik --json)
+if(NOT step_output MATCHES "\"status\": \"ok\"")
+  message(FATAL_ERROR "installed hexatwist ik did not report ok:\n${step_output}")
+endif()

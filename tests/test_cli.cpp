@@ -1,0 +1,434 @@
+// The hexatwist command-line tool, end to end: runs the real binary, reads its JSON, checks exit
+// codes (0 ok, 2 bad input, 3 outside a limit or FK failure) and that every error is one line.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+double deg2rad(double d) { return d * kPi / 180.0; }
+
+// A fresh directory for the files of this run, removed at exit.
+const std::filesystem::path& temp_dir() {
+  struct Dir {
+    std::filesystem::path path;
+    Dir() {
+      std::string tmpl = (std::filesystem::temp_directory_path() / "hexatwist_cli_XXXXXX").string();
+      if (mkdtemp(tmpl.data()) == nullptr) std::abort();
+      path = tmpl;
+    }
+    ~Dir() {
+      std::error_code ec;
+      std::filesystem::remove_all(path, ec);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
+}
+
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Writes `text` to a new file in the temp dir; returns its path.
+std::string write_file(const std::string& name, const std::string& text) {
+  const std::filesystem::path path = temp_dir() / name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path.string();
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (const char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+struct Outcome {
+  int code = -1;
+  std::string out, err;
+  std::string command;
+};
+
+// Runs the tool with `args`; stdout through a pipe, stderr through a file.
+Outcome run(const std::vector<std::string>& args) {
+  Outcome r;
+  const std::filesystem::path err_path = temp_dir() / "stderr.txt";
+  r.command = shell_quote(HEXATWIST_CLI);
+  for (const std::string& a : args) r.command += " " + shell_quote(a);
+  FILE* pipe = popen((r.command + " 2>" + shell_quote(err_path.string())).c_str(), "r");
+  if (pipe == nullptr) return r;
+  std::array<char, 4096> buf;
+  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) r.out.append(buf.data(), n);
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.err = read_file(err_path);
+  return r;
+}
+
+// The run failed with `code` and exactly one line on stderr that contains every one of `parts`.
+void expect_error(const Outcome& r, int code, std::initializer_list<std::string_view> parts) {
+  SCOPED_TRACE(r.command + "\nstderr: " + r.err);
+  EXPECT_EQ(r.code, code);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "not exactly one line";
+  EXPECT_TRUE(!r.err.empty() && r.err.back() == '\n');
+  EXPECT_EQ(r.err.rfind("hexatwist: ", 0), 0u);
+  for (const std::string_view p : parts) EXPECT_NE(r.err.find(p), std::string::npos) << "does not name '" << p << "'";
+}
+
+YAML::Node json(const Outcome& r) {
+  try {
+    return YAML::Load(r.out);
+  } catch (const YAML::Exception& e) {
+    ADD_FAILURE() << "not JSON: " << e.what() << "\n" << r.out;
+    return YAML::Node();
+  }
+}
+
+std::string numbers(const std::vector<double>& v) {
+  std::ostringstream os;
+  os.precision(17);
+  for (std::size_t i = 0; i < v.size(); ++i) os << (i ? "," : "") << v[i];
+  return os.str();
+}
+
+std::vector<double> leg_values(const YAML::Node& j, const char* key) {
+  std::vector<double> v;
+  for (const auto& leg : j["legs"]) v.push_back(leg[key].as<double>());
+  return v;
+}
+
+std::string vec(const YAML::Node& v) {
+  std::ostringstream os;
+  os.precision(17);
+  os << "[" << v[0].as<double>() << ", " << v[1].as<double>() << ", " << v[2].as<double>() << "]";
+  return os.str();
+}
+
+// The seed platform, symmetric form, one key per line.
+const std::string kSymmetric =
+    "name: cli test platform\n"     //  1
+    "symmetric:\n"                  //  2
+    "  Ra: 1.2\n"                   //  3
+    "  Rb: 1.5\n"                   //  4
+    "  da: 0.2\n"                   //  5
+    "  db: 0.3\n"                   //  6
+    "  H: 1.511\n"                  //  7
+    "screw:\n"                      //  8
+    "  lead: 0.010\n"               //  9
+    "  thread: right\n"             // 10
+    "  driven_side: base\n"         // 11
+    "limits:\n"                     // 12
+    "  length_min: 1.40\n"          // 13
+    "  length_max: 2.45\n"          // 14
+    "  bend_max_deg: 40\n"          // 15
+    "  singularity_margin_deg: 5\n";  // 16
+
+std::string replace_line(const std::string& text, int n, const std::string& with) {
+  std::istringstream in(text);
+  std::string out;
+  int k = 0;
+  for (std::string l; std::getline(in, l);) out += (++k == n ? with : l) + "\n";
+  return out;
+}
+
+// The default platform in the `legs` form, built from `config --json`. Lines: 1 home_height,
+// 2-5 screw, 6-8 limits, 9 "legs:", then leg i (0-based) from line 10 + 4 i: base, platform,
+// base_axis, platform_axis.
+constexpr int legs_line(int i, int field) { return 10 + 4 * i + field; }
+std::string seed_legs_yaml() {
+  const YAML::Node c = json(run({"config", "--json"}));
+  std::ostringstream os;
+  os.precision(17);
+  os << "home_height: " << c["home_height"].as<double>() << "\n"
+     << "screw:\n  lead: 0.010\n  thread: right\n  driven_side: base\n"
+     << "limits:\n  length_min: 1.40\n  length_max: 2.45\n"
+     << "legs:\n";
+  for (const auto& leg : c["legs"])
+    os << "  - base: " << vec(leg["base"]) << "\n"
+       << "    platform: " << vec(leg["platform"]) << "\n"
+       << "    base_axis: " << vec(leg["base_axis"]) << "\n"
+       << "    platform_axis: " << vec(leg["platform_axis"]) << "\n";
+  return os.str();
+}
+
+// ---- ik --------------------------------------------------------------------------------------
+
+TEST(Cli, IkJsonReportsEveryLegWithConsistentCommands) {
+  const Outcome r = run({"ik", "--pose=0.05,-0.02,0.1,3,-2,5", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const YAML::Node j = json(r);
+  EXPECT_EQ(j["status"].as<std::string>(), "ok");
+  EXPECT_TRUE(j["limit"].IsNull());
+  ASSERT_TRUE(j["legs"].IsSequence());
+  ASSERT_EQ(j["legs"].size(), 6u);
+  for (std::size_t i = 0; i < 6; ++i) {
+    const YAML::Node leg = j["legs"][i];
+    SCOPED_TRACE("leg " + std::to_string(i + 1));
+    EXPECT_EQ(leg["leg"].as<int>(), static_cast<int>(i) + 1);
+    for (const char* key : {"length", "twist", "length_error", "command_conventional", "command_compensated"})
+      ASSERT_TRUE(leg[key].IsScalar()) << key;
+    const double length = leg["length"].as<double>();
+    EXPECT_GT(length, 1.4);
+    EXPECT_LT(length, 2.45);
+    EXPECT_EQ(leg["command_conventional"].as<double>(), length);
+    // Eq. (12): compensated = length - length_error; the JSON numbers round-trip exactly.
+    EXPECT_NEAR(leg["command_compensated"].as<double>(), length - leg["length_error"].as<double>(), 1e-12);
+    EXPECT_NE(leg["length_error"].as<double>(), 0.0);
+    // Eq. (10) with the seed's +lead/2pi: length_error = 0.01/2pi * twist.
+    EXPECT_NEAR(leg["length_error"].as<double>(), 0.010 / (2 * kPi) * leg["twist"].as<double>(), 1e-15);
+  }
+}
+
+TEST(Cli, IkHeaveTwistsLegsOneAndTwoOppositely) {
+  const Outcome r = run({"ik", "--pose=0,0,0.3,0,0,0", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<double> twist = leg_values(json(r), "twist");
+  ASSERT_EQ(twist.size(), 6u);
+  EXPECT_GT(std::abs(twist[0]), deg2rad(1.0));
+  EXPECT_NEAR(twist[0], -twist[1], 1e-12);
+}
+
+TEST(Cli, IkTextOutputHasOneRowPerLeg) {
+  const Outcome r = run({"ik", "--pose=0,0,0.1,0,0,10"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (int i = 1; i <= 6; ++i) EXPECT_NE(r.out.find("\n  " + std::to_string(i) + "  "), std::string::npos) << i;
+  EXPECT_NE(r.out.find("status: ok"), std::string::npos);
+}
+
+TEST(Cli, NegativeNumbersWorkWithAndWithoutEquals) {
+  const Outcome eq = run({"ik", "--pose=-0.1,0,0,0,0,-5", "--json"});
+  const Outcome space = run({"ik", "--pose", "-0.1,0,0,0,0,-5", "--json"});
+  ASSERT_EQ(eq.code, 0) << eq.err;
+  ASSERT_EQ(space.code, 0) << space.err;
+  EXPECT_EQ(eq.out, space.out);
+  EXPECT_EQ(json(eq)["pose"][0].as<double>(), -0.1);
+  EXPECT_NEAR(json(eq)["pose"][5].as<double>(), deg2rad(-5.0), 1e-15);
+}
+
+// ---- fk --------------------------------------------------------------------------------------
+
+TEST(Cli, FkOfCompensatedCommandsWithMotorReturnsTheIkPose) {
+  // ik takes degrees, fk's JSON answers in radians.
+  const std::vector<double> pose_deg{0.05, -0.03, 0.12, 4.0, -3.0, 7.0};
+  const std::vector<double> pose{0.05, -0.03, 0.12, deg2rad(4.0), deg2rad(-3.0), deg2rad(7.0)};
+  const Outcome ik = run({"ik", "--pose=" + numbers(pose_deg), "--json"});
+  ASSERT_EQ(ik.code, 0) << ik.err;
+  const std::vector<double> commands = leg_values(json(ik), "command_compensated");
+  const Outcome fk = run({"fk", "--lengths=" + numbers(commands), "--motor", "--json"});
+  ASSERT_EQ(fk.code, 0) << fk.err;
+  const YAML::Node j = json(fk);
+  EXPECT_EQ(j["status"].as<std::string>(), "ok");
+  EXPECT_EQ(j["lengths_kind"].as<std::string>(), "motor");
+  ASSERT_EQ(j["pose"].size(), 6u);
+  // Measured worst component error 8e-17 (m or rad); bound 10x the worst FK error seen (4e-16).
+  for (std::size_t k = 0; k < 6; ++k) EXPECT_NEAR(j["pose"][k].as<double>(), pose[k], 5e-15) << "component " << k;
+}
+
+TEST(Cli, FkWithoutMotorOnMotorCommandsGivesAnotherPose) {
+  // The same numbers read as geometric lengths miss the twist: the pose is off by far more
+  // than the solver's accuracy.
+  const Outcome ik = run({"ik", "--pose=0.05,-0.03,0.12,4,-3,7", "--json"});
+  ASSERT_EQ(ik.code, 0) << ik.err;
+  const std::string lengths = "--lengths=" + numbers(leg_values(json(ik), "command_compensated"));
+  const Outcome motor = run({"fk", lengths, "--motor", "--json"});
+  const Outcome geometric = run({"fk", lengths, "--json"});
+  ASSERT_EQ(motor.code, 0) << motor.err;
+  ASSERT_EQ(geometric.code, 0) << geometric.err;
+  EXPECT_EQ(json(geometric)["lengths_kind"].as<std::string>(), "geometric");
+  double diff = 0.0;
+  for (std::size_t k = 0; k < 6; ++k)
+    diff = std::max(diff, std::abs(json(motor)["pose"][k].as<double>() - json(geometric)["pose"][k].as<double>()));
+  EXPECT_GT(diff, 1e-5);  // measured 3.5e-4
+}
+
+TEST(Cli, FkOfIkLengthsReturnsThePose) {
+  const Outcome ik = run({"ik", "--pose=-0.04,0.06,-0.05,-2,5,-8", "--json"});
+  ASSERT_EQ(ik.code, 0) << ik.err;
+  const Outcome fk = run({"fk", "--lengths=" + numbers(leg_values(json(ik), "length")), "--json"});
+  ASSERT_EQ(fk.code, 0) << fk.err;
+  const std::vector<double> pose{-0.04, 0.06, -0.05, deg2rad(-2), deg2rad(5), deg2rad(-8)};
+  // Measured worst component error 4e-16; bound about 10x.
+  for (std::size_t k = 0; k < 6; ++k) EXPECT_NEAR(json(fk)["pose"][k].as<double>(), pose[k], 5e-15) << k;
+}
+
+TEST(Cli, FkWithImpossibleLengthsFailsWithExitThree) {
+  const Outcome r = run({"fk", "--lengths=1,1,1,1,1,1", "--json"});
+  expect_error(r, 3, {"forward kinematics failed"});
+  EXPECT_TRUE(r.err.find("no_convergence") != std::string::npos || r.err.find("singular") != std::string::npos) << r.err;
+  const YAML::Node j = json(r);
+  const std::string status = j["status"].as<std::string>();
+  EXPECT_TRUE(status == "no_convergence" || status.rfind("singular", 0) == 0) << status;
+  EXPECT_TRUE(j["pose"].IsNull());
+}
+
+TEST(Cli, FkRejectsFiveLengths) {
+  expect_error(run({"fk", "--lengths=1.9,1.9,1.9,1.9,1.9"}), 2, {"--lengths", "6"});
+}
+
+// ---- config ----------------------------------------------------------------------------------
+
+TEST(Cli, ConfigJsonListsSixLegs) {
+  const Outcome r = run({"config", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const YAML::Node j = json(r);
+  EXPECT_EQ(j["status"].as<std::string>(), "ok");
+  ASSERT_EQ(j["legs"].size(), 6u);
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_EQ(j["legs"][i]["leg"].as<int>(), static_cast<int>(i) + 1);
+    EXPECT_NEAR(j["legs"][i]["length_home"].as<double>(), 1.910247, 5e-7);
+    EXPECT_EQ(j["legs"][i]["base"].size(), 3u);
+  }
+}
+
+TEST(Cli, ConfigFileInLegsFormGivesTheDefaultIk) {
+  // Joints and axes read back from `config --json`, written as a legs-form file: same IK.
+  const std::string file = write_file("legs.yaml", seed_legs_yaml());
+  const std::string pose = "--pose=0.03,0.02,-0.04,2,-4,6";
+  const Outcome a = run({"ik", pose, "--json"});
+  const Outcome b = run({"ik", pose, "--json", "--config=" + file});
+  ASSERT_EQ(a.code, 0) << a.err;
+  ASSERT_EQ(b.code, 0) << b.err;
+  const std::vector<double> la = leg_values(json(a), "command_compensated");
+  const std::vector<double> lb = leg_values(json(b), "command_compensated");
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_NEAR(la[i], lb[i], 1e-15) << "leg " << i + 1;
+}
+
+TEST(Cli, ConfigFileSettingsReachTheModel) {
+  const std::string file =
+      write_file("left.yaml", replace_line(replace_line(kSymmetric, 9, "  lead: 0.004"), 10, "  thread: left"));
+  const Outcome r = run({"config", "--json", "--config=" + file});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const YAML::Node j = json(r);
+  EXPECT_EQ(j["name"].as<std::string>(), "cli test platform");
+  for (const auto& leg : j["legs"]) EXPECT_NEAR(leg["twist_gain"].as<double>(), -0.004 / (2 * kPi), 1e-18);
+}
+
+// ---- bad input -------------------------------------------------------------------------------
+
+TEST(Cli, PoseWithFiveNumbersIsBadInput) {
+  const Outcome r = run({"ik", "--pose=0,0,0,0,0"});
+  expect_error(r, 2, {"--pose", "6"});
+  EXPECT_EQ(r.out, "");
+}
+
+TEST(Cli, NonNumberInPoseIsBadInput) {
+  expect_error(run({"ik", "--pose=0,0,abc,0,0,0"}), 2, {"--pose", "'abc'", "value 3"});
+  expect_error(run({"ik", "--pose=0,0,0.1.2,0,0,0"}), 2, {"--pose", "'0.1.2'"});
+  expect_error(run({"ik", "--pose=0,0,,0,0,0"}), 2, {"--pose", "value 3"});
+  expect_error(run({"ik", "--pose=+-1,0,0,0,0,0"}), 2, {"--pose", "'+-1'"});
+}
+
+TEST(Cli, NanOrInfInPoseIsBadInput) {
+  for (const char* v : {"nan", "inf", "-inf", "NaN"})
+    expect_error(run({"ik", std::string("--pose=0,") + v + ",0,0,0,0"}), 2, {"--pose", "value 2", "finite"});
+  expect_error(run({"ik", "--pose=1e999,0,0,0,0,0"}), 2, {"--pose", "range"});
+}
+
+TEST(Cli, NewlineInAnArgumentStillGivesOneLine) {
+  expect_error(run({"ik", "--pose=0,0\n,0,0,0,0"}), 2, {"--pose"});
+}
+
+TEST(Cli, MissingConfigFileIsBadInput) {
+  const std::string missing = (temp_dir() / "does_not_exist.yaml").string();
+  expect_error(run({"ik", "--config=" + missing}), 2, {"--config", missing});
+  expect_error(run({"ik", "--config=" + temp_dir().string()}), 2, {"--config", "directory"});
+}
+
+TEST(Cli, MalformedYamlConfigNamesFileAndLine) {
+  const std::string file = write_file("malformed.yaml", replace_line(kSymmetric, 4, "  Rb: 1.5: 3"));
+  expect_error(run({"ik", "--config=" + file}), 2, {file + ":4:", "YAML"});
+}
+
+TEST(Cli, ConfigErrorsNameFileLineAndField) {
+  struct Case {
+    const char* name;
+    std::string yaml;
+    int line;
+    const char* field;
+  };
+  const std::string legs = seed_legs_yaml();
+  const std::vector<Case> cases{
+      {"missing_key", replace_line(kSymmetric, 7, ""), 2, "symmetric.H"},
+      {"string", replace_line(kSymmetric, 4, "  Rb: wide"), 4, "symmetric.Rb"},
+      {"nan", replace_line(kSymmetric, 6, "  db: .nan"), 6, "symmetric.db"},
+      {"min_above_max", replace_line(kSymmetric, 13, "  length_min: 2.5"), 13, "limits.length_min"},
+      {"zero_axis", replace_line(legs, legs_line(2, 2), "    base_axis: [0, 0, 0]"), legs_line(2, 2),
+       "legs[2] (leg 3).base_axis"},
+      {"unknown_key", replace_line(kSymmetric, 3, "  Rq: 1.2"), 3, "symmetric.Rq"},
+      {"sideways", replace_line(kSymmetric, 10, "  thread: sideways"), 10, "screw.thread"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string file = write_file(std::string(c.name) + ".yaml", c.yaml);
+    expect_error(run({"ik", "--config=" + file}), 2, {file + ":" + std::to_string(c.line) + ":", c.field});
+  }
+}
+
+TEST(Cli, AxisParallelToItsLegIsBadInput) {
+  const YAML::Node c = json(run({"config", "--json"}));
+  const std::string yaml =
+      replace_line(seed_legs_yaml(), legs_line(4, 3), "    platform_axis: " + vec(c["legs"][4]["direction_home"]));
+  const std::string file = write_file("parallel.yaml", yaml);
+  expect_error(run({"config", "--config=" + file}), 2,
+               {file + ":" + std::to_string(legs_line(4, 3)) + ":", "legs[4] (leg 5).platform_axis", "singularity"});
+}
+
+TEST(Cli, UnknownSubcommandOrOptionIsBadInput) {
+  expect_error(run({"bogus"}), 2, {"'bogus'", "ik, fk or config"});
+  expect_error(run({}), 2, {"subcommand"});
+  expect_error(run({"ik", "--bogus"}), 2, {"--bogus"});
+  expect_error(run({"fk"}), 2, {"--lengths"});
+  expect_error(run({"fk", "--lengths=1.9,1.9,1.9,1.9,1.9,1.9", "--max-iterations=0"}), 2, {"--max-iterations"});
+}
+
+TEST(Cli, PoseOutsideALimitExitsThreeAndEmitsNoCommand) {
+  const Outcome r = run({"ik", "--pose=0,0,0.9,0,0,0", "--json"});
+  expect_error(r, 3, {"leg 1", "limits.length_max"});
+  const YAML::Node j = json(r);
+  EXPECT_EQ(j["status"].as<std::string>(), "stroke_above_max");
+  EXPECT_EQ(j["limit"]["leg"].as<int>(), 1);
+  EXPECT_GT(j["limit"]["value"].as<double>(), j["limit"]["bound"].as<double>());
+  ASSERT_EQ(j["legs"].size(), 6u);
+  for (const auto& leg : j["legs"]) {
+    EXPECT_TRUE(leg["command_conventional"].IsNull());
+    EXPECT_TRUE(leg["command_compensated"].IsNull());
+    EXPECT_TRUE(leg["length"].IsScalar());  // the geometry is still reported
+  }
+  // Text output: no command either.
+  const Outcome text = run({"ik", "--pose=0,0,0.9,0,0,0"});
+  expect_error(text, 3, {"leg 1", "limits.length_max"});
+  EXPECT_NE(text.out.find("status: stroke_above_max"), std::string::npos);
+}
+
+TEST(Cli, HelpAndVersionExitZero) {
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--help"}, {"ik", "--help"}, {"fk", "--help"}, {"config", "--help"}}) {
+    const Outcome r = run(args);
+    EXPECT_EQ(r.code, 0) << r.command;
+    EXPECT_NE(r.out.find("Usage"), std::string::npos) << r.command;
+    EXPECT_EQ(r.err, "") << r.command;
+  }
+  const Outcome v = run({"--version"});
+  EXPECT_EQ(v.code, 0);
+  EXPECT_NE(v.out.find("hexatwist"), std::string::npos);
+}
+
+}  // namespace

@@ -1,0 +1,438 @@
+// Config: YAML text to Model. The seed file gives the default model, the `legs` form of the seed
+// gives the same kinematics, per-leg screw settings override the screw block, and every bad
+// input is one line naming "file:line" and the field path.
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+#include <string>
+#include <string_view>
+
+#include "support.hpp"
+
+namespace hexatwist::test {
+namespace {
+
+// ---- YAML text helpers ----------------------------------------------------------------------
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  EXPECT_TRUE(in.good()) << "cannot read " << path;
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<std::string> split_lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
+}
+
+std::string join_lines(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const std::string& l : lines) out += l + "\n";
+  return out;
+}
+
+// Line `n` (1-based) of `text`.
+std::string line_of(const std::string& text, int n) { return split_lines(text).at(static_cast<std::size_t>(n - 1)); }
+
+// `text` with line `n` (1-based) replaced by `with` (which may hold several lines).
+std::string replace_line(const std::string& text, int n, const std::string& with) {
+  std::vector<std::string> lines = split_lines(text);
+  lines.at(static_cast<std::size_t>(n - 1)) = with;
+  return join_lines(lines);
+}
+
+// `text` without lines first..last (1-based, inclusive).
+std::string erase_lines(const std::string& text, int first, int last) {
+  std::vector<std::string> lines = split_lines(text);
+  lines.erase(lines.begin() + (first - 1), lines.begin() + last);
+  return join_lines(lines);
+}
+
+std::string vec(const Vector3d& v) {
+  std::ostringstream os;
+  os.precision(17);
+  os << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
+  return os.str();
+}
+
+// The seed platform in the symmetric form, one key per line (line numbers are used below).
+const std::string kSymmetric =
+    "name: test platform\n"         //  1
+    "symmetric:\n"                  //  2
+    "  Ra: 1.2\n"                   //  3
+    "  Rb: 1.5\n"                   //  4
+    "  da: 0.2\n"                   //  5
+    "  db: 0.3\n"                   //  6
+    "  H: 1.511\n"                  //  7
+    "screw:\n"                      //  8
+    "  lead: 0.010\n"               //  9
+    "  thread: right\n"             // 10
+    "  driven_side: base\n"         // 11
+    "limits:\n"                     // 12
+    "  length_min: 1.40\n"          // 13
+    "  length_max: 2.45\n"          // 14
+    "  bend_max_deg: 40\n"          // 15
+    "  singularity_margin_deg: 5\n";  // 16
+
+// A model in the `legs` form. Layout: 1 name, 2 home_height, 3-6 screw, 7-11 limits, 12 "legs:",
+// then four lines per leg i (0-based) from line 13 + 4 i: base, platform, base_axis, platform_axis.
+constexpr int kLegsKeyLine = 12;
+enum LegLine { kBase = 0, kPlatform = 1, kBaseAxis = 2, kPlatformAxis = 3 };
+constexpr int leg_line(int i, LegLine field) { return 13 + 4 * i + field; }
+
+std::string legs_yaml(const ModelSpec& spec) {
+  std::ostringstream os;
+  os.precision(17);
+  os << "name: legs form\n"
+     << "home_height: " << spec.home_height << "\n"
+     << "screw:\n"
+     << "  lead: " << spec.legs[0].lead << "\n"
+     << "  thread: " << (spec.legs[0].thread == ThreadSense::Right ? "right" : "left") << "\n"
+     << "  driven_side: " << (spec.legs[0].driven == DrivenSide::Base ? "base" : "platform") << "\n"
+     << "limits:\n"
+     << "  length_min: " << spec.limits.length_min << "\n"
+     << "  length_max: " << spec.limits.length_max << "\n"
+     << "  bend_max_deg: " << rad2deg(spec.limits.bend_max) << "\n"
+     << "  singularity_margin_deg: " << rad2deg(spec.limits.singularity_margin) << "\n"
+     << "legs:\n";
+  for (const LegSpec& leg : spec.legs)
+    os << "  - base: " << vec(leg.base_B) << "\n"
+       << "    platform: " << vec(leg.platform_P) << "\n"
+       << "    base_axis: " << vec(leg.axis_base_B) << "\n"
+       << "    platform_axis: " << vec(leg.axis_platform_P) << "\n";
+  return os.str();
+}
+
+const std::string& seed_legs_yaml() {
+  static const std::string text = legs_yaml(seed_model().spec());
+  return text;
+}
+
+// load_model(yaml, "bad.yaml") must throw; returns what() ("" and a failure if it loaded).
+std::string load_error(const std::string& yaml) {
+  try {
+    (void)load_model(yaml, "bad.yaml");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "loaded without error:\n" << yaml;
+  return {};
+}
+
+// The error is one line that starts with "bad.yaml:<line>:" and contains every one of `parts`.
+void expect_error(const std::string& yaml, int line, std::initializer_list<std::string_view> parts) {
+  const std::string msg = load_error(yaml);
+  SCOPED_TRACE("message: " + msg);
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << "not a single line";
+  const std::string where = "bad.yaml:" + std::to_string(line) + ":";
+  EXPECT_EQ(msg.rfind(where, 0), 0u) << "does not start with " << where;
+  for (const std::string_view p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "does not name '" << p << "'";
+}
+
+// Same leg geometry, limits and screw settings.
+void expect_same_model(const Model& a, const Model& b) {
+  const ModelSpec &sa = a.spec(), &sb = b.spec();
+  EXPECT_EQ(sa.home_height, sb.home_height);
+  EXPECT_EQ(sa.limits.length_min, sb.limits.length_min);
+  EXPECT_EQ(sa.limits.length_max, sb.limits.length_max);
+  EXPECT_EQ(sa.limits.bend_max, sb.limits.bend_max);
+  EXPECT_EQ(sa.limits.singularity_margin, sb.limits.singularity_margin);
+  EXPECT_EQ(sa.observation_P, sb.observation_P);
+  EXPECT_EQ(sa.pivot_P, sb.pivot_P);
+  EXPECT_EQ(a.has_twist(), b.has_twist());
+  for (int i = 0; i < kLegs; ++i) {
+    SCOPED_TRACE("leg " + std::to_string(i + 1));
+    const Leg &la = a.leg(i), &lb = b.leg(i);
+    EXPECT_EQ(la.base_B, lb.base_B);
+    EXPECT_EQ(la.platform_P, lb.platform_P);
+    EXPECT_EQ(la.axis_base_B, lb.axis_base_B);
+    EXPECT_EQ(la.axis_platform_P, lb.axis_platform_P);
+    EXPECT_EQ(la.s_home_B, lb.s_home_B);
+    EXPECT_EQ(la.length_home, lb.length_home);
+    EXPECT_EQ(la.theta_home, lb.theta_home);
+    EXPECT_EQ(la.lead, lb.lead);
+    EXPECT_EQ(la.twist_gain, lb.twist_gain);
+    EXPECT_EQ(la.thread, lb.thread);
+    EXPECT_EQ(la.driven, lb.driven);
+  }
+}
+
+// ---- valid configurations -------------------------------------------------------------------
+
+TEST(Config, SeedFileGivesTheDefaultModel) {
+  const std::string text = read_file(HEXATWIST_SOURCE_DIR "/configs/seed.yaml");
+  expect_same_model(load_model(text, "seed.yaml"), default_model());
+  EXPECT_EQ(std::string(seed_config_yaml()), text) << "the embedded seed differs from configs/seed.yaml";
+}
+
+TEST(Config, SeedFileIsTheDocumentedSymmetricPlatform) {
+  // Ra 1.2, Rb 1.5, da 0.2, db 0.3, H 1.511 m; lead 10 mm, right hand, driven at the base.
+  SymmetricSpec s;
+  s.Ra = 1.2, s.Rb = 1.5, s.da = 0.2, s.db = 0.3, s.H = 1.511;
+  const PerLeg<LegSpec> legs = symmetric_legs(s);
+  const Model model = default_model();
+  const ModelSpec& seed = model.spec();
+  EXPECT_EQ(seed.home_height, 1.511);
+  EXPECT_EQ(seed.limits.length_min, 1.40);
+  EXPECT_EQ(seed.limits.length_max, 2.45);
+  EXPECT_NEAR(rad2deg(seed.limits.bend_max), 40.0, 1e-12);
+  EXPECT_NEAR(rad2deg(seed.limits.singularity_margin), 5.0, 1e-12);
+  for (int i = 0; i < kLegs; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    EXPECT_EQ(seed.legs[k].base_B, legs[k].base_B) << "leg " << i + 1;
+    EXPECT_EQ(seed.legs[k].platform_P, legs[k].platform_P) << "leg " << i + 1;
+    EXPECT_EQ(seed.legs[k].axis_base_B, legs[k].axis_base_B) << "leg " << i + 1;
+    EXPECT_EQ(seed.legs[k].axis_platform_P, legs[k].axis_platform_P) << "leg " << i + 1;
+    EXPECT_EQ(seed.legs[k].lead, 0.010);
+    EXPECT_EQ(seed.legs[k].thread, ThreadSense::Right);
+    EXPECT_EQ(seed.legs[k].driven, DrivenSide::Base);
+  }
+}
+
+TEST(Config, SymmetricTextOfTheTestsIsTheSeedGeometry) {
+  // The base text the error tests break one line at a time is valid.
+  const Model m = load_model(kSymmetric, "good.yaml");
+  for (int i = 0; i < kLegs; ++i) EXPECT_EQ(m.leg(i).length_home, seed_model().leg(i).length_home);
+  EXPECT_EQ(m.spec().name, "test platform");
+}
+
+TEST(Config, LegsFormOfTheSeedGivesTheSameLengthsAndTwists) {
+  // Cross-form round trip: the seed's joints and axes written out as six explicit legs.
+  const Model legs = load_model(seed_legs_yaml(), "legs.yaml");
+  ASSERT_TRUE(legs.has_twist());
+  std::mt19937_64 rng(kSeed + 20);
+  double worst_length = 0.0, worst_twist = 0.0;
+  for (int n = 0; n < 300; ++n) {
+    const Pose p = random_valid_pose(seed_model(), rng, 0.4, deg2rad(25));
+    LegState sa, sb;
+    Vector6d ta, tb;
+    ASSERT_EQ(inverse_kinematics(seed_model(), p, sa), Status::Ok);
+    ASSERT_EQ(inverse_kinematics(legs, p, sb), Status::Ok);
+    ASSERT_EQ(twist(seed_model(), sa, ta), Status::Ok);
+    ASSERT_EQ(twist(legs, sb, tb), Status::Ok);
+    worst_length = std::max(worst_length, (sa.length - sb.length).cwiseAbs().maxCoeff());
+    worst_twist = std::max(worst_twist, (ta - tb).cwiseAbs().maxCoeff());
+    EXPECT_GT(ta.cwiseAbs().maxCoeff(), 0.0) << str(p);  // the comparison is not 0 == 0
+  }
+  // 17 significant digits round-trip every double: measured 0 m and 0 rad.
+  EXPECT_LE(worst_length, 1e-15);
+  EXPECT_LE(worst_twist, 1e-15);
+}
+
+TEST(Config, PerLegScrewSettingsOverrideTheScrewBlock) {
+  // Screw block: 10 mm, right, base. Leg 2: 4 mm lead; leg 3: left hand; leg 5: driven at the
+  // platform; leg 6: left hand and driven at the platform.
+  std::string yaml = seed_legs_yaml();
+  const auto add = [&](int i, const std::string& extra) {
+    const int n = leg_line(i, kPlatformAxis);
+    yaml = replace_line(yaml, n, line_of(yaml, n) + "\n    " + extra);
+  };
+  // Bottom up, so that the line numbers above stay valid.
+  add(5, "thread: left\n    driven_side: platform");
+  add(4, "driven_side: platform");
+  add(2, "thread: left");
+  add(1, "lead: 0.004");
+  const Model m = load_model(yaml, "override.yaml");
+  const double g = 0.010 / (2.0 * kPi);
+  const std::array<double, kLegs> expected{g, 0.004 / (2.0 * kPi), -g, g, -g, g};
+  for (int i = 0; i < kLegs; ++i)
+    EXPECT_NEAR(m.leg(i).twist_gain, expected[static_cast<std::size_t>(i)], 1e-18) << "leg " << i + 1;
+  EXPECT_EQ(m.leg(1).lead, 0.004);
+  EXPECT_EQ(m.leg(2).thread, ThreadSense::Left);
+  EXPECT_EQ(m.leg(2).driven, DrivenSide::Base);
+  EXPECT_EQ(m.leg(4).thread, ThreadSense::Right);
+  EXPECT_EQ(m.leg(4).driven, DrivenSide::Platform);
+}
+
+TEST(Config, ZeroLeadLegsFormNeedsNoAxesAndNoThread) {
+  // A plain Stewart platform: joints only.
+  std::string yaml =
+      "home_height: 1.511\n"
+      "screw:\n"
+      "  lead: 0\n"
+      "limits: {length_min: 1.4, length_max: 2.45}\n"
+      "legs:\n";
+  for (const LegSpec& leg : seed_model().spec().legs)
+    yaml += "  - {base: " + vec(leg.base_B) + ", platform: " + vec(leg.platform_P) + "}\n";
+  const Model plain = load_model(yaml, "plain.yaml");
+  EXPECT_FALSE(plain.has_twist());
+  EXPECT_EQ(plain.spec().name, "plain.yaml");  // no name: the source
+  std::mt19937_64 rng(kSeed + 21);
+  for (int n = 0; n < 50; ++n) {
+    const Pose p = random_valid_pose(seed_model(), rng, 0.4, deg2rad(25));
+    LegState sa, sb;
+    ASSERT_EQ(inverse_kinematics(seed_model(), p, sa), Status::Ok);
+    ASSERT_EQ(inverse_kinematics(plain, p, sb), Status::Ok);
+    EXPECT_LE((sa.length - sb.length).cwiseAbs().maxCoeff(), 1e-15) << str(p);
+  }
+}
+
+TEST(Config, ZeroLeadSymmetricFormNeedsNoThread) {
+  const std::string yaml = erase_lines(replace_line(kSymmetric, 9, "  lead: 0"), 10, 11);
+  const Model m = load_model(yaml, "plain.yaml");
+  EXPECT_FALSE(m.has_twist());
+}
+
+TEST(Config, DefaultLimitsAreThirtyDegreesBendAndFiveDegreesMargin) {
+  const Model m = load_model(erase_lines(kSymmetric, 15, 16), "defaults.yaml");
+  EXPECT_NEAR(rad2deg(m.spec().limits.bend_max), 30.0, 1e-12);
+  EXPECT_NEAR(rad2deg(m.spec().limits.singularity_margin), 5.0, 1e-12);
+}
+
+TEST(Config, ParseModelSpecLeavesValidationToModel) {
+  // parse_model_spec reads; the Model validates. load_model does both and locates the error.
+  const std::string yaml = replace_line(kSymmetric, 13, "  length_min: 2.5");
+  const ModelSpec spec = parse_model_spec(yaml, "bad.yaml");
+  EXPECT_EQ(spec.limits.length_min, 2.5);
+  EXPECT_THROW(Model{spec}, Error);
+}
+
+// ---- bad input: one line, file:line, field path ---------------------------------------------
+
+TEST(Config, SyntaxErrorNamesItsLine) {
+  expect_error(replace_line(kSymmetric, 4, "  Rb: 1.5: 3"), 4, {"YAML syntax error"});
+  expect_error(replace_line(kSymmetric, 4, " Rb: 1.5"), 4, {"YAML syntax error"});
+  expect_error(replace_line(kSymmetric, 5, "\tda: 0.2"), 5, {"YAML syntax error"});
+}
+
+TEST(Config, MissingKeyPointsAtTheBlockThatLacksIt) {
+  expect_error(erase_lines(kSymmetric, 7, 7), 2, {"field 'symmetric.H'", "missing"});
+  expect_error(erase_lines(kSymmetric, 13, 13), 12, {"field 'limits.length_min'", "missing"});
+  expect_error(erase_lines(kSymmetric, 12, 16), 1, {"field 'limits'", "missing"});
+  expect_error(erase_lines(seed_legs_yaml(), leg_line(3, kPlatform), leg_line(3, kPlatform)), leg_line(3, kBase),
+               {"field 'legs[3] (leg 4).platform'", "missing"});
+  expect_error(erase_lines(seed_legs_yaml(), 2, 2), 1, {"field 'home_height'", "missing"});
+}
+
+TEST(Config, TextWhereANumberBelongsIsRejected) {
+  expect_error(replace_line(kSymmetric, 4, "  Rb: wide"), 4, {"field 'symmetric.Rb'", "number", "'wide'"});
+  expect_error(replace_line(kSymmetric, 14, "  length_max: 2.45m"), 14, {"field 'limits.length_max'", "'2.45m'"});
+  expect_error(replace_line(kSymmetric, 13, "  length_min: [1.4]"), 13, {"field 'limits.length_min'", "a list"});
+  const int n = leg_line(2, kPlatform);
+  expect_error(replace_line(seed_legs_yaml(), n, "    platform: [1, two, 0]"), n,
+               {"field 'legs[2] (leg 3).platform[1]'", "'two'"});
+  expect_error(replace_line(seed_legs_yaml(), n, "    platform: [1, 0]"), n,
+               {"field 'legs[2] (leg 3).platform'", "three numbers"});
+}
+
+TEST(Config, EmptyValueIsReportedOnItsOwnLine) {
+  // yaml-cpp marks an empty value at the next key; the message must still point at "Rb:".
+  expect_error(replace_line(kSymmetric, 4, "  Rb:"), 4, {"field 'symmetric.Rb'"});
+  expect_error(replace_line(kSymmetric, 16, "  singularity_margin_deg:"), 16, {"field 'limits.singularity_margin_deg'"});
+}
+
+TEST(Config, NanAndInfAreRejected) {
+  for (const char* v : {".nan", ".NaN", ".inf", "-.inf", "+.Inf"}) {
+    SCOPED_TRACE(v);
+    expect_error(replace_line(kSymmetric, 7, std::string("  H: ") + v), 7, {"field 'symmetric.H'", "finite", v});
+    const int n = leg_line(1, kBase);
+    expect_error(replace_line(seed_legs_yaml(), n, std::string("  - base: [0.9, ") + v + ", 0]"), n,
+                 {"field 'legs[1] (leg 2).base[1]'", "finite"});
+  }
+}
+
+TEST(Config, ZeroAxisInLegsFormNamesTheLegAndLine) {
+  const int n = leg_line(2, kBaseAxis);
+  ASSERT_EQ(line_of(seed_legs_yaml(), n).rfind("    base_axis: ", 0), 0u);
+  expect_error(replace_line(seed_legs_yaml(), n, "    base_axis: [0, 0, 0]"), n,
+               {"field 'legs[2] (leg 3).base_axis'", "zero"});
+}
+
+TEST(Config, AxisParallelToItsLegAtHomeNamesTheLegAndLine) {
+  const int n = leg_line(2, kBaseAxis);
+  expect_error(replace_line(seed_legs_yaml(), n, "    base_axis: " + vec(seed_model().leg(2).s_home_B)), n,
+               {"field 'legs[2] (leg 3).base_axis'", "singularity margin"});
+  const int m = leg_line(5, kPlatformAxis);
+  ASSERT_EQ(line_of(seed_legs_yaml(), m).rfind("    platform_axis: ", 0), 0u);
+  expect_error(replace_line(seed_legs_yaml(), m, "    platform_axis: " + vec(-seed_model().leg(5).s_home_B)), m,
+               {"field 'legs[5] (leg 6).platform_axis'", "singularity margin"});
+}
+
+TEST(Config, LengthMinAboveLengthMaxIsRejected) {
+  expect_error(replace_line(kSymmetric, 13, "  length_min: 2.5"), 13, {"field 'limits.length_min'", "length_max"});
+  expect_error(replace_line(kSymmetric, 13, "  length_min: -1"), 13, {"field 'limits.length_min'", "> 0"});
+}
+
+TEST(Config, OtherModelErrorsAreLocated) {
+  expect_error(replace_line(kSymmetric, 15, "  bend_max_deg: 100"), 15, {"field 'limits.bend_max_deg'", "90"});
+  expect_error(replace_line(kSymmetric, 9, "  lead: -0.01"), 9, {"field 'screw.lead'", ">= 0"});
+  // A derived (symmetric) leg outside the stroke: the block it came from, and the leg.
+  expect_error(replace_line(kSymmetric, 14, "  length_max: 1.9"), 2, {"field 'symmetric'", "leg 1", "stroke"});
+  // Two legs in the same place in the legs form: the platform is not held.
+  std::string yaml = seed_legs_yaml();
+  for (int f = kBase; f <= kPlatformAxis; ++f)
+    yaml = replace_line(yaml, leg_line(1, LegLine(f)), line_of(yaml, leg_line(0, LegLine(f))));
+  expect_error(yaml, kLegsKeyLine, {"field 'legs'", "do not hold"});
+}
+
+TEST(Config, UnknownKeyIsRejected) {
+  expect_error(replace_line(kSymmetric, 3, "  Rq: 1.2"), 3, {"field 'symmetric.Rq'", "unknown key", "Ra"});
+  expect_error(replace_line(kSymmetric, 12, "limit:"), 12, {"field 'limit'", "unknown key", "limits"});
+  const int n = leg_line(4, kBaseAxis);
+  expect_error(replace_line(seed_legs_yaml(), n, "    base_axes: [1, 0, 0]"), n,
+               {"field 'legs[4] (leg 5).base_axes'", "unknown key"});
+}
+
+TEST(Config, KeyGivenTwiceIsRejected) {
+  // yaml-cpp would silently keep the first value.
+  expect_error(replace_line(kSymmetric, 9, "  lead: 0.010\n  lead: 0.005"), 10, {"field 'screw.lead'", "twice", "line 9"});
+}
+
+TEST(Config, LegsListMustHoldSixLegs) {
+  const std::string five = erase_lines(seed_legs_yaml(), leg_line(5, kBase), leg_line(5, kPlatformAxis));
+  expect_error(five, kLegsKeyLine, {"field 'legs'", "exactly 6", "got 5"});
+  const std::string seven = seed_legs_yaml() + erase_lines(seed_legs_yaml(), 1, kLegsKeyLine + 20);
+  expect_error(seven, kLegsKeyLine, {"field 'legs'", "exactly 6", "got 7"});
+  const std::string scalar = erase_lines(seed_legs_yaml(), kLegsKeyLine, leg_line(5, kPlatformAxis)) + "legs: 6\n";
+  expect_error(scalar, kLegsKeyLine, {"field 'legs'", "exactly 6"});
+}
+
+TEST(Config, SymmetricAndLegsTogetherAreRejected) {
+  // The later of the two is reported, with the line of the other.
+  const std::string both = seed_legs_yaml() + "symmetric: {Ra: 1.2, Rb: 1.5, da: 0.2, db: 0.3, H: 1.511}\n";
+  expect_error(both, kLegsKeyLine + 4 * kLegs + 1, {"field 'symmetric'", "'legs' (line 12)", "exactly one"});
+}
+
+TEST(Config, NeitherSymmetricNorLegsIsRejected) {
+  expect_error(erase_lines(kSymmetric, 2, 7), 1, {"exactly one of 'symmetric'", "neither"});
+}
+
+TEST(Config, ThreadMustBeRightOrLeft) {
+  expect_error(replace_line(kSymmetric, 10, "  thread: sideways"), 10, {"field 'screw.thread'", "right or left", "'sideways'"});
+  expect_error(replace_line(kSymmetric, 11, "  driven_side: middle"), 11, {"field 'screw.driven_side'", "base or platform"});
+}
+
+TEST(Config, ThreadAndDrivenSideAreRequiredWhenLeadIsPositive) {
+  expect_error(erase_lines(kSymmetric, 10, 10), 8, {"field 'screw.thread'", "missing"});
+  expect_error(erase_lines(kSymmetric, 11, 11), 8, {"field 'screw.driven_side'", "missing"});
+  // A leg's own lead > 0 needs a thread too, when the screw block (lead 0) gives none.
+  std::string yaml = seed_legs_yaml();
+  const int n = leg_line(3, kPlatformAxis);
+  yaml = replace_line(yaml, n, line_of(yaml, n) + "\n    lead: 0.01");
+  yaml = erase_lines(replace_line(yaml, 4, "  lead: 0"), 5, 6);  // leg 4 moves up two lines
+  expect_error(yaml, leg_line(3, kBase) - 2, {"field 'legs[3] (leg 4).thread'", "missing"});
+}
+
+TEST(Config, EmptyDocumentIsRejected) {
+  for (const char* text : {"", "# nothing but a comment\n", "\n\n"}) {
+    SCOPED_TRACE(text);
+    expect_error(text, 1, {"empty document"});
+  }
+}
+
+TEST(Config, NonMappingDocumentAndSecondDocumentAreRejected) {
+  expect_error("- 1\n- 2\n", 1, {"expected a mapping"});
+  expect_error(kSymmetric + "---\nname: again\n", 18, {"one YAML document"});  // the second one's first line
+}
+
+TEST(Config, MultiLineValueInAMessageStaysOneLine) {
+  expect_error(replace_line(kSymmetric, 4, "  Rb: |\n    1.5\n    wide"), 4, {"field 'symmetric.Rb'", "\\n"});
+  expect_error(replace_line(kSymmetric, 3, "  ? |\n    R\n    a\n  : 1.2"), 3, {"unknown key"});
+}
+
+}  // namespace
+}  // namespace hexatwist::test

@@ -1,0 +1,67 @@
+// The internal vectorised sin/cos and atan2 (src/fast_math.hpp) against libm.
+#include "../src/fast_math.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace hexatwist::detail {
+namespace {
+
+TEST(FastMath, Atan2MatchesLibmOverAllQuadrantsAndScales) {
+  // Measured worst difference 4.4e-16 rad (2 ulp of pi); bound 10x.
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  double worst = 0.0;
+  for (int n = 0; n < 200000; ++n) {
+    Array6d y, x;
+    for (int i = 0; i < kLegs; ++i) {
+      const double scale = std::pow(10.0, 12 * u(rng));
+      y[i] = u(rng) * scale;
+      x[i] = u(rng) * (n % 3 == 0 ? scale : 1.0);
+    }
+    const Array6d a = atan2(y, x);
+    for (int i = 0; i < kLegs; ++i) worst = std::max(worst, std::abs(a[i] - std::atan2(y[i], x[i])));
+  }
+  EXPECT_LT(worst, 4.5e-15);
+}
+
+TEST(FastMath, Atan2HandlesAxesZerosAndInfinity) {
+  const double inf = INFINITY;
+  const std::vector<std::pair<double, double>> cases{{0.0, 1.0},  {1.0, 0.0},  {0.0, -1.0}, {-1.0, 0.0}, {1.0, 1.0},
+                                                     {-1.0, -1.0}, {1.0, -0.0}, {-0.0, 1.0}, {0.0, 0.0},  {1e-300, 1.0},
+                                                     {1.0, 1e-300}, {inf, 1.0}, {1.0, inf},  {-1.0, -inf}};
+  for (const auto& [y, x] : cases) {
+    Array6d ya = Array6d::Constant(y), xa = Array6d::Constant(x);
+    EXPECT_NEAR(atan2(ya, xa)[0], std::atan2(y, x), 1e-15) << "atan2(" << y << ", " << x << ")";
+  }
+}
+
+TEST(FastMath, SinCosMatchLibmAndFallBackForHugeAngles) {
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  double worst = 0.0;
+  for (int n = 0; n < 200000; ++n) {
+    const Vector3d a(1000 * u(rng), 10 * u(rng), u(rng));
+    Vector3d s, c;
+    sin_cos(a, s, c);
+    for (int k = 0; k < 3; ++k) worst = std::max({worst, std::abs(s[k] - std::sin(a[k])), std::abs(c[k] - std::cos(a[k]))});
+  }
+  EXPECT_LT(worst, 2e-15);  // measured 2.2e-16
+  const Vector3d huge(1e7, -3e9, kPi);
+  Vector3d s, c;
+  sin_cos(huge, s, c);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(s[k], std::sin(huge[k]));
+    EXPECT_EQ(c[k], std::cos(huge[k]));
+  }
+  // Exact quadrant boundaries.
+  for (const double a : {0.0, kPi / 2, kPi, -kPi / 2, 3 * kPi / 2, -kPi, 2 * kPi, -2.5 * kPi}) {
+    sin_cos(Vector3d(a, a, a), s, c);
+    EXPECT_NEAR(s[0], std::sin(a), 1e-15) << a;
+    EXPECT_NEAR(c[0], std::cos(a), 1e-15) << a;
+  }
+}
+
+}  // namespace
+}  // namespace hexatwist::detail
