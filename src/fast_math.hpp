@@ -3,7 +3,7 @@
 // budget, and Eigen 3.4's select() compiles to scalar branches, so these kernels use GCC/Clang
 // vector extensions (two doubles per vector: SSE2, NEON) with bitwise blends. Both use exact
 // range reduction followed by a Taylor series (sin, cos) or its Pade approximant (atan),
-// truncated where the error is below 1e-17; tests/test_fast_math.cpp checks them against libm.
+// truncated where the error is below 1e-17; tests/test_kernels.cpp checks them against libm.
 #pragma once
 
 #include <cmath>

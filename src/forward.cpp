@@ -1,9 +1,9 @@
 #include "hexatwist/forward.hpp"
 
-#include <Eigen/LU>
 #include <cmath>
 
 #include "hexatwist/twist.hpp"
+#include "linear_solve.hpp"
 
 namespace hexatwist {
 namespace {
@@ -11,27 +11,36 @@ namespace {
 // Largest number of step halvings in the line search.
 constexpr int kMaxHalvings = 12;
 
-}  // namespace
+// J_f_x at the state `legs` (inverse kinematics already done): the length Jacobian, minus the
+// twist gain times the twist Jacobian for motor-side lengths.
+Status residual_jacobian(const Model& model, const LegState& legs, LengthKind kind, Matrix6d& J) noexcept {
+  length_jacobian(legs, J);
+  if (kind == LengthKind::Geometric || !model.has_twist()) return Status::Ok;
+  Matrix6d J_twist;
+  if (const Status s = twist_jacobian(model, legs, J_twist); s != Status::Ok) return s;
+  J -= model.geometry().twist_gain.asDiagonal() * J_twist;
+  return Status::Ok;
+}
 
-Status fk_residual(const Model& model, const Placement& x, const Vector6d& lengths, LengthKind kind,
-                   LegState& legs, Vector6d& f, Matrix6d* J) noexcept {
+// f = g(x) - lengths at the placement x, with g the geometric or motor-side lengths.
+Status residual(const Model& model, const Placement& x, const Vector6d& lengths, LengthKind kind, LegState& legs,
+                Vector6d& f) noexcept {
   if (const Status s = inverse_kinematics(model, x, legs); s != Status::Ok) return s;
   f = legs.length - lengths;
-  if (J != nullptr) length_jacobian(legs, *J);
   if (kind == LengthKind::Geometric || !model.has_twist()) return Status::Ok;
   // Motor-side length m = |L| - twist_gain * dtheta (docs/theory.md §5).
   Vector6d dtheta;
   if (const Status s = twist(model, legs, dtheta); s != Status::Ok) return s;
-  Matrix6d J_twist;
-  if (J != nullptr) {
-    if (const Status s = twist_jacobian(model, legs, J_twist); s != Status::Ok) return s;
-  }
-  for (int i = 0; i < kLegs; ++i) {
-    const double gain = model.leg(i).twist_gain;
-    f[i] -= gain * dtheta[i];
-    if (J != nullptr) J->row(i) -= gain * J_twist.row(i);
-  }
+  f -= model.geometry().twist_gain.cwiseProduct(dtheta);
   return Status::Ok;
+}
+
+}  // namespace
+
+Status fk_residual(const Model& model, const Placement& x, const Vector6d& lengths, LengthKind kind,
+                   LegState& legs, Vector6d& f, Matrix6d* J) noexcept {
+  if (const Status s = residual(model, x, lengths, kind, legs, f); s != Status::Ok) return s;
+  return J != nullptr ? residual_jacobian(model, legs, kind, *J) : Status::Ok;
 }
 
 Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKind kind, const Placement& guess,
@@ -43,12 +52,11 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
 
   Placement x = guess;
   Vector6d f;
-  Matrix6d J;
-  if (const Status s = fk_residual(model, x, lengths, kind, out.legs, f, &J); s != Status::Ok) return s;
+  if (const Status s = residual(model, x, lengths, kind, out.legs, f); s != Status::Ok) return s;
 
   Placement x_try;
-  Vector6d f_try;
-  Matrix6d J_try;
+  Vector6d f_try, step;
+  Matrix6d J;
   LegState legs_try;
   for (;;) {
     out.placement = x;
@@ -59,28 +67,26 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
     }
     if (out.iterations >= options.max_iterations) return Status::NoConvergence;
 
-    // Newton step on R^3 x SO(3): J [dt; dw] = -f, then t += dt, R = exp(dw) R.
-    const Eigen::PartialPivLU<Matrix6d> lu(J);
-    const Vector6d pivots = lu.matrixLU().diagonal().cwiseAbs();
-    if (!(pivots.minCoeff() > options.singular_ratio * pivots.maxCoeff())) return Status::SingularJacobian;
-    const Vector6d step = -lu.solve(f);
+    // Newton step on R^3 x SO(3): J [dt; dw] = -f, then t += dt, R = exp(dw) R. The Jacobian is
+    // formed only here, so the converged last iterate never pays for one.
+    if (const Status s = residual_jacobian(model, out.legs, kind, J); s != Status::Ok) return s;
+    if (!(detail::solve6(J, -f, step) > options.singular_ratio)) return Status::SingularJacobian;
 
     // Backtracking: accept the first fraction of the step that lowers |f| (and stays away from
     // singular joints), so a far guess cannot throw the iterate to another assembly mode.
-    const double norm_f = f.norm();
+    const double norm_f = f.squaredNorm();
     double alpha = 1.0;
     bool accepted = false;
     for (int h = 0; h <= kMaxHalvings && !accepted; ++h, alpha *= 0.5) {
       x_try.t = x.t + alpha * step.head<3>();
       x_try.R_BP = exp_so3(alpha * step.tail<3>()) * x.R_BP;
-      if (fk_residual(model, x_try, lengths, kind, legs_try, f_try, &J_try) != Status::Ok) continue;
-      accepted = f_try.norm() < norm_f;
+      if (residual(model, x_try, lengths, kind, legs_try, f_try) != Status::Ok) continue;
+      accepted = f_try.squaredNorm() < norm_f;
     }
     ++out.iterations;
     if (!accepted) return Status::NoConvergence;
     x = x_try;
     f = f_try;
-    J = J_try;
     out.legs = legs_try;
   }
 }

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs the Debian packages hexatwist needs to build and test, if any is missing.
+# Non-interactive; runs apt-get as root (or through sudo). Safe to run again: it installs nothing
+# when everything is present.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config     # toolchain
+  libeigen3-dev libyaml-cpp-dev libcli11-dev libfmt-dev   # library and CLI
+  libgtest-dev libgmock-dev libbenchmark-dev        # tests and benchmarks
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+echo "hexatwist setup: installing ${missing[*]}" >&2
+if [ "$(id -u)" -eq 0 ]; then
+  sudo=()
+elif command -v sudo >/dev/null 2>&1; then
+  sudo=(sudo)
+else
+  echo "hexatwist setup: not root and no sudo; install as root: apt-get install ${missing[*]}" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo[@]}" apt-get update -qq
+"${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
