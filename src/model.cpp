@@ -87,8 +87,10 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
     leg.lead = ls.lead;
     leg.thread = ls.thread;
     leg.driven = ls.driven;
-    // docs/theory.md §4: right-hand thread driven from the base: real = motor + lead*dtheta/2pi.
-    leg.twist_sign = (ls.thread == ThreadSense::Right ? 1.0 : -1.0) * (ls.driven == DrivenSide::Base ? 1.0 : -1.0);
+    // docs/theory.md §4: real = motor-side + lead*dtheta/2pi for a right-hand thread, whichever end
+    // is driven (swapping the screw and nut between housing and rod negates both the relative
+    // rotation and the axial sense); a left-hand thread negates it.
+    leg.twist_sign = ls.thread == ThreadSense::Right ? 1.0 : -1.0;
     leg.twist_gain = leg.twist_sign * ls.lead / (2.0 * kPi);
     length_home_[i] = leg.length_home;
 

@@ -50,7 +50,7 @@ TEST(Compensation, ConventionalCommandsMissThePoseByTheTwist) {
   EXPECT_LT(previous, 5e-3);
 }
 
-TEST(Compensation, LengthErrorIsLeadTimesTwistOverTwoPiWithTheHardwareSign) {
+TEST(Compensation, LengthErrorIsLeadTimesTwistOverTwoPiWithTheThreadHandSign) {
   const Vector6d dtheta = (Vector6d() << 0.1, -0.2, 0.3, -0.4, 0.5, -0.6).finished();
   const auto error_for = [&](ThreadSense thread, DrivenSide side) {
     ModelSpec spec = seed_model().spec();
@@ -65,8 +65,9 @@ TEST(Compensation, LengthErrorIsLeadTimesTwistOverTwoPiWithTheHardwareSign) {
   const Vector6d expected = 0.010 * dtheta / (2 * kPi);  // Eq. (10), lead 10 mm
   EXPECT_LT((error_for(ThreadSense::Right, DrivenSide::Base) - expected).cwiseAbs().maxCoeff(), 1e-18);
   EXPECT_LT((error_for(ThreadSense::Left, DrivenSide::Base) + expected).cwiseAbs().maxCoeff(), 1e-18);
-  EXPECT_LT((error_for(ThreadSense::Right, DrivenSide::Platform) + expected).cwiseAbs().maxCoeff(), 1e-18);
-  EXPECT_LT((error_for(ThreadSense::Left, DrivenSide::Platform) - expected).cwiseAbs().maxCoeff(), 1e-18);
+  // The driven side does not change the sign (docs/theory.md §4; tests/test_model.cpp derives it).
+  EXPECT_LT((error_for(ThreadSense::Right, DrivenSide::Platform) - expected).cwiseAbs().maxCoeff(), 1e-18);
+  EXPECT_LT((error_for(ThreadSense::Left, DrivenSide::Platform) + expected).cwiseAbs().maxCoeff(), 1e-18);
 }
 
 TEST(Compensation, RealTimeCommandsAgreeWithTheFullReport) {

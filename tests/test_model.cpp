@@ -228,30 +228,45 @@ TEST(Model, OneLeadedLegMakesTheModelTwist) {
   EXPECT_TRUE(Model(spec).has_twist());
 }
 
-TEST(Model, TwistGainIsPlusOrMinusLeadOverTwoPiByThreadAndDrivenSide) {
-  // Right-hand thread driven at the base: +lead/2pi; each of left hand, platform drive flips it.
-  struct Case {
-    ThreadSense thread;
-    DrivenSide driven;
-    double sign;
-  };
-  const std::array<Case, 4> cases{{{ThreadSense::Right, DrivenSide::Base, 1.0},
-                                   {ThreadSense::Left, DrivenSide::Base, -1.0},
-                                   {ThreadSense::Right, DrivenSide::Platform, -1.0},
-                                   {ThreadSense::Left, DrivenSide::Platform, 1.0}}};
+// First principles of a screw and its nut, independent of the library: for a right-hand (hand =
+// +1) thread, turning the nut by +a about the axis relative to the screw moves it lead*a/2pi along
+// the axis. Driven at the base, the housing carries the screw (turned by the motor angle qm) and
+// the rod the nut; driven at the platform, the rod carries the screw and the housing the nut.
+// Returns real length minus motor-side length for a rod-to-housing twist dtheta.
+double screw_nut_length_error(double hand, DrivenSide side, double lead, double qm, double dtheta) {
+  const double k = hand * lead / (2.0 * kPi);
+  if (side == DrivenSide::Base) {
+    const double extension = k * (dtheta - qm);  // nut (rod) relative to screw (housing)
+    const double motor_side = k * (0.0 - qm);    // the same with no twist: what the encoder implies
+    return extension - motor_side;
+  }
+  const double extension = -k * (0.0 - (dtheta + qm));  // screw (rod) relative to nut (housing)
+  const double motor_side = -k * (0.0 - qm);
+  return extension - motor_side;
+}
+
+TEST(Model, TwistGainFollowsScrewAndNutMechanicsForEveryThreadAndDrivenSide) {
+  // The thread hand sets the sign; the driven side does not (docs/theory.md §4).
   ModelSpec spec = seed_spec();
+  const std::array<ThreadSense, 2> hands{ThreadSense::Right, ThreadSense::Left};
+  const std::array<DrivenSide, 2> sides{DrivenSide::Base, DrivenSide::Platform};
   for (int i = 0; i < kLegs; ++i) {
     LegSpec& leg = spec.legs[static_cast<std::size_t>(i)];
-    const Case& c = cases[static_cast<std::size_t>(i % 4)];
     leg.lead = 0.002 * (i + 1);
-    leg.thread = c.thread;
-    leg.driven = c.driven;
+    leg.thread = hands[static_cast<std::size_t>(i % 2)];
+    leg.driven = sides[static_cast<std::size_t>((i / 2) % 2)];
   }
   const Model model(spec);
   for (int i = 0; i < kLegs; ++i) {
-    const double sign = cases[static_cast<std::size_t>(i % 4)].sign;
-    EXPECT_EQ(model.leg(i).twist_sign, sign) << "leg " << i + 1;
-    EXPECT_NEAR(model.leg(i).twist_gain, sign * 0.002 * (i + 1) / (2.0 * kPi), 1e-18) << "leg " << i + 1;
+    const LegSpec& leg = spec.legs[static_cast<std::size_t>(i)];
+    const double hand = leg.thread == ThreadSense::Right ? 1.0 : -1.0;
+    for (const double qm : {0.0, 3.7, -12.0}) {
+      for (const double dtheta : {0.3, -0.7}) {
+        EXPECT_NEAR(model.leg(i).twist_gain * dtheta, screw_nut_length_error(hand, leg.driven, leg.lead, qm, dtheta), 1e-15)
+            << "leg " << i + 1;
+      }
+    }
+    EXPECT_EQ(model.leg(i).twist_sign, hand) << "leg " << i + 1;
   }
 }
 

@@ -10,7 +10,8 @@ namespace hexatwist {
 /// Hand of the lead screw's thread.
 enum class ThreadSense { Right, Left };
 
-/// Which end of the leg carries the motor that turns the screw.
+/// Which end of the leg carries the motor that turns the screw. It does not change the sign of the
+/// twist term (docs/theory.md §4); it is recorded for the servo model and for the report.
 enum class DrivenSide { Base, Platform };
 
 /// One leg as given by the user (unvalidated).
@@ -56,7 +57,7 @@ struct Leg {
   double cos_theta_home;     ///< cos(theta_home)
   double sin_theta_home;     ///< sin(theta_home)
   double lead;               ///< screw lead [m]
-  double twist_sign;         ///< +1 right-hand thread driven at the base; each flip negates
+  double twist_sign;         ///< +1 for a right-hand thread, -1 for a left-hand one (docs/theory.md §4)
   double twist_gain;         ///< twist_sign * lead / 2pi: real minus motor-side length per rad [m/rad]
   ThreadSense thread;        ///< thread hand
   DrivenSide driven;         ///< driven side
