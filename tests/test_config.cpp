@@ -238,7 +238,8 @@ TEST(Config, PerLegScrewSettingsOverrideTheScrewBlock) {
   add(1, "lead: 0.004");
   const Model m = load_model(yaml, "override.yaml");
   const double g = 0.010 / (2.0 * kPi);
-  const std::array<double, kLegs> expected{g, 0.004 / (2.0 * kPi), -g, g, -g, g};
+  // The thread hand sets the sign of the twist term; the driven side does not (theory.md §4).
+  const std::array<double, kLegs> expected{g, 0.004 / (2.0 * kPi), -g, g, g, -g};
   for (int i = 0; i < kLegs; ++i)
     EXPECT_NEAR(m.leg(i).twist_gain, expected[static_cast<std::size_t>(i)], 1e-18) << "leg " << i + 1;
   EXPECT_EQ(m.leg(1).lead, 0.004);
