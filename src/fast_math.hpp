@@ -42,10 +42,12 @@ inline v2d atan2(v2d y, v2d x) noexcept {
   const v2d w = z * z;
   // atan(z)/z as the [6/6] Pade approximant in w = z^2 of its Taylor series sum (-w)^n/(2n+1);
   // its error is below 1e-18 for w <= tan(pi/8)^2 (checked in 50-digit arithmetic).
-  const v2d P = 1.0 + w * (2.7866666666666666 + w * (2.8904347826086956 + w * (1.3693416149068323 +
-                w * (0.28994079401402056 + w * (0.02213105421074192 + w * 0.0002685815488923002)))));
-  const v2d Q = 1.0 + w * (3.12 + w * (3.7304347826086954 + w * (2.1316770186335403 +
-                w * (0.5890160183066362 + w * (0.0692960021537219 + w * 0.0023098667384573966)))));
+  // Estrin's scheme (w^2, w^4) instead of Horner: half the dependent multiply-adds.
+  const v2d w2 = w * w, w4 = w2 * w2;
+  const v2d P = (1.0 + 2.7866666666666666 * w) + w2 * (2.8904347826086956 + 1.3693416149068323 * w) +
+                w4 * ((0.28994079401402056 + 0.02213105421074192 * w) + w2 * 0.0002685815488923002);
+  const v2d Q = (1.0 + 3.12 * w) + w2 * (3.7304347826086954 + 2.1316770186335403 * w) +
+                w4 * ((0.5890160183066362 + 0.0692960021537219 * w) + w2 * 0.0023098667384573966);
   v2d a = z * P / Q + masked(upper, kPi / 4);
   // Unfold: swapped octant a -> pi/2 - a; x < 0: a -> pi - a; y < 0 (sign bit): a -> -a.
   a = masked(swap, kPi / 2) + from_bits(bits(a) ^ (swap & bits(splat(-0.0))));
@@ -78,16 +80,21 @@ inline void sin_cos(v2d x, v2d& s, v2d& c) noexcept {
   const v2d r = ((x - k * 1.5707963267341256) - k * 6.077100506303966e-11) - k * 2.0222662487959506e-21;
   const v2d r2 = r * r;
   // Taylor to r^17 (sin) and r^18 (cos): the first omitted terms are < 5e-17 at |r| = pi/4.
-  const v2d sr = r + r * r2 * (-1.0 / 6 + r2 * (1.0 / 120 + r2 * (-1.0 / 5040 + r2 * (1.0 / 362880 +
-                 r2 * (-1.0 / 39916800 + r2 * (1.0 / 6227020800.0 + r2 * (-1.0 / 1307674368000.0 +
-                 r2 * (1.0 / 355687428096000.0))))))));
-  const v2d cr = 1.0 + r2 * (-0.5 + r2 * (1.0 / 24 + r2 * (-1.0 / 720 + r2 * (1.0 / 40320 +
-                 r2 * (-1.0 / 3628800 + r2 * (1.0 / 479001600.0 + r2 * (-1.0 / 87178291200.0 +
-                 r2 * (1.0 / 20922789888000.0 + r2 * (-1.0 / 6402373705728000.0)))))))));
+  // Estrin's scheme in r^2, r^4, r^8 keeps the chain of dependent multiply-adds short.
+  const v2d r4 = r2 * r2, r8 = r4 * r4;
+  const v2d sin_poly = ((-1.0 / 6 + r2 * (1.0 / 120)) + r4 * (-1.0 / 5040 + r2 * (1.0 / 362880))) +
+                       r8 * ((-1.0 / 39916800 + r2 * (1.0 / 6227020800.0)) +
+                             r4 * (-1.0 / 1307674368000.0 + r2 * (1.0 / 355687428096000.0)));
+  const v2d sr = r + r * r2 * sin_poly;
+  const v2d cos_poly = ((-0.5 + r2 * (1.0 / 24)) + r4 * (-1.0 / 720 + r2 * (1.0 / 40320))) +
+                       r8 * (((-1.0 / 3628800 + r2 * (1.0 / 479001600.0)) +
+                              r4 * (-1.0 / 87178291200.0 + r2 * (1.0 / 20922789888000.0))) +
+                             r8 * (-1.0 / 6402373705728000.0));
+  const v2d cr = 1.0 + r2 * cos_poly;
   // Quadrant q = k mod 4: q odd swaps sin and cos; sin < 0 for q = 2, 3; cos < 0 for q = 1, 2.
   const v2d k4 = k * 0.25;
   const v2d n = (k4 + kShift) - kShift;                           // round(k / 4)
-  const v2d q = k - 4.0 * (n - blend(n > k4, splat(1.0), splat(0.0)));  // k - 4 floor(k / 4)
+  const v2d q = k - 4.0 * (n - masked(n > k4, 1.0));           // k - 4 floor(k / 4)
   const v2m odd = (q == 1.0) | (q == 3.0);
   const v2d s0 = blend(odd, cr, sr), c0 = blend(odd, sr, cr);
   s = blend(q >= 2.0, -s0, s0);
