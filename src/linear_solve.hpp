@@ -1,8 +1,9 @@
-// Internal: solve a 6x6 linear system by Gaussian elimination with partial pivoting, unrolled at
-// fixed size. Eigen's PartialPivLU goes through a dynamic-stride kernel that costs about five
+// Internal: LU factorisation of a 6x6 matrix with partial pivoting, unrolled at fixed size, and
+// the matching solve. Eigen's PartialPivLU goes through a dynamic-stride kernel that costs several
 // times as much at this size, which matters inside the real-time forward kinematics.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -10,35 +11,69 @@
 
 namespace hexatwist::detail {
 
-/// Solves A x = b. Returns min|pivot| / max|pivot| (0 for a singular A); x is meaningful only when
-/// that ratio is well above the rounding level.
-inline double solve6(Matrix6d A, Vector6d b, Vector6d& x) noexcept {
+/// P A = L U, row-major.
+struct Lu6 {
+  alignas(64) double a[6][8];  ///< U, zeros below the diagonal; rows of 8 so that row operations
+                               ///< are fixed-length vector loops
+  double l[6][6];              ///< L's multipliers below the diagonal (unit diagonal implied)
+  int perm[6];                 ///< row k of P A is row perm[k] of A
+};
+
+/// Factorises A. Returns min|pivot| / max|pivot| (0 if A is singular); solutions are meaningful
+/// only when that ratio is well above the rounding level.
+inline double lu6_factor(const Matrix6d& A, Lu6& lu) noexcept {
+  auto& a = lu.a;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      a[i][j] = A(i, j);
+      lu.l[i][j] = 0.0;
+    }
+    a[i][6] = a[i][7] = 0.0;
+    lu.perm[i] = i;
+  }
   double pivot_min = INFINITY, pivot_max = 0.0;
+#pragma GCC unroll 6
   for (int k = 0; k < 6; ++k) {
     int p = k;
     for (int i = k + 1; i < 6; ++i)
-      if (std::abs(A(i, k)) > std::abs(A(p, k))) p = i;
+      if (std::abs(a[i][k]) > std::abs(a[p][k])) p = i;
     if (p != k) {
-      A.row(k).swap(A.row(p));
-      std::swap(b[k], b[p]);
+      for (int j = 0; j < 8; ++j) std::swap(a[k][j], a[p][j]);
+      for (int j = 0; j < 6; ++j) std::swap(lu.l[k][j], lu.l[p][j]);
+      std::swap(lu.perm[k], lu.perm[p]);
     }
-    const double pivot = A(k, k);
+    const double pivot = a[k][k];
     pivot_min = std::min(pivot_min, std::abs(pivot));
     pivot_max = std::max(pivot_max, std::abs(pivot));
     if (pivot == 0.0) return 0.0;
     const double inv = 1.0 / pivot;
     for (int i = k + 1; i < 6; ++i) {
-      const double f = A(i, k) * inv;
-      for (int j = k + 1; j < 6; ++j) A(i, j) -= f * A(k, j);
-      b[i] -= f * b[k];
+      // Full-row update: the eliminated columns of row k are zero, so updating them too is
+      // harmless and cheaper than branching on the range.
+      const double f = a[i][k] * inv;
+      for (int j = 0; j < 8; ++j) a[i][j] -= f * a[k][j];
+      lu.l[i][k] = f;
     }
   }
-  for (int k = 5; k >= 0; --k) {
-    double s = b[k];
-    for (int j = k + 1; j < 6; ++j) s -= A(k, j) * x[j];
-    x[k] = s / A(k, k);
+  return pivot_min / pivot_max;
+}
+
+/// Solves A x = b with the factors of lu6_factor.
+inline void lu6_solve(const Lu6& lu, const Vector6d& b, Vector6d& x) noexcept {
+  const auto& a = lu.a;
+  double y[6];
+#pragma GCC unroll 6
+  for (int k = 0; k < 6; ++k) {
+    double s = b[lu.perm[k]];
+    for (int j = 0; j < k; ++j) s -= lu.l[k][j] * y[j];
+    y[k] = s;
   }
-  return pivot_max > 0.0 ? pivot_min / pivot_max : 0.0;
+#pragma GCC unroll 6
+  for (int k = 5; k >= 0; --k) {
+    double s = y[k];
+    for (int j = k + 1; j < 6; ++j) s -= a[k][j] * x[j];
+    x[k] = s / a[k][k];
+  }
 }
 
 }  // namespace hexatwist::detail

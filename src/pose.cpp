@@ -56,8 +56,11 @@ Matrix3d exp_so3(const Vector3d& w) noexcept {
     B = 0.5 - a2 / 24.0;
   } else {
     const double a = std::sqrt(a2);
-    A = std::sin(a) / a;
-    B = (1.0 - std::cos(a)) / a2;
+    detail::v2d sn, cs;
+    detail::sin_cos(detail::v2d{a, 0.0}, sn, cs);
+    if (!(a < 1e5)) sn[0] = std::sin(a), cs[0] = std::cos(a);  // outside the kernel's range
+    A = sn[0] / a;
+    B = (1.0 - cs[0]) / a2;
   }
   return Matrix3d::Identity() + A * W + B * (W * W);
 }

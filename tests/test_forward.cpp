@@ -5,8 +5,8 @@
 namespace hexatwist::test {
 namespace {
 
-// Measured worst round trip 1.0e-12 m / rad (FK stops at a 1e-12 m residual); issue bound 1e-10.
-constexpr double kRoundTripTol = 1e-11;
+// Measured worst round trip 1.4e-13 m / rad (FK stops at a 1e-13 m residual); issue bound 1e-10.
+constexpr double kRoundTripTol = 1.5e-12;
 
 // Lengths of `kind` for a pose: geometric or motor-side (the compensated command).
 Vector6d lengths_for(const Model& model, const Placement& x, LengthKind kind) {
@@ -71,7 +71,7 @@ TEST(Forward, WarmStartFromOneMillisecondEarlierTakesFewIterations) {
     worst = std::max(worst, r.iterations);
     previous = r.placement;
   }
-  EXPECT_LE(worst, 3);
+  EXPECT_LE(worst, 3);  // measured: 2
 }
 
 Matrix6d residual_jacobian_fd(const Model& model, const Placement& x, const Vector6d& m, LengthKind kind, double h) {
