@@ -5,8 +5,10 @@
 namespace hexatwist::test {
 namespace {
 
-// Measured worst round trip 1.4e-13 m / rad (FK stops at a 1e-13 m residual); issue bound 1e-10.
-constexpr double kRoundTripTol = 1.5e-12;
+// FK stops at a 1e-12 m residual. Measured worst round trip: 1.0e-12 m / rad on the seed
+// platform, 8.3e-12 on the random asymmetric ones (worse conditioned); issue bound 1e-10.
+constexpr double kRoundTripTol = 1e-11;
+constexpr double kRandomPlatformTol = 1e-10;
 
 // Lengths of `kind` for a pose: geometric or motor-side (the compensated command).
 Vector6d lengths_for(const Model& model, const Placement& x, LengthKind kind) {
@@ -19,7 +21,8 @@ Vector6d lengths_for(const Model& model, const Placement& x, LengthKind kind) {
   return st.length - err;
 }
 
-void round_trip(const Model& model, LengthKind kind, int count, double dpos, double drot, std::uint32_t seed) {
+void round_trip(const Model& model, LengthKind kind, int count, double dpos, double drot, std::uint32_t seed,
+                double tol = kRoundTripTol) {
   std::mt19937_64 rng(seed);
   int worst_iterations = 0;
   for (int n = 0; n < count; ++n) {
@@ -29,9 +32,9 @@ void round_trip(const Model& model, LengthKind kind, int count, double dpos, dou
     ASSERT_EQ(forward_kinematics(model, lengths_for(model, x, kind), kind, Placement{}, r), Status::Ok)
         << "pose " << str(p) << " iterations " << r.iterations << " residual " << r.residual;
     const PoseError e = pose_error(r.placement, x);
-    ASSERT_LT(e.position, kRoundTripTol) << str(p);
-    ASSERT_LT(e.rotation, kRoundTripTol) << str(p);
-    ASSERT_LT((r.pose.to_vector() - p.to_vector()).cwiseAbs().maxCoeff(), kRoundTripTol) << str(p);
+    ASSERT_LT(e.position, tol) << str(p);
+    ASSERT_LT(e.rotation, tol) << str(p);
+    ASSERT_LT((r.pose.to_vector() - p.to_vector()).cwiseAbs().maxCoeff(), tol) << str(p);
     ASSERT_LE(r.residual, FkOptions{}.tolerance);
     worst_iterations = std::max(worst_iterations, r.iterations);
   }
@@ -50,7 +53,8 @@ TEST(Forward, TwistAwareRoundTripOnRandomAsymmetricPlatforms) {
   std::mt19937_64 rng(kSeed + 11);
   for (int m = 0; m < 40; ++m) {
     const Model model = random_platform(rng);
-    round_trip(model, LengthKind::Motor, 50, 0.2, deg2rad(15), kSeed + 100 + static_cast<std::uint32_t>(m));
+    round_trip(model, LengthKind::Motor, 50, 0.2, deg2rad(15), kSeed + 100 + static_cast<std::uint32_t>(m),
+               kRandomPlatformTol);
   }
 }
 
