@@ -11,7 +11,7 @@ TEST(Pose, RotationIsRzRyRxAsInEquationThree) {
     const Matrix3d expected = (Eigen::AngleAxisd(rpy[2], Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy[1], Vector3d::UnitY()) *
                                Eigen::AngleAxisd(rpy[0], Vector3d::UnitX()))
                                   .toRotationMatrix();
-    EXPECT_LT((rotation_from_rpy(rpy) - expected).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_LT((rotation_from_rpy(rpy) - expected).cwiseAbs().maxCoeff(), 4e-15);  // measured 1.1e-15 (FMA)
   }
 }
 
