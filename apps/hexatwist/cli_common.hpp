@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <stdexcept>
@@ -51,6 +52,9 @@ std::vector<double> parse_numbers(const std::string& text, std::size_t count, co
 
 /// Parses "x,y,z,roll,pitch,yaw" in m and degrees into a pose [m, rad].
 Pose parse_pose_m_deg(const std::string& text, const std::string& option);
+
+/// A rounding-level value (|v| < 1e-12) as 0, so that text output shows 0.0000, not -0.0000.
+inline double tidy(double v) { return std::abs(v) < 1e-12 ? 0.0 : v; }
 
 /// "leg 3: length 2.5012 m above the maximum 2.45 m": one line for a limit report.
 std::string describe_limit(const LimitReport& report);

@@ -16,7 +16,7 @@ struct ConfigOptions {
   bool yaml = false;
 };
 
-std::string v3(const Vector3d& v) { return fmt::format("[{:.6f}, {:.6f}, {:.6f}]", v.x(), v.y(), v.z()); }
+std::string v3(const Vector3d& v) { return fmt::format("[{:.6f}, {:.6f}, {:.6f}]", tidy(v.x()), tidy(v.y()), tidy(v.z())); }
 
 int run_config(const ConfigOptions& o) {
   if (o.yaml) {
@@ -35,7 +35,7 @@ int run_config(const ConfigOptions& o) {
     j.key("observation_point").vector(spec.observation_P);
     j.key("limits").begin_object().field("length_min", lim.length_min).field("length_max", lim.length_max);
     j.field("bend_max", lim.bend_max).field("singularity_margin", lim.singularity_margin).end_object();
-    j.key("legs").begin_array();
+    j.key("legs").begin_array(true);
     for (int i = 0; i < kLegs; ++i) {
       const Leg& l = model.leg(i);
       const bool axes = !std::isnan(l.theta_home);

@@ -50,16 +50,17 @@ int run_fk(const FkOptionsCli& o) {
     std::string out = fmt::format("hexatwist fk on {} ({} lengths{})\n", model_source(o.model), kind_name,
                                   o.motor ? ", twist included" : "");
     if (status == Status::Ok)
-      out += fmt::format("pose: x={:.9f} y={:.9f} z={:.9f} m, roll={:.9f} pitch={:.9f} yaw={:.9f} deg\n", q[0], q[1],
-                         q[2], rad2deg(q[3]), rad2deg(q[4]), rad2deg(q[5]));
+      out += fmt::format("pose: x={:.9f} y={:.9f} z={:.9f} m, roll={:.9f} pitch={:.9f} yaw={:.9f} deg\n", tidy(q[0]),
+                         tidy(q[1]), tidy(q[2]), rad2deg(tidy(q[3])), rad2deg(tidy(q[4])), rad2deg(tidy(q[5])));
     out += fmt::format("iterations: {}, residual: {:.3g} m\n", result->iterations, result->residual);
     out += fmt::format("status: {}\n", final_status == Status::Ok ? std::string("ok") : std::string(to_string(final_status)));
     std::fputs(out.c_str(), stdout);
   }
   if (status != Status::Ok) {
-    std::fprintf(stderr, "hexatwist: forward kinematics failed: %s (%s) after %d iterations, residual %.3g m\n",
-                 std::string(to_string(status)).c_str(), std::string(describe(status)).c_str(), result->iterations,
-                 result->residual);
+    std::fprintf(stderr,
+                 "hexatwist: forward kinematics failed: %s after %d iterations, residual %.3g m (lengths out of reach, "
+                 "or try --guess near the expected pose)\n",
+                 std::string(to_string(status)).c_str(), result->iterations, result->residual);
     return kExitOutOfLimit;
   }
   if (final_status != Status::Ok) {

@@ -17,9 +17,6 @@ struct IkOptions {
   bool json = false;
 };
 
-// Prints a rounding-level value as 0 rather than -0.0000.
-double tidy(double v) { return std::abs(v) < 1e-12 ? 0.0 : v; }
-
 int run_ik(const IkOptions& o) {
   const Model model = load_model_from(o.model);
   const Pose pose = parse_pose_m_deg(o.pose, "--pose");
@@ -43,7 +40,7 @@ int run_ik(const IkOptions& o) {
     j.key("pose").vector(pose.to_vector());
     j.key("limit");
     write_limit_json(j, report->limit);
-    j.key("legs").begin_array();
+    j.key("legs").begin_array(true);
     for (int i = 0; i < kLegs; ++i) {
       j.begin_object().field("leg", i + 1).field("length", report->legs.length[i]);
       j.key("twist");

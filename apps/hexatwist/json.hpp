@@ -17,7 +17,8 @@ class JsonWriter {
  public:
   JsonWriter& begin_object() { return open('{', true); }
   JsonWriter& end_object() { return close('}'); }
-  JsonWriter& begin_array() { return open('[', false); }
+  /// An array; `multiline` puts each element on its own line (for arrays of objects).
+  JsonWriter& begin_array(bool multiline = false) { return open('[', multiline); }
   JsonWriter& end_array() { return close(']'); }
 
   JsonWriter& key(std::string_view k) {
