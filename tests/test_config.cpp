@@ -169,6 +169,24 @@ TEST(Config, SeedFileGivesTheDefaultModel) {
   EXPECT_EQ(std::string(seed_config_yaml()), text) << "the embedded seed differs from configs/seed.yaml";
 }
 
+TEST(Config, SeedLegsFileIsTheSeedPlatformInTheLegsForm) {
+  // configs/seed-legs.yaml writes the seed's vectors to 15 significant digits: lengths and twists
+  // agree to the rounding of those digits (measured 2.0e-15 m, 2.7e-15 rad); bound 5e-14.
+  const Model legs = load_model(read_file(HEXATWIST_SOURCE_DIR "/configs/seed-legs.yaml"), "seed-legs.yaml");
+  std::mt19937_64 rng(kSeed + 70);
+  for (int n = 0; n < 200; ++n) {
+    const Pose p = random_valid_pose(seed_model(), rng, 0.5, deg2rad(30));
+    CommandReport a, b;
+    ASSERT_EQ(compute_commands(seed_model(), p, a), Status::Ok);
+    ASSERT_EQ(compute_commands(legs, p, b), Status::Ok) << str(p);
+    EXPECT_LT((a.legs.length - b.legs.length).cwiseAbs().maxCoeff(), 5e-14) << str(p);
+    EXPECT_LT((a.twist - b.twist).cwiseAbs().maxCoeff(), 5e-14) << str(p);
+    EXPECT_LT((a.compensated - b.compensated).cwiseAbs().maxCoeff(), 5e-14) << str(p);
+  }
+  EXPECT_EQ(legs.spec().observation_P, seed_model().spec().observation_P);
+  EXPECT_EQ(legs.spec().limits.length_max, seed_model().spec().limits.length_max);
+}
+
 TEST(Config, SeedFileIsTheDocumentedSymmetricPlatform) {
   // Ra 1.2, Rb 1.5, da 0.2, db 0.3, H 1.511 m; lead 10 mm, right hand, driven at the base.
   SymmetricSpec s;
