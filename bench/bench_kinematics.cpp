@@ -67,30 +67,23 @@ void add_statistics(benchmark::internal::Benchmark* b) {
   })->ComputeStatistics("min", [](const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); });
 }
 
-void BM_CompensatedCommand(benchmark::State& state) {
+// Motor commands for one strategy, cycling through the random poses.
+void commands(benchmark::State& state, Strategy strategy) {
   const auto& poses = random_poses();
   Vector6d cmd;
   LimitReport lim;
   std::size_t i = 0;
   for (auto _ : state) {
-    const Status s = motor_commands(model(), poses[i++ & 1023], Strategy::Compensated, cmd, lim);
+    const Status s = motor_commands(model(), poses[i++ & 1023], strategy, cmd, lim);
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(cmd);
   }
 }
+
+void BM_CompensatedCommand(benchmark::State& state) { commands(state, Strategy::Compensated); }
 BENCHMARK(BM_CompensatedCommand)->Apply(add_statistics);
 
-void BM_ConventionalCommand(benchmark::State& state) {
-  const auto& poses = random_poses();
-  Vector6d cmd;
-  LimitReport lim;
-  std::size_t i = 0;
-  for (auto _ : state) {
-    const Status s = motor_commands(model(), poses[i++ & 1023], Strategy::Conventional, cmd, lim);
-    benchmark::DoNotOptimize(s);
-    benchmark::DoNotOptimize(cmd);
-  }
-}
+void BM_ConventionalCommand(benchmark::State& state) { commands(state, Strategy::Conventional); }
 BENCHMARK(BM_ConventionalCommand)->Apply(add_statistics);
 
 void BM_TwistAwareFkWarm(benchmark::State& state) {

@@ -17,6 +17,8 @@
 #include <string_view>
 #include <vector>
 
+#include "yaml_text.hpp"
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -121,32 +123,10 @@ std::string vec(const YAML::Node& v) {
   return os.str();
 }
 
-// The seed platform, symmetric form, one key per line.
-const std::string kSymmetric =
-    "name: cli test platform\n"     //  1
-    "symmetric:\n"                  //  2
-    "  Ra: 1.2\n"                   //  3
-    "  Rb: 1.5\n"                   //  4
-    "  da: 0.2\n"                   //  5
-    "  db: 0.3\n"                   //  6
-    "  H: 1.511\n"                  //  7
-    "screw:\n"                      //  8
-    "  lead: 0.010\n"               //  9
-    "  thread: right\n"             // 10
-    "  driven_side: base\n"         // 11
-    "limits:\n"                     // 12
-    "  length_min: 1.40\n"          // 13
-    "  length_max: 2.45\n"          // 14
-    "  bend_max_deg: 40\n"          // 15
-    "  singularity_margin_deg: 5\n";  // 16
+using hexatwist::test::kSymmetricYaml;
+const std::string& kSymmetric = kSymmetricYaml;
 
-std::string replace_line(const std::string& text, int n, const std::string& with) {
-  std::istringstream in(text);
-  std::string out;
-  int k = 0;
-  for (std::string l; std::getline(in, l);) out += (++k == n ? with : l) + "\n";
-  return out;
-}
+using hexatwist::test::replace_line;
 
 // The default platform in the `legs` form, built from `config --json`. Lines: 1 home_height,
 // 2-5 screw, 6-8 limits, 9 "legs:", then leg i (0-based) from line 10 + 4 i: base, platform,
@@ -317,7 +297,7 @@ TEST(Cli, ConfigFileSettingsReachTheModel) {
   const Outcome r = run({"config", "--json", "--config=" + file});
   ASSERT_EQ(r.code, 0) << r.err;
   const YAML::Node j = json(r);
-  EXPECT_EQ(j["name"].as<std::string>(), "cli test platform");
+  EXPECT_EQ(j["name"].as<std::string>(), "test platform");
   for (const auto& leg : j["legs"]) EXPECT_NEAR(leg["twist_gain"].as<double>(), -0.004 / (2 * kPi), 1e-18);
 }
 

@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "support.hpp"
+#include "yaml_text.hpp"
 
 namespace hexatwist::test {
 namespace {
@@ -22,36 +23,6 @@ std::string read_file(const std::string& path) {
   return s.str();
 }
 
-std::vector<std::string> split_lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);) lines.push_back(l);
-  return lines;
-}
-
-std::string join_lines(const std::vector<std::string>& lines) {
-  std::string out;
-  for (const std::string& l : lines) out += l + "\n";
-  return out;
-}
-
-// Line `n` (1-based) of `text`.
-std::string line_of(const std::string& text, int n) { return split_lines(text).at(static_cast<std::size_t>(n - 1)); }
-
-// `text` with line `n` (1-based) replaced by `with` (which may hold several lines).
-std::string replace_line(const std::string& text, int n, const std::string& with) {
-  std::vector<std::string> lines = split_lines(text);
-  lines.at(static_cast<std::size_t>(n - 1)) = with;
-  return join_lines(lines);
-}
-
-// `text` without lines first..last (1-based, inclusive).
-std::string erase_lines(const std::string& text, int first, int last) {
-  std::vector<std::string> lines = split_lines(text);
-  lines.erase(lines.begin() + (first - 1), lines.begin() + last);
-  return join_lines(lines);
-}
-
 std::string vec(const Vector3d& v) {
   std::ostringstream os;
   os.precision(17);
@@ -59,24 +30,7 @@ std::string vec(const Vector3d& v) {
   return os.str();
 }
 
-// The seed platform in the symmetric form, one key per line (line numbers are used below).
-const std::string kSymmetric =
-    "name: test platform\n"         //  1
-    "symmetric:\n"                  //  2
-    "  Ra: 1.2\n"                   //  3
-    "  Rb: 1.5\n"                   //  4
-    "  da: 0.2\n"                   //  5
-    "  db: 0.3\n"                   //  6
-    "  H: 1.511\n"                  //  7
-    "screw:\n"                      //  8
-    "  lead: 0.010\n"               //  9
-    "  thread: right\n"             // 10
-    "  driven_side: base\n"         // 11
-    "limits:\n"                     // 12
-    "  length_min: 1.40\n"          // 13
-    "  length_max: 2.45\n"          // 14
-    "  bend_max_deg: 40\n"          // 15
-    "  singularity_margin_deg: 5\n";  // 16
+const std::string& kSymmetric = kSymmetricYaml;
 
 // A model in the `legs` form. Layout: 1 name, 2 home_height, 3-6 screw, 7-11 limits, 12 "legs:",
 // then four lines per leg i (0-based) from line 13 + 4 i: base, platform, base_axis, platform_axis.
