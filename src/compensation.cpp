@@ -38,7 +38,9 @@ Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, V
                       LimitReport& report) noexcept {
   LegState legs;
   if (!pose.is_finite()) return fail(report, Status::NonFiniteInput);
-  if (const Status s = inverse_kinematics(model, pose, legs); s != Status::Ok) return fail(report, s);
+  // The Placement overload: the Pose one would test finiteness a second time.
+  if (const Status s = inverse_kinematics(model, placement_from_pose(pose), legs); s != Status::Ok)
+    return fail(report, s);
   if (const Status s = check_limits(model, legs, report); s != Status::Ok) return s;
   if (strategy == Strategy::Conventional || !model.has_twist()) {
     command = legs.length;

@@ -28,6 +28,31 @@ inline v2d vabs(v2d a) noexcept { return from_bits(bits(a) & ~bits(splat(-0.0)))
 /// c where the mask is set, else 0.
 inline v2d masked(v2m mask, double c) noexcept { return from_bits(mask & bits(splat(c))); }
 
+/// Two legs' worth of a leg-vector set: lanes are legs i and i+1 (rows i, i+1 of a LegVectors).
+/// Per-leg code written on these packets keeps every intermediate in registers; the equivalent
+/// expressions on whole LegVectors went through memory temporaries and out-of-line helpers.
+struct v3d {
+  v2d x, y, z;
+};
+inline v2d load2(const double* p) noexcept {
+  v2d v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store2(double* p, v2d v) noexcept { std::memcpy(p, &v, sizeof v); }
+/// Rows i and i+1 of a column-major 6-row matrix or vector, column by column.
+template <class M>
+inline v3d load_rows(const M& m, int i) noexcept {
+  return {load2(m.data() + i), load2(m.data() + kLegs + i), load2(m.data() + 2 * kLegs + i)};
+}
+inline v2d dot(const v3d& a, const v3d& b) noexcept { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline v3d cross(const v3d& a, const v3d& b) noexcept {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline v3d operator*(v2d f, const v3d& a) noexcept { return {f * a.x, f * a.y, f * a.z}; }
+inline v3d operator+(const v3d& a, const v3d& b) noexcept { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline v3d operator-(const v3d& a, const v3d& b) noexcept { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+
 /// atan2 of two lanes, in [-pi, pi] (-pi only for y = -0), atan2(+-0, +0) = +-0. Error below 2 ulp of pi.
 inline v2d atan2(v2d y, v2d x) noexcept {
   const v2d ax = vabs(x), ay = vabs(y);

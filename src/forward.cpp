@@ -1,9 +1,11 @@
 #include "hexatwist/forward.hpp"
 
 #include <cmath>
+#include <utility>
 
 #include "hexatwist/twist.hpp"
 #include "linear_solve.hpp"
+#include "twist_internal.hpp"
 
 namespace hexatwist {
 namespace {
@@ -14,12 +16,11 @@ constexpr int kMaxHalvings = 12;
 // J_f_x at the state `legs` (inverse kinematics already done): the length Jacobian, minus the
 // twist gain times the twist Jacobian for motor-side lengths.
 Status residual_jacobian(const Model& model, const LegState& legs, LengthKind kind, Matrix6d& J) noexcept {
-  length_jacobian(legs, J);
-  if (kind == LengthKind::Geometric || !model.has_twist()) return Status::Ok;
-  Matrix6d J_twist;
-  if (const Status s = twist_jacobian(model, legs, J_twist); s != Status::Ok) return s;
-  J -= model.geometry().twist_gain.asDiagonal() * J_twist;
-  return Status::Ok;
+  if (kind == LengthKind::Geometric || !model.has_twist()) {
+    length_jacobian(legs, J);
+    return Status::Ok;
+  }
+  return detail::motor_length_jacobian(model, legs, J);
 }
 
 // f = g(x) - lengths at the placement x, with g the geometric or motor-side lengths.
@@ -50,29 +51,38 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
   out.placement = guess;
   if (!lengths.allFinite() || !guess.t.allFinite() || !guess.R_BP.allFinite()) return Status::NonFiniteInput;
 
+  // The state at the iterate and at the trial point live in two buffers that trade places when
+  // a step is accepted (copying a LegState is ~90 moves); *legs ends up in out.legs on return.
+  LegState legs_try;
+  LegState* legs = &out.legs;
+  LegState* trial = &legs_try;
+  const auto finish = [&](Status status) noexcept {
+    if (legs != &out.legs) out.legs = *legs;
+    return status;
+  };
+
   Placement x = guess;
   Vector6d f;
-  if (const Status s = residual(model, x, lengths, kind, out.legs, f); s != Status::Ok) return s;
+  if (const Status s = residual(model, x, lengths, kind, *legs, f); s != Status::Ok) return s;
 
   Placement x_try;
   Vector6d f_try, step;
   Matrix6d J;
   detail::Lu6 lu;
-  LegState legs_try;
   for (;;) {
     out.placement = x;
     out.residual = f.cwiseAbs().maxCoeff();
     if (out.residual <= options.tolerance) {
       out.pose = pose_from_placement(x);
-      return Status::Ok;
+      return finish(Status::Ok);
     }
-    if (out.iterations >= options.max_iterations) return Status::NoConvergence;
+    if (out.iterations >= options.max_iterations) return finish(Status::NoConvergence);
 
     // Newton step on R^3 x SO(3): J [dt; dw] = -f, then t += dt, R = exp(dw) R. The Jacobian is
     // formed only here, so the converged last iterate never pays for one. (Reusing it for chord
     // steps was measured: more iterations, no gain, since two Newton steps usually suffice.)
-    if (const Status s = residual_jacobian(model, out.legs, kind, J); s != Status::Ok) return s;
-    if (!(detail::lu6_factor(J, lu) > options.singular_ratio)) return Status::SingularJacobian;
+    if (const Status s = residual_jacobian(model, *legs, kind, J); s != Status::Ok) return finish(s);
+    if (!(detail::lu6_factor(J, lu) > options.singular_ratio)) return finish(Status::SingularJacobian);
     detail::lu6_solve(lu, -f, step);
 
     // Backtracking: accept the first fraction of the step that lowers |f| (and stays away from
@@ -83,14 +93,14 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
     for (int h = 0; h <= kMaxHalvings && !accepted; ++h, alpha *= 0.5) {
       x_try.t = x.t + alpha * step.head<3>();
       x_try.R_BP = exp_so3(alpha * step.tail<3>()) * x.R_BP;
-      if (residual(model, x_try, lengths, kind, legs_try, f_try) != Status::Ok) continue;
+      if (residual(model, x_try, lengths, kind, *trial, f_try) != Status::Ok) continue;
       accepted = f_try.squaredNorm() < norm_f;
     }
     ++out.iterations;
-    if (!accepted) return Status::NoConvergence;
+    if (!accepted) return finish(Status::NoConvergence);
     x = x_try;
     f = f_try;
-    out.legs = legs_try;
+    std::swap(legs, trial);
   }
 }
 

@@ -47,8 +47,6 @@ Vector3d rpy_from_rotation(const Matrix3d& R) noexcept {
 
 Matrix3d exp_so3(const Vector3d& w) noexcept {
   const double a2 = w.squaredNorm();
-  Matrix3d W;
-  W << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
   double A, B;  // R = I + A W + B W^2
   if (a2 < 1e-12) {
     // Taylor series: error below 1e-25 for |w| < 1e-6.
@@ -62,7 +60,20 @@ Matrix3d exp_so3(const Vector3d& w) noexcept {
     A = sn[0] / a;
     B = (1.0 - cs[0]) / a2;
   }
-  return Matrix3d::Identity() + A * W + B * (W * W);
+  // Written out with W = [w]x and W^2 = w w^T - |w|^2 I, each entry in the order the 3x3 product
+  // W * W sums it (the zero terms are exact), without the matrix temporaries and product.
+  const double x = w.x(), y = w.y(), z = w.z();
+  Matrix3d R;
+  R(0, 0) = 1.0 + B * (-(z * z) - y * y);
+  R(1, 1) = 1.0 + B * (-(z * z) - x * x);
+  R(2, 2) = 1.0 + B * (-(y * y) - x * x);
+  R(0, 1) = A * -z + B * (y * x);
+  R(1, 0) = A * z + B * (x * y);
+  R(0, 2) = A * y + B * (z * x);
+  R(2, 0) = A * -y + B * (x * z);
+  R(1, 2) = A * -x + B * (z * y);
+  R(2, 1) = A * x + B * (y * z);
+  return R;
 }
 
 Placement placement_from_pose(const Pose& pose) noexcept {

@@ -4,6 +4,7 @@
 
 #include "fast_math.hpp"
 #include "geometry.hpp"
+#include "twist_internal.hpp"
 
 namespace hexatwist {
 namespace {
@@ -45,6 +46,38 @@ Status singular_joint(const Model& model, const LegState& st, const Coordinates&
 // Wraps an angle to (-pi, pi].
 double wrap(double a) noexcept { return a - 2.0 * kPi * std::ceil((a - kPi) / (2.0 * kPi)); }
 
+// The twist terms of legs i and i+1 (one packet), the same quantities and operation order as
+// coordinates() and twist_jacobian's, kept in registers.
+struct PacketTerms {
+  detail::v3d s, ja, jd;
+  detail::v2d ja_s, jd_s;
+  detail::v3d ja_x_jd;
+  detail::v2d x, y;
+};
+
+PacketTerms packet_terms(const Model& model, const LegState& st, int i) noexcept {
+  using namespace detail;
+  PacketTerms t;
+  t.s = load_rows(st.s_B, i);
+  t.ja = load_rows(model.geometry().axis_base_B, i);
+  t.jd = load_rows(st.axis_platform_B, i);
+  t.ja_s = dot(t.ja, t.s);
+  t.jd_s = dot(t.jd, t.s);
+  t.ja_x_jd = cross(t.ja, t.jd);
+  t.x = dot(t.ja, t.jd) - t.ja_s * t.jd_s;
+  t.y = dot(t.s, t.ja_x_jd);
+  return t;
+}
+
+// Lanes set where the leg is away from a U-joint singularity or has no axes (the fast path of
+// singular_joint; NaN fails it, and the slow path then names the joint). Callers AND the masks
+// of all packets and test once: extracting lanes costs more than the test itself.
+detail::v2m packet_regular(const PacketTerms& t, detail::v2d no_axes) noexcept {
+  return (t.x * t.x + t.y * t.y) + no_axes >= kSingularSin2;
+}
+
+bool all_lanes(detail::v2m m) noexcept { return (m[0] & m[1]) != 0; }
+
 }  // namespace
 
 Status twist_absolute(const Model& model, const LegState& state, Vector6d& theta) noexcept {
@@ -55,12 +88,21 @@ Status twist_absolute(const Model& model, const LegState& state, Vector6d& theta
 }
 
 Status twist(const Model& model, const LegState& state, Vector6d& dtheta) noexcept {
-  const Coordinates c = coordinates(model, state);
-  if (const Status s = singular_joint(model, state, c); s != Status::Ok) return s;
-  // theta - theta_home in one atan2: rotate (x, y) by -theta_home.
+  using namespace detail;
   const LegGeometry& g = model.geometry();
-  const Array6d c0 = g.cos_theta_home.array(), s0 = g.sin_theta_home.array();
-  dtheta = (detail::atan2(c.y * c0 - c.x * s0, c.x * c0 + c.y * s0) * g.has_axes.array()).matrix();
+  v2d y_rot[3], x_rot[3];
+  v2m regular = bits(splat(-0.0)) | ~bits(splat(-0.0));  // all ones
+  for (int i = 0; i < kLegs; i += 2) {
+    const PacketTerms t = packet_terms(model, state, i);
+    regular &= packet_regular(t, 1.0 - load2(g.has_axes.data() + i));
+    // theta - theta_home in one atan2: rotate (x, y) by -theta_home.
+    const v2d c0 = load2(g.cos_theta_home.data() + i), s0 = load2(g.sin_theta_home.data() + i);
+    y_rot[i / 2] = t.y * c0 - t.x * s0;
+    x_rot[i / 2] = t.x * c0 + t.y * s0;
+  }
+  if (!all_lanes(regular)) return singular_joint(model, state, coordinates(model, state));
+  for (int i = 0; i < kLegs; i += 2)
+    store2(dtheta.data() + i, atan2(y_rot[i / 2], x_rot[i / 2]) * load2(g.has_axes.data() + i));
   return Status::Ok;
 }
 
@@ -72,33 +114,67 @@ Status twist_continued(const Model& model, const LegState& state, const Vector6d
   return Status::Ok;
 }
 
-Status twist_jacobian(const Model& model, const LegState& state, Matrix6d& J) noexcept {
-  using detail::cross;
-  using detail::dot;
-  using detail::scale_rows;
-  const Coordinates c = coordinates(model, state);
-  if (const Status s = singular_joint(model, state, c); s != Status::Ok) return s;
+namespace {
+
+// Rows i, i+1 of the twist Jacobian (twist_jacobian), or, with kMotor, of the motor-side length
+// Jacobian [s^T, (arm x s)^T] - twist_gain * (twist Jacobian). Returns packet_regular's lane
+// mask; where a lane is clear the leg is near a U-joint singularity and J's rows are unspecified.
+template <bool kMotor>
+detail::v2m jacobian_rows(const Model& model, const LegState& state, int i, Matrix6d& J) noexcept {
+  using namespace detail;
   const LegGeometry& g = model.geometry();
-  const LegVectors& s = state.s_B;
-  const LegVectors& ja = g.axis_base_B;
-  const LegVectors& jd = state.axis_platform_B;
-  // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2), with the partials of y and x in s and jd.
+  const PacketTerms t = packet_terms(model, state, i);
+  const v2d mask = load2(g.has_axes.data() + i);
+  const v2m regular = packet_regular(t, 1.0 - mask);
+  // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2), with the partials of y and x in s and jd:
+  // dy/ds = ja x jd, dx/ds = -(jd.s) ja - (ja.s) jd, dy/djd = s x ja, dx/djd = ja - (ja.s) s.
   // Legs without axes have x = y = 0: give them n2 = 1 and mask their rows to zero.
-  const Array6d mask = g.has_axes.array();
-  const Array6d n2 = c.x.square() + c.y.square() + (1.0 - mask);
-  const Array6d fx = mask * c.x / n2, fy = mask * c.y / n2;
-  const Array6d ja_s = dot(ja, s), jd_s = dot(jd, s);
-  const LegVectors dy_ds = cross(ja, jd);
-  const LegVectors dx_ds = -scale_rows(jd_s, ja) - scale_rows(ja_s, jd);
-  const LegVectors dy_djd = cross(s, ja);
-  const LegVectors dx_djd = ja - scale_rows(ja_s, s);
-  const LegVectors g_s = scale_rows(fx, dy_ds) - scale_rows(fy, dx_ds);
-  const LegVectors g_jd = scale_rows(fx, dy_djd) - scale_rows(fy, dx_djd);
+  const v2d n2 = t.x * t.x + t.y * t.y + (1.0 - mask);
+  const v2d fx = mask * t.x / n2, fy = mask * t.y / n2;
+  const v3d dx_ds = (-t.jd_s) * t.ja - t.ja_s * t.jd;
+  const v3d g_s = fx * t.ja_x_jd - fy * dx_ds;
+  const v3d g_jd = fx * cross(t.s, t.ja) - fy * (t.ja - t.ja_s * t.s);
   // s = L/|L|: ds = (I - s s^T) dL / |L|; dL = dt + dw x arm; djd = dw x jd.
-  const LegVectors a = scale_rows(state.length.array().inverse(), g_s - scale_rows(dot(g_s, s), s));
-  J.leftCols<3>() = a;
-  J.rightCols<3>() = cross(state.arm_B, a) + cross(jd, g_jd);
+  const v2d inv_length = 1.0 / load2(state.length.data() + i);
+  const v3d a = inv_length * (g_s - dot(g_s, t.s) * t.s);
+  const v3d arm = load_rows(state.arm_B, i);
+  const v3d b = cross(arm, a) + cross(t.jd, g_jd);
+  const v2d col[6] = {a.x, a.y, a.z, b.x, b.y, b.z};
+  if constexpr (kMotor) {
+    // J = length Jacobian - twist_gain * twist Jacobian (docs/theory.md §5).
+    const v2d gain = load2(g.twist_gain.data() + i);
+    const v3d arm_x_s = cross(arm, t.s);
+    const v2d length_col[6] = {t.s.x, t.s.y, t.s.z, arm_x_s.x, arm_x_s.y, arm_x_s.z};
+    for (int k = 0; k < 6; ++k) store2(J.data() + kLegs * k + i, length_col[k] - gain * col[k]);
+  } else {
+    for (int k = 0; k < 6; ++k) store2(J.data() + kLegs * k + i, col[k]);
+  }
+  return regular;
+}
+
+template <bool kMotor>
+Status jacobian(const Model& model, const LegState& state, Matrix6d& J) noexcept {
+  const detail::v2m regular = jacobian_rows<kMotor>(model, state, 0, J) & jacobian_rows<kMotor>(model, state, 2, J) &
+                              jacobian_rows<kMotor>(model, state, 4, J);
+  return all_lanes(regular) ? Status::Ok : singular_joint(model, state, coordinates(model, state));
+}
+
+}  // namespace
+
+Status twist_jacobian(const Model& model, const LegState& state, Matrix6d& J) noexcept {
+  // Computed into a temporary so that J is left untouched at a singular joint, as before.
+  Matrix6d J_twist;
+  if (const Status s = jacobian<false>(model, state, J_twist); s != Status::Ok) return s;
+  J = J_twist;
   return Status::Ok;
 }
+
+namespace detail {
+
+Status motor_length_jacobian(const Model& model, const LegState& state, Matrix6d& J) noexcept {
+  return jacobian<true>(model, state, J);
+}
+
+}  // namespace detail
 
 }  // namespace hexatwist

@@ -1,0 +1,13 @@
+// Internal: the twist kernels forward kinematics calls directly.
+#pragma once
+
+#include "hexatwist/twist.hpp"
+
+namespace hexatwist::detail {
+
+/// Jacobian of the motor-side lengths |L_i| - twist_gain_i * dtheta_i for the perturbation of
+/// length_jacobian: length_jacobian - diag(twist_gain) * twist_jacobian, in one pass over the
+/// legs. Returns SingularBase/SingularPlatform (J unspecified) as twist_jacobian does.
+[[nodiscard]] Status motor_length_jacobian(const Model& model, const LegState& state, Matrix6d& J) noexcept;
+
+}  // namespace hexatwist::detail
