@@ -13,7 +13,7 @@ Status fail(LimitReport& report, Status status) noexcept {
 }  // namespace
 
 void length_error(const Model& model, const Vector6d& dtheta, Vector6d& error) noexcept {
-  // Eq. (10): lenP_i = dtheta_i / 2pi * P_h, with the thread/driven-side sign in twist_gain.
+  // Eq. (10): lenP_i = dtheta_i / 2pi * P_h, with the thread-hand sign in twist_gain.
   error = model.geometry().twist_gain.cwiseProduct(dtheta);
 }
 
