@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <initializer_list>
 #include <map>
@@ -133,8 +134,15 @@ class Reader {
     if (f.node.IsNull()) fail(f.at(), f.path, fmt::format("no value; expected a number ({})", what));
     if (!f.node.IsScalar()) fail(f.at(), f.path, fmt::format("expected a number ({}), got {}", what, kind(f.node)));
     double v = 0.0;
-    if (!YAML::convert<double>::decode(f.node, v))
+    if (!YAML::convert<double>::decode(f.node, v)) {
+      // yaml-cpp cannot tell "1.5e999" from "abc": ask strtod whether it is a number too large.
+      const std::string& text = f.node.Scalar();
+      char* end = nullptr;
+      const double parsed = std::strtod(text.c_str(), &end);
+      if (!text.empty() && end == text.c_str() + text.size() && std::isinf(parsed))
+        fail(f.at(), f.path, fmt::format("number out of range ({}), got {}", what, quoted(f.node)));
       fail(f.at(), f.path, fmt::format("expected a number ({}), got {}", what, quoted(f.node)));
+    }
     if (!std::isfinite(v))
       fail(f.at(), f.path, fmt::format("expected a finite number ({}), got {}", what, quoted(f.node)));
     return v;
@@ -148,7 +156,7 @@ class Reader {
     require(f, what);
     if (!f.node.IsSequence() || f.node.size() != 3)
       fail(f.at(), f.path,
-           fmt::format("expected a list of three numbers [x, y, z] ({}), got {}", what,
+           fmt::format("expected a list of three numbers ({}), got {}", what,
                        f.node.IsSequence() ? fmt::format("{} numbers", f.node.size()) : std::string(kind(f.node))));
     Vector3d v;
     for (std::size_t i = 0; i < 3; ++i)
@@ -314,10 +322,10 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
       locs[who] = Loc{n.path, n.key};
       LegSpec& leg = spec.legs[static_cast<std::size_t>(i)];
       const Field base = Reader::child(n, "base");
-      leg.base_B = r.vec3(base, "base joint [m, base frame]");
+      leg.base_B = r.vec3(base, "base joint x, y, z [m, base frame]");
       locs[who + ": base"] = loc(base);
       const Field platform = Reader::child(n, "platform");
-      leg.platform_P = r.vec3(platform, "platform joint [m, platform frame]");
+      leg.platform_P = r.vec3(platform, "platform joint x, y, z [m, platform frame]");
       locs[who + ": platform"] = loc(platform);
       const Screw ls = read_screw(r, n, screw, false);
       leg.lead = ls.lead;
@@ -327,12 +335,12 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
       const bool need_axes = leg.lead > 0.0;
       const Field base_axis = Reader::child(n, "base_axis");
       if (need_axes || base_axis.present()) {
-        leg.axis_base_B = r.vec3(base_axis, "base U-joint fixed axis, base frame; needed when lead > 0");
+        leg.axis_base_B = r.vec3(base_axis, "base U-joint fixed axis x, y, z, base frame; needed when lead > 0");
         locs[who + ": base_axis"] = loc(base_axis);
       }
       const Field platform_axis = Reader::child(n, "platform_axis");
       if (need_axes || platform_axis.present()) {
-        leg.axis_platform_P = r.vec3(platform_axis, "platform U-joint fixed axis, platform frame; needed when lead > 0");
+        leg.axis_platform_P = r.vec3(platform_axis, "platform U-joint fixed axis x, y, z, platform frame; needed when lead > 0");
         locs[who + ": platform_axis"] = loc(platform_axis);
       }
       // Default observation point: the platform joint farthest from the platform centre.
@@ -359,8 +367,8 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
   locs["limits.singularity_margin"] = loc(margin);
 
   const Field obs = Reader::child(top, "observation_point"), pivot = Reader::child(top, "pivot");
-  if (obs.present()) spec.observation_P = r.vec3(obs, "[m, platform frame]");
-  if (pivot.present()) spec.pivot_P = r.vec3(pivot, "[m, platform frame]");
+  if (obs.present()) spec.observation_P = r.vec3(obs, "point x, y, z [m, platform frame]");
+  if (pivot.present()) spec.pivot_P = r.vec3(pivot, "point x, y, z [m, platform frame]");
   locs["observation_point"] = loc(obs);
   locs["pivot"] = loc(pivot);
   return spec;

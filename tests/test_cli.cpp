@@ -263,6 +263,11 @@ TEST(Cli, FkRejectsFiveLengths) {
   expect_error(run({"fk", "--lengths=1.9,1.9,1.9,1.9,1.9"}), 2, {"--lengths", "6"});
 }
 
+TEST(Cli, FkRejectsLengthsThatAreNotLengths) {
+  expect_error(run({"fk", "--lengths=1.9,1.9,-1.9,1.9,1.9,1.9"}), 2, {"--lengths", "value 3", "> 0"});
+  expect_error(run({"fk", "--lengths=0,0,0,0,0,0", "--motor"}), 2, {"--lengths", "value 1"});
+}
+
 // ---- config ----------------------------------------------------------------------------------
 
 TEST(Cli, ConfigJsonListsSixLegs) {

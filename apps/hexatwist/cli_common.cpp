@@ -84,7 +84,7 @@ std::vector<double> parse_numbers(const std::string& text, std::size_t count, co
                                                  values.size() + 1, printable(item), what));
     if (!std::isfinite(v))
       throw ExitError(kExitBadInput, fmt::format("{}: value {} ('{}') is not finite; expected {}", option,
-                                                 values.size() + 1, item, what));
+                                                 values.size() + 1, printable(item), what));
     values.push_back(v);
     if (comma == std::string::npos) break;
     start = comma + 1;
@@ -117,7 +117,8 @@ std::string describe_limit(const LimitReport& r) {
                          r.status == Status::BendBase ? "base" : "platform", rad2deg(r.value), rad2deg(r.bound));
     case Status::SingularBase:
     case Status::SingularPlatform:
-      return fmt::format("{}leg is {:.3f} deg from the {} U-joint's fixed axis, inside the singularity margin {:.3f} deg",
+      return fmt::format("{}leg is {:.3f} deg from the {} U-joint's fixed axis, inside the singularity margin {:.3f} deg "
+                         "(limits.singularity_margin_deg)",
                          leg, rad2deg(r.value), r.status == Status::SingularBase ? "base" : "platform", rad2deg(r.bound));
     default:
       return leg + std::string(describe(r.status));

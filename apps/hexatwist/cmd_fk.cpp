@@ -23,7 +23,12 @@ int run_fk(const FkOptionsCli& o) {
   const Model model = load_model_from(o.model);
   const auto v = parse_numbers(o.lengths, 6, "--lengths", "six leg lengths L1..L6 [m]");
   Vector6d lengths;
-  for (int i = 0; i < kLegs; ++i) lengths[i] = v[static_cast<std::size_t>(i)];
+  for (int i = 0; i < kLegs; ++i) {
+    lengths[i] = v[static_cast<std::size_t>(i)];
+    if (!(lengths[i] > 0.0))
+      throw ExitError(kExitBadInput, fmt::format("--lengths: value {} ({}) is not a length; expected > 0 m", i + 1,
+                                                 lengths[i]));
+  }
   const Pose guess = parse_pose_m_deg(o.guess, "--guess");
   const LengthKind kind = o.motor ? LengthKind::Motor : LengthKind::Geometric;
   FkOptions fo;
