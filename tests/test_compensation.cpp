@@ -88,6 +88,26 @@ TEST(Compensation, RealTimeCommandsAgreeWithTheFullReport) {
   }
 }
 
+TEST(Compensation, RealTimePathAndFullReportReachTheSameLimitDecision) {
+  // Poses well past the limits too: both paths must name the same status, leg and value.
+  std::mt19937_64 rng(kSeed + 22);
+  int rejected = 0;
+  for (int n = 0; n < 3000; ++n) {
+    const Pose p = random_pose(rng, 0.8, deg2rad(45));
+    CommandReport rep;
+    const Status full = compute_commands(seed_model(), p, rep);
+    Vector6d cmd;
+    LimitReport lim;
+    const Status rt = motor_commands(seed_model(), p, Strategy::Compensated, cmd, lim);
+    ASSERT_EQ(rt, full) << str(p);
+    EXPECT_EQ(lim.leg, rep.limit.leg) << str(p);
+    EXPECT_EQ(lim.value, rep.limit.value) << str(p);
+    rejected += rt != Status::Ok;
+  }
+  EXPECT_GT(rejected, 1000);  // the sample reaches far outside the limits
+  EXPECT_LT(rejected, 2990);  // ... and inside them
+}
+
 TEST(Compensation, ZeroLeadMakesBothStrategiesEqual) {
   ModelSpec spec = seed_model().spec();
   for (LegSpec& l : spec.legs) l.lead = 0.0;
