@@ -14,40 +14,35 @@ using detail::Array6d;
 // Squared |s x ja| |s x jd| below which the U-joint's cross axis (Eq. 8) is undefined.
 constexpr double kSingularSin2 = 1e-24;
 
-// The twist coordinates (docs/theory.md §3) of all legs: theta = atan2(y, x).
-struct Coordinates {
-  Array6d x;
-  Array6d y;
-};
-
-Coordinates coordinates(const Model& model, const LegState& st) noexcept {
-  const LegVectors& ja = model.geometry().axis_base_B;
-  const LegVectors& jd = st.axis_platform_B;
-  return {detail::dot(ja, jd) - detail::dot(ja, st.s_B) * detail::dot(jd, st.s_B),
-          detail::dot(st.s_B, detail::cross(ja, jd))};
-}
-
-// Ok, or which joint of the first singular leg is singular (legs without axes never are).
-Status singular_joint(const Model& model, const LegState& st, const Coordinates& c) noexcept {
-  const Array6d n2 = c.x.square() + c.y.square();
-  const Array6d has_axes = model.geometry().has_axes.array();
-  // Legs without axes (x = y = 0) are lifted out of the test by 1 - has_axes.
-  if ((n2 + (1.0 - has_axes)).minCoeff() >= kSingularSin2) return Status::Ok;
+// Called when the fast test of a packet failed: the singular joint of the leg nearest to a
+// singularity (legs without axes never are), by the scalar formula of geometry.hpp. Always
+// returns SingularBase or SingularPlatform, so no caller can mistake it for success.
+Status singular_joint(const Model& model, const LegState& st) noexcept {
+  int worst = -1;
+  double worst_n2 = INFINITY;
   for (int i = 0; i < kLegs; ++i) {
-    if (has_axes[i] == 0.0 || n2[i] >= kSingularSin2) continue;
-    const Vector3d s = st.s_B.row(i).transpose();
-    return s.cross(model.leg(i).axis_base_B).squaredNorm() <= s.cross(st.axis_platform_B.row(i).transpose()).squaredNorm()
-               ? Status::SingularBase
-               : Status::SingularPlatform;
+    if (model.geometry().has_axes[i] == 0.0) continue;
+    const auto xy = detail::twist_xy(st.s_B.row(i).transpose(), model.leg(i).axis_base_B,
+                                     st.axis_platform_B.row(i).transpose());
+    const double n2 = xy.x * xy.x + xy.y * xy.y;
+    if (!(n2 >= worst_n2)) {  // also picks a NaN leg
+      worst = i;
+      worst_n2 = n2;
+    }
   }
-  return Status::Ok;
+  if (worst < 0) return Status::SingularBase;  // unreachable: the fast test passes without axes
+  const Vector3d s = st.s_B.row(worst).transpose();
+  return s.cross(model.leg(worst).axis_base_B).squaredNorm() <=
+                 s.cross(st.axis_platform_B.row(worst).transpose()).squaredNorm()
+             ? Status::SingularBase
+             : Status::SingularPlatform;
 }
 
 // Wraps an angle to (-pi, pi].
 double wrap(double a) noexcept { return a - 2.0 * kPi * std::ceil((a - kPi) / (2.0 * kPi)); }
 
-// The twist terms of legs i and i+1 (one packet), the same quantities and operation order as
-// coordinates() and twist_jacobian's, kept in registers.
+// The twist terms of legs i and i+1 (one packet): the coordinates of docs/theory.md §3,
+// theta = atan2(y, x), and the products the Jacobian reuses, kept in registers.
 struct PacketTerms {
   detail::v3d s, ja, jd;
   detail::v2d ja_s, jd_s;
@@ -80,14 +75,10 @@ bool all_lanes(detail::v2m m) noexcept { return (m[0] & m[1]) != 0; }
 
 }  // namespace
 
-Status twist_absolute(const Model& model, const LegState& state, Vector6d& theta) noexcept {
-  const Coordinates c = coordinates(model, state);
-  if (const Status s = singular_joint(model, state, c); s != Status::Ok) return s;
-  theta = (detail::atan2(c.y, c.x) * model.geometry().has_axes.array()).matrix();
-  return Status::Ok;
-}
+namespace {
 
-Status twist(const Model& model, const LegState& state, Vector6d& dtheta) noexcept {
+// Absolute (relative = false) or home-relative twist of all legs, two legs per register.
+Status twist_angles(const Model& model, const LegState& state, bool relative, Vector6d& out) noexcept {
   using namespace detail;
   const LegGeometry& g = model.geometry();
   v2d y_rot[3], x_rot[3];
@@ -96,14 +87,25 @@ Status twist(const Model& model, const LegState& state, Vector6d& dtheta) noexce
     const PacketTerms t = packet_terms(model, state, i);
     regular &= packet_regular(t, 1.0 - load2(g.has_axes.data() + i));
     // theta - theta_home in one atan2: rotate (x, y) by -theta_home.
-    const v2d c0 = load2(g.cos_theta_home.data() + i), s0 = load2(g.sin_theta_home.data() + i);
+    const v2d c0 = relative ? load2(g.cos_theta_home.data() + i) : splat(1.0);
+    const v2d s0 = relative ? load2(g.sin_theta_home.data() + i) : splat(0.0);
     y_rot[i / 2] = t.y * c0 - t.x * s0;
     x_rot[i / 2] = t.x * c0 + t.y * s0;
   }
-  if (!all_lanes(regular)) return singular_joint(model, state, coordinates(model, state));
+  if (!all_lanes(regular)) return singular_joint(model, state);
   for (int i = 0; i < kLegs; i += 2)
-    store2(dtheta.data() + i, atan2(y_rot[i / 2], x_rot[i / 2]) * load2(g.has_axes.data() + i));
+    store2(out.data() + i, atan2(y_rot[i / 2], x_rot[i / 2]) * load2(g.has_axes.data() + i));
   return Status::Ok;
+}
+
+}  // namespace
+
+Status twist_absolute(const Model& model, const LegState& state, Vector6d& theta) noexcept {
+  return twist_angles(model, state, false, theta);
+}
+
+Status twist(const Model& model, const LegState& state, Vector6d& dtheta) noexcept {
+  return twist_angles(model, state, true, dtheta);
 }
 
 Status twist_continued(const Model& model, const LegState& state, const Vector6d& reference,
@@ -156,7 +158,7 @@ template <bool kMotor>
 Status jacobian(const Model& model, const LegState& state, Matrix6d& J) noexcept {
   const detail::v2m regular = jacobian_rows<kMotor>(model, state, 0, J) & jacobian_rows<kMotor>(model, state, 2, J) &
                               jacobian_rows<kMotor>(model, state, 4, J);
-  return all_lanes(regular) ? Status::Ok : singular_joint(model, state, coordinates(model, state));
+  return all_lanes(regular) ? Status::Ok : singular_joint(model, state);
 }
 
 }  // namespace

@@ -162,6 +162,24 @@ TEST(Twist, JacobianMatchesCentralFiniteDifferences) {
   }
 }
 
+TEST(Twist, ALegAlongAFixedAxisIsReportedAsThatJointsSingularity) {
+  // Put leg 3 exactly along its base axis, then along its platform axis: every twist function
+  // must name that joint and never report Ok.
+  LegState st;
+  ASSERT_EQ(inverse_kinematics(seed_model(), Pose{}, st), Status::Ok);
+  Vector6d v;
+  Matrix6d J;
+  LegState base = st;
+  base.s_B.row(2) = seed_model().leg(2).axis_base_B.transpose();
+  EXPECT_EQ(twist(seed_model(), base, v), Status::SingularBase);
+  EXPECT_EQ(twist_absolute(seed_model(), base, v), Status::SingularBase);
+  EXPECT_EQ(twist_jacobian(seed_model(), base, J), Status::SingularBase);
+  LegState platform = st;
+  platform.s_B.row(2) = -st.axis_platform_B.row(2);
+  EXPECT_EQ(twist(seed_model(), platform, v), Status::SingularPlatform);
+  EXPECT_EQ(twist_jacobian(seed_model(), platform, J), Status::SingularPlatform);
+}
+
 TEST(Twist, ContinuedTwistFollowsAMotionPastPi) {
   // A slow yaw sweep of 300 deg on a plain model (no limits involved in the twist itself): the
   // wrapped twist jumps by 2 pi somewhere, the continued one never jumps.
