@@ -19,6 +19,7 @@ enum ExitCode : int {
   kExitOk = 0,
   kExitBadInput = 2,    ///< malformed input, bad configuration, unreadable file
   kExitOutOfLimit = 3,  ///< a pose outside a limit, or a forward-kinematics failure
+  kExitOutputFailed = 4,  ///< an output file or figure could not be written
 };
 
 /// A failure the tool reports as one line on stderr with its exit code.
