@@ -222,7 +222,9 @@ Screw read_screw(const Reader& r, const Field& n, Screw s, bool top) {
   return s;
 }
 
-ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& locs) {
+void read_extras(const Reader& r, const Field& top, Locations& locs, ConfigSpec& out);
+
+ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& locs, ConfigSpec& extras) {
   const Reader r(source);
   std::vector<YAML::Node> docs;
   try {
@@ -241,7 +243,8 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
     throw Error(fmt::format("{}: expected a mapping with 'symmetric' or 'legs', 'screw' and 'limits' at top level, got {}",
                             r.where(root.Mark()), kind(root)));
   const Field top{root, "", root.Mark()};
-  r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "limits", "observation_point", "pivot"});
+  r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "limits", "observation_point", "pivot",
+                   "servo", "load", "simulation", "study"});
 
   ModelSpec spec;
   const Field name = Reader::child(top, "name");
@@ -371,7 +374,91 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
   if (pivot.present()) spec.pivot_P = r.vec3(pivot, "point x, y, z [m, platform frame]");
   locs["observation_point"] = loc(obs);
   locs["pivot"] = loc(pivot);
+  read_extras(r, top, locs, extras);
   return spec;
+}
+
+// Optional sections; every key has a default (rig.hpp, study.hpp). Sign and range errors are
+// caught here, where the units the file uses (rpm, Hz, deg) are known.
+void read_extras(const Reader& r, const Field& top, Locations& locs, ConfigSpec& out) {
+  enum Range { Positive, NonNegative };
+  const auto section = [&](const char* key, std::initializer_list<const char*> keys) {
+    const Field f = Reader::child(top, key);
+    if (f.present()) {
+      r.require_map(f, "a mapping of settings");
+      r.only_keys(f, keys);
+    }
+    return f;
+  };
+  // Reads `key` of `sec` into `value` times `scale` if present; `field` is the name the library's
+  // validation uses in its messages.
+  const auto num = [&](const Field& sec, const char* key, const char* what, Range range, double& value,
+                       double scale = 1.0, const char* field = nullptr) {
+    if (!sec.present()) return;
+    const Field f = Reader::child(sec, key);
+    if (!f.present()) return;
+    const double v = r.number(f, what);
+    if (range == Positive && !(v > 0.0)) r.fail(f.at(), f.path, fmt::format("expected > 0 ({}), got {}", what, v));
+    if (range == NonNegative && v < 0.0) r.fail(f.at(), f.path, fmt::format("expected >= 0 ({}), got {}", what, v));
+    value = v * scale;
+    locs[field != nullptr ? std::string(field) : f.path] = loc(f);
+  };
+  const auto vec = [&](const Field& sec, const char* key, const char* what, Vector3d& value) {
+    if (!sec.present()) return;
+    const Field f = Reader::child(sec, key);
+    if (!f.present()) return;
+    value = r.vec3(f, what);
+    locs[f.path] = loc(f);
+  };
+  constexpr double kRpm = 2.0 * kPi / 60.0;
+
+  ServoSpec& sv = out.rig.servo;
+  const Field servo = section("servo", {"motor_inertia", "screw_inertia", "viscous_friction", "torque_limit",
+                                        "max_speed_rpm", "encoder_counts", "gear_ratio", "bandwidth_hz", "kp", "ki",
+                                        "kd", "velocity_feedforward", "acceleration_feedforward"});
+  num(servo, "motor_inertia", "rotor inertia [kg m^2]", Positive, sv.motor_inertia);
+  num(servo, "screw_inertia", "screw and coupling inertia [kg m^2]", NonNegative, sv.screw_inertia);
+  num(servo, "viscous_friction", "at the motor shaft [N m s/rad]", NonNegative, sv.viscous_friction);
+  num(servo, "torque_limit", "peak motor torque [N m]", Positive, sv.torque_limit);
+  num(servo, "max_speed_rpm", "motor speed limit [rpm]", Positive, sv.max_speed, kRpm, "servo.max_speed");
+  num(servo, "encoder_counts", "counts per motor revolution", Positive, sv.encoder_counts);
+  num(servo, "gear_ratio", "motor revolutions per screw revolution", Positive, sv.gear_ratio);
+  num(servo, "bandwidth_hz", "position-loop bandwidth [Hz]", Positive, sv.bandwidth, 1.0, "servo.bandwidth");
+  num(servo, "kp", "[N m/rad]; 0 = from bandwidth_hz", NonNegative, sv.kp);
+  num(servo, "ki", "[N m/(rad s)]; 0 = from bandwidth_hz", NonNegative, sv.ki);
+  num(servo, "kd", "[N m s/rad]; 0 = from bandwidth_hz", NonNegative, sv.kd);
+  num(servo, "velocity_feedforward", "fraction of the viscous torque", NonNegative, sv.velocity_feedforward);
+  num(servo, "acceleration_feedforward", "fraction of the inertia torque", NonNegative, sv.acceleration_feedforward);
+
+  LoadSpec& ld = out.rig.load;
+  const Field load = section("load", {"mass", "center_of_mass", "inertia", "gravity"});
+  num(load, "mass", "platform + payload [kg]", Positive, ld.mass);
+  vec(load, "center_of_mass", "x, y, z [m, platform frame]", ld.center_of_mass_P);
+  vec(load, "inertia", "principal moments Ixx, Iyy, Izz about the centre of mass [kg m^2]", ld.inertia);
+  num(load, "gravity", "[m/s^2]", NonNegative, ld.gravity);
+
+  SimulationSpec& sm = out.rig.simulation;
+  const Field sim = section("simulation", {"control_rate_hz", "plant_step"});
+  num(sim, "control_rate_hz", "servo rate [Hz]", Positive, sm.control_rate, 1.0, "simulation.control_rate");
+  num(sim, "plant_step", "largest plant integration step [s]", Positive, sm.plant_step);
+
+  StudySpec& st = out.study;
+  const Field study = section("study", {"linear_amplitude", "angular_amplitude_deg", "linear", "angular_deg", "dwell"});
+  num(study, "linear_amplitude", "translation sweep amplitude [m]", Positive, st.linear_amplitude);
+  num(study, "angular_amplitude_deg", "rotation sweep amplitude [deg]", Positive, st.angular_amplitude, deg2rad(1.0));
+  num(study, "dwell", "rest before, between and after the moves [s]", NonNegative, st.dwell);
+  const auto limits = [&](const char* key, const char* unit, double scale, MotionLimits& m) {
+    if (!study.present()) return;
+    const Field f = Reader::child(study, key);
+    if (!f.present()) return;
+    r.require_map(f, "velocity, acceleration, jerk");
+    r.only_keys(f, {"velocity", "acceleration", "jerk"});
+    num(f, "velocity", fmt::format("largest speed [{}/s]", unit).c_str(), Positive, m.velocity, scale);
+    num(f, "acceleration", fmt::format("largest acceleration [{}/s^2]", unit).c_str(), Positive, m.acceleration, scale);
+    num(f, "jerk", fmt::format("largest jerk [{}/s^3]", unit).c_str(), Positive, m.jerk, scale);
+  };
+  limits("linear", "m", 1.0, st.linear);
+  limits("angular_deg", "deg", deg2rad(1.0), st.angular);
 }
 
 // Turns a Model error into a located one. Model messages are "field: what", with field one of
@@ -410,12 +497,34 @@ std::string locate(const Reader& r, const Locations& locs, std::string_view sour
 
 ModelSpec parse_model_spec(std::string_view yaml_text, std::string_view source) {
   Locations locs;
-  return parse(yaml_text, source, locs);
+  ConfigSpec extras;
+  return parse(yaml_text, source, locs, extras);
+}
+
+ConfigSpec parse_config_spec(std::string_view yaml_text, std::string_view source) {
+  Locations locs;
+  ConfigSpec out;
+  out.rig.model = parse(yaml_text, source, locs, out);
+  return out;
+}
+
+Config load_config(std::string_view yaml_text, std::string_view source) {
+  Locations locs;
+  ConfigSpec spec;
+  spec.rig.model = parse(yaml_text, source, locs, spec);
+  try {
+    Config config{Rig(spec.rig), spec.study};
+    seed_tests(spec.study);  // the study's numbers are checked where they are used; fail early here
+    return config;
+  } catch (const Error& e) {
+    throw Error(locate(Reader(source), locs, source, e.what()));
+  }
 }
 
 Model load_model(std::string_view yaml_text, std::string_view source) {
   Locations locs;
-  const ModelSpec spec = parse(yaml_text, source, locs);
+  ConfigSpec extras;
+  const ModelSpec spec = parse(yaml_text, source, locs, extras);
   try {
     return Model(spec);
   } catch (const Error& e) {
@@ -423,6 +532,12 @@ Model load_model(std::string_view yaml_text, std::string_view source) {
   }
 }
 
-Model default_model() { return load_model(seed_config_yaml(), "seed platform (embedded configs/seed.yaml)"); }
+namespace {
+constexpr const char* kSeedSource = "seed platform (embedded configs/seed.yaml)";
+}
+
+Model default_model() { return load_model(seed_config_yaml(), kSeedSource); }
+
+Config default_config() { return load_config(seed_config_yaml(), kSeedSource); }
 
 }  // namespace hexatwist

@@ -13,16 +13,6 @@ namespace {
 // Largest number of step halvings in the line search.
 constexpr int kMaxHalvings = 12;
 
-// J_f_x at the state `legs` (inverse kinematics already done): the length Jacobian, minus the
-// twist gain times the twist Jacobian for motor-side lengths.
-Status residual_jacobian(const Model& model, const LegState& legs, LengthKind kind, Matrix6d& J) noexcept {
-  if (kind == LengthKind::Geometric || !model.has_twist()) {
-    length_jacobian(legs, J);
-    return Status::Ok;
-  }
-  return detail::motor_length_jacobian(model, legs, J);
-}
-
 // f = g(x) - lengths at the placement x, with g the geometric or motor-side lengths.
 Status residual(const Model& model, const Placement& x, const Vector6d& lengths, LengthKind kind, LegState& legs,
                 Vector6d& f) noexcept {
@@ -38,10 +28,18 @@ Status residual(const Model& model, const Placement& x, const Vector6d& lengths,
 
 }  // namespace
 
+Status length_jacobian(const Model& model, const LegState& legs, LengthKind kind, Matrix6d& J) noexcept {
+  if (kind == LengthKind::Geometric || !model.has_twist()) {
+    length_jacobian(legs, J);
+    return Status::Ok;
+  }
+  return detail::motor_length_jacobian(model, legs, J);
+}
+
 Status fk_residual(const Model& model, const Placement& x, const Vector6d& lengths, LengthKind kind,
                    LegState& legs, Vector6d& f, Matrix6d* J) noexcept {
   if (const Status s = residual(model, x, lengths, kind, legs, f); s != Status::Ok) return s;
-  return J != nullptr ? residual_jacobian(model, legs, kind, *J) : Status::Ok;
+  return J != nullptr ? length_jacobian(model, legs, kind, *J) : Status::Ok;
 }
 
 Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKind kind, const Placement& guess,
@@ -81,7 +79,7 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
     // Newton step on R^3 x SO(3): J [dt; dw] = -f, then t += dt, R = exp(dw) R. The Jacobian is
     // formed only here, so the converged last iterate never pays for one. (Reusing it for chord
     // steps was measured: more iterations, no gain, since two Newton steps usually suffice.)
-    if (const Status s = residual_jacobian(model, *legs, kind, J); s != Status::Ok) return finish(s);
+    if (const Status s = length_jacobian(model, *legs, kind, J); s != Status::Ok) return finish(s);
     if (!(detail::lu6_factor(J, lu) > options.singular_ratio)) return finish(Status::SingularJacobian);
     detail::lu6_solve(lu, -f, step);
 

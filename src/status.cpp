@@ -14,6 +14,7 @@ std::string_view to_string(Status s) noexcept {
     case Status::SingularPlatform: return "singular_platform";
     case Status::NoConvergence: return "no_convergence";
     case Status::SingularJacobian: return "singular_jacobian";
+    case Status::MotorSpeedAboveMax: return "motor_speed_above_max";
   }
   return "unknown";
 }
@@ -30,6 +31,7 @@ std::string_view describe(Status s) noexcept {
     case Status::SingularPlatform: return "leg too close to the platform U-joint's fixed axis (singular joint)";
     case Status::NoConvergence: return "forward kinematics did not converge";
     case Status::SingularJacobian: return "forward kinematics met a singular platform Jacobian";
+    case Status::MotorSpeedAboveMax: return "a motor would have to turn faster than its speed limit";
   }
   return "unknown status";
 }

@@ -409,3 +409,95 @@ TEST(Config, MultiLineValueInAMessageStaysOneLine) {
 
 }  // namespace
 }  // namespace hexatwist::test
+
+namespace hexatwist {
+namespace {
+
+const std::string kRigSections =
+    "servo:\n"                          // 17
+    "  max_speed_rpm: 1500\n"           // 18
+    "  kp: 100\n"                       // 19
+    "  ki: 1000\n"                      // 20
+    "  kd: 0.5\n"                       // 21
+    "load:\n"                           // 22
+    "  mass: 900\n"                     // 23
+    "  inertia: [100, 200, 300]\n"      // 24
+    "simulation:\n"                     // 25
+    "  control_rate_hz: 2000\n"         // 26
+    "  plant_step: 1.0e-4\n"            // 27
+    "study:\n"                          // 28
+    "  angular_amplitude_deg: 20\n"     // 29
+    "  linear: {velocity: 0.1, acceleration: 0.4, jerk: 2}\n";  // 30
+
+std::string config_error(const std::string& yaml) {
+  try {
+    (void)load_config(yaml, "rig.yaml");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Config, RigSectionsReachTheRigInSiUnits) {
+  const Config c = load_config(test::kSymmetricYaml + kRigSections, "rig.yaml");
+  EXPECT_NEAR(c.rig.servo().max_speed, 1500 * 2 * kPi / 60, 1e-12);
+  EXPECT_EQ(c.rig.kp()[0], 100);
+  EXPECT_EQ(c.rig.ki()[5], 1000);
+  EXPECT_EQ(c.rig.kd()[2], 0.5);
+  EXPECT_EQ(c.rig.load().mass, 900);
+  EXPECT_EQ(c.rig.load().inertia, Vector3d(100, 200, 300));
+  EXPECT_EQ(c.rig.load().center_of_mass_P, LoadSpec{}.center_of_mass_P);  // not given: default
+  EXPECT_DOUBLE_EQ(c.rig.control_period(), 0.5e-3);
+  EXPECT_EQ(c.rig.substeps(), 5);
+  EXPECT_NEAR(c.study.angular_amplitude, deg2rad(20), 1e-15);
+  EXPECT_EQ(c.study.linear.jerk, 2);
+  EXPECT_EQ(c.study.dwell, StudySpec{}.dwell);
+}
+
+TEST(Config, SeedFileSpellsOutTheDefaults) {
+  // configs/seed.yaml lists every servo, load, simulation and study key with its default value.
+  const Config c = default_config();
+  const ServoSpec d;
+  EXPECT_EQ(c.rig.servo().motor_inertia, d.motor_inertia);
+  EXPECT_EQ(c.rig.servo().screw_inertia, d.screw_inertia);
+  EXPECT_EQ(c.rig.servo().viscous_friction, d.viscous_friction);
+  EXPECT_EQ(c.rig.servo().torque_limit, d.torque_limit);
+  EXPECT_NEAR(c.rig.servo().max_speed, d.max_speed, 1e-12);
+  EXPECT_EQ(c.rig.servo().encoder_counts, d.encoder_counts);
+  EXPECT_EQ(c.rig.servo().bandwidth, d.bandwidth);
+  EXPECT_EQ(c.rig.load().mass, LoadSpec{}.mass);
+  EXPECT_EQ(c.rig.load().center_of_mass_P, LoadSpec{}.center_of_mass_P);
+  EXPECT_EQ(c.rig.load().inertia, LoadSpec{}.inertia);
+  EXPECT_EQ(c.rig.simulation().plant_step, SimulationSpec{}.plant_step);
+  const StudySpec s;
+  EXPECT_EQ(c.study.linear.velocity, s.linear.velocity);
+  EXPECT_NEAR(c.study.angular.jerk, s.angular.jerk, 1e-12);
+  EXPECT_NEAR(c.study.angular_amplitude, s.angular_amplitude, 1e-15);
+  EXPECT_EQ(c.study.dwell, s.dwell);
+}
+
+TEST(Config, RigSectionErrorsNameLineAndField) {
+  const std::string base = test::kSymmetricYaml + kRigSections;
+  const struct {
+    int line;
+    const char* text;
+    const char* expect;
+  } cases[] = {
+      {18, "  max_speed_rpm: -5", "rig.yaml:18:18: field 'servo.max_speed_rpm': expected > 0"},
+      {18, "  max_speed: 5", "rig.yaml:18:3: field 'servo.max_speed': unknown key"},
+      {19, "  kp: 0", "rig.yaml:19:7: field 'servo.kp': expected > 0 when ki or kd is given"},
+      {23, "  mass: heavy", "rig.yaml:23:9: field 'load.mass': expected a number"},
+      {24, "  inertia: [100, 200]", "rig.yaml:24:"},
+      {27, "  plant_step: 0.01", "rig.yaml:27:15: field 'simulation.plant_step': 0.01 s is longer than the control period"},
+      {30, "  linear: {velocity: 0.1, acceleration: 0, jerk: 2}", "field 'study.linear.acceleration': expected > 0"},
+  };
+  for (const auto& c : cases) {
+    const std::string msg = config_error(test::replace_line(base, c.line, c.text));
+    EXPECT_NE(msg.find(c.expect), std::string::npos) << c.text << "\n  got: " << msg;
+  }
+  // The servo needs a screw on every leg.
+  EXPECT_NE(config_error(test::replace_line(base, 9, "  lead: 0")).find("needs a lead screw"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hexatwist

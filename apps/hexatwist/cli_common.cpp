@@ -40,21 +40,33 @@ std::string model_source(const ModelOptions& opts) {
   return opts.config.empty() ? std::string("embedded seed platform") : opts.config;
 }
 
+std::string read_text_file(const std::string& path, const std::string& option, const std::string& what) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw ExitError(kExitBadInput, fmt::format("{}: '{}' is a directory, expected {}", option, printable(path), what));
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw ExitError(kExitBadInput, fmt::format("{}: cannot read {} '{}': {}", option, what, printable(path),
+                                               errno != 0 ? std::strerror(errno) : "cannot open"));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 Model load_model_from(const ModelOptions& opts) {
   try {
     if (opts.config.empty()) return default_model();
-    std::error_code ec;
-    if (std::filesystem::is_directory(opts.config, ec))
-      throw ExitError(kExitBadInput, fmt::format("--config: '{}' is a directory, expected a YAML file",
-                                                 printable(opts.config)));
-    errno = 0;
-    std::ifstream in(opts.config, std::ios::binary);
-    if (!in)
-      throw ExitError(kExitBadInput, fmt::format("--config: cannot read config file '{}': {}", printable(opts.config),
-                                                 errno != 0 ? std::strerror(errno) : "cannot open"));
-    std::ostringstream text;
-    text << in.rdbuf();
-    return load_model(text.str(), opts.config);
+    return load_model(read_text_file(opts.config, "--config", "config file"), opts.config);
+  } catch (const Error& e) {
+    throw ExitError(kExitBadInput, e.what());
+  }
+}
+
+Config load_config_from(const ModelOptions& opts) {
+  try {
+    if (opts.config.empty()) return default_config();
+    return load_config(read_text_file(opts.config, "--config", "config file"), opts.config);
   } catch (const Error& e) {
     throw ExitError(kExitBadInput, e.what());
   }
@@ -120,6 +132,9 @@ std::string describe_limit(const LimitReport& r) {
       return fmt::format("{}leg is {:.3f} deg from the {} U-joint's fixed axis, inside the singularity margin {:.3f} deg "
                          "(limits.singularity_margin_deg)",
                          leg, rad2deg(r.value), r.status == Status::SingularBase ? "base" : "platform", rad2deg(r.bound));
+    case Status::MotorSpeedAboveMax:
+      return fmt::format("{}motor speed {:.0f} rpm is above the limit {:.0f} rpm (servo.max_speed_rpm)", leg,
+                         r.value * 60.0 / (2.0 * kPi), r.bound * 60.0 / (2.0 * kPi));
     default:
       return leg + std::string(describe(r.status));
   }

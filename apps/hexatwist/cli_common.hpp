@@ -43,6 +43,12 @@ void add_model_options(CLI::App& app, ModelOptions& opts);
 /// Loads the model named by --config (or the embedded default); errors become ExitError(2).
 Model load_model_from(const ModelOptions& opts);
 
+/// Loads the whole configuration (platform, servo, load, simulation, study) the same way.
+Config load_config_from(const ModelOptions& opts);
+
+/// Reads a whole file; a missing, unreadable or directory path becomes ExitError(2) naming `option`.
+std::string read_text_file(const std::string& path, const std::string& option, const std::string& what);
+
 /// Name of the platform source for messages.
 std::string model_source(const ModelOptions& opts);
 
@@ -72,5 +78,7 @@ struct Command {
 Command make_ik_command(CLI::App& root);
 Command make_fk_command(CLI::App& root);
 Command make_config_command(CLI::App& root);
+Command make_study_command(CLI::App& root);
+Command make_simulate_command(CLI::App& root);
 
 }  // namespace hexatwist::cli

@@ -29,10 +29,11 @@ int main(int argc, char** argv) {
   CLI::App app{
       "hexatwist: twist-aware kinematics of lead-screw Stewart platforms.\n"
       "Poses are typed as x,y,z [m] and roll,pitch,yaw [deg] (R = Rz*Ry*Rx); all JSON output is SI (m, rad).\n"
-      "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit or forward-kinematics failure."};
+      "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit or numerical failure, 4 output not written."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
-  const std::vector<Command> commands{make_ik_command(app), make_fk_command(app), make_config_command(app)};
+  const std::vector<Command> commands{make_study_command(app),  make_simulate_command(app), make_ik_command(app),
+                                      make_fk_command(app), make_config_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -51,7 +52,7 @@ int main(int argc, char** argv) {
       if (word.starts_with("-")) continue;
       for (const Command& c : commands) chosen = chosen || c.app->get_name() == word;
       if (chosen) break;
-      print_error("hexatwist: error: ", fmt::format("unknown subcommand '{}'; expected ik, fk or config (see --help)", word));
+      print_error("hexatwist: error: ", fmt::format("unknown subcommand '{}'; expected study, simulate, ik, fk or config (see --help)", word));
       return kExitBadInput;
     }
     print_error("hexatwist: error: ", fmt::format("{} (see --help)", e.what()));

@@ -4,7 +4,8 @@
 #include <string>
 #include <string_view>
 
-#include "hexatwist/model.hpp"
+#include "hexatwist/rig.hpp"
+#include "hexatwist/study.hpp"
 
 namespace hexatwist {
 
@@ -20,5 +21,28 @@ Model load_model(std::string_view yaml_text, std::string_view source);
 
 /// The embedded default: the seed platform with a 10 mm lead.
 Model default_model();
+
+/// A whole configuration: the platform and, in the optional sections `servo`, `load`,
+/// `simulation` and `study`, its drives, load, simulation rates and test motion (defaults where
+/// a section or key is absent; configs/seed.yaml lists them all).
+struct ConfigSpec {
+  RigSpec rig;
+  StudySpec study;
+};
+
+/// Parses a whole configuration (errors as parse_model_spec).
+ConfigSpec parse_config_spec(std::string_view yaml_text, std::string_view source);
+
+/// A validated configuration.
+struct Config {
+  Rig rig;
+  StudySpec study;
+};
+
+/// parse_config_spec followed by validation of the rig and the study (errors located in the text).
+Config load_config(std::string_view yaml_text, std::string_view source);
+
+/// The embedded seed configuration with its servo, load and study sections.
+Config default_config();
 
 }  // namespace hexatwist

@@ -28,6 +28,11 @@ struct FkResult {
   LegState legs;             ///< inverse kinematics at the solution
 };
 
+/// Jacobian of the lengths of `kind` at the state `legs` (inverse kinematics done) for the
+/// perturbation of length_jacobian: the length Jacobian, minus diag(twist_gain) times the twist
+/// Jacobian for motor-side lengths. Returns SingularBase/SingularPlatform as twist_jacobian does.
+[[nodiscard]] Status length_jacobian(const Model& model, const LegState& legs, LengthKind kind, Matrix6d& J) noexcept;
+
 /// Residual f(x) = g(x) - lengths, with g the geometric or motor-side lengths, and its Jacobian
 /// J_f_x for the perturbation t += dt, R = exp(dw) R. The motor-side rows include the twist's
 /// derivative.

@@ -1,0 +1,296 @@
+#include "study_report.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "cli_common.hpp"
+#include "figures.hpp"
+#include "json.hpp"
+
+namespace hexatwist::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kCoordinateNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
+
+// The paper's Table 1 (mm), columns Lz, Lx, Rz, Ry: for comparison in summary.md only.
+struct PaperRow {
+  const char* label;
+  double values[4];
+};
+constexpr PaperRow kPaperTable1[] = {
+    {"paper, simulation, conventional", {0.03006, 0.02431, 0.04637, 0.05836}},
+    {"paper, simulation, compensated", {0.002486, 0.003283, 0.01097, 0.02955}},
+    {"paper, experiment, conventional", {0.2694, 1.726, 1.292, 1.164}},
+    {"paper, experiment, compensated", {0.1431, 0.4954, 0.7534, 0.6362}},
+};
+constexpr const char* kPaperColumns[4] = {"Lz", "Lx", "Rz", "Ry"};
+
+// Writes `content` to `path` whole: to a temporary name first, then renamed.
+void write_file(const fs::path& path, std::string_view content) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out.write(content.data(), static_cast<std::streamsize>(content.size()));
+    out.close();
+    if (!out) {
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}'", path.string()));
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}': {}", path.string(), ec.message()));
+}
+
+// The swept coordinate of a sample as plotted: m for translations, deg for rotations, or time.
+double displacement(const ReportedTest& t, const SimulationSample& s) {
+  if (t.coordinate < 0) return s.time;
+  const double v = s.desired[t.coordinate];
+  return t.coordinate < 3 ? v : rad2deg(v);
+}
+
+std::string displacement_label(const ReportedTest& t) {
+  if (t.coordinate < 0) return "time [s]";
+  if (t.coordinate < 3) return fmt::format("commanded {} displacement [m]", kCoordinateNames[t.coordinate]);
+  return fmt::format("commanded {} angle [deg]", kCoordinateNames[t.coordinate]);
+}
+
+std::string csv(const ReportedTest& t, const StrategyRun& run, const Model& model) {
+  fmt::memory_buffer b;
+  auto out = std::back_inserter(b);
+  fmt::format_to(out, "t_s");
+  for (const char* what : {"desired", "actual"})
+    for (int c = 0; c < 6; ++c) fmt::format_to(out, ",{}_{}_{}", what, kCoordinateNames[c], c < 3 ? "m" : "rad");
+  for (const char* what : {"command", "encoder", "motor", "length"})
+    for (int i = 1; i <= kLegs; ++i) fmt::format_to(out, ",{}_{}_m", what, i);
+  for (int i = 1; i <= kLegs; ++i) fmt::format_to(out, ",twist_{}_rad", i);
+  for (int i = 1; i <= kLegs; ++i) fmt::format_to(out, ",length_error_{}_m", i);
+  for (int i = 1; i <= kLegs; ++i) fmt::format_to(out, ",torque_{}_Nm", i);
+  fmt::format_to(out, ",error_total_m,error_twist_only_m,error_tracking_only_m\n");
+  const Vector6d& gain = model.geometry().twist_gain;
+  for (std::size_t k = 0; k < run.samples.size(); ++k) {
+    const SimulationSample& s = run.samples[k];
+    fmt::format_to(out, "{:.6f}", s.time);
+    for (const Vector6d* v : {&s.desired, &s.actual, &s.command, &s.encoder, &s.motor, &s.length, &s.twist})
+      for (int i = 0; i < 6; ++i) fmt::format_to(out, ",{:.10g}", (*v)[i]);
+    for (int i = 0; i < kLegs; ++i) fmt::format_to(out, ",{:.9g}", gain[i] * s.twist[i]);  // Eq. (10)
+    for (int i = 0; i < kLegs; ++i) fmt::format_to(out, ",{:.6g}", s.torque[i]);
+    const double tracking = k < t.run.tracking_only.size() ? t.run.tracking_only[k] : NAN;
+    fmt::format_to(out, ",{:.6g},{:.6g},{:.6g}\n", s.error, s.error_twist_only, tracking);
+  }
+  return fmt::to_string(b);
+}
+
+void stats_json(JsonWriter& j, const StrategyRun& r, const Rig& rig) {
+  double max_torque = 0.0;
+  std::size_t saturated = 0;
+  for (const SimulationSample& s : r.samples) {
+    const double m = s.torque.cwiseAbs().maxCoeff();
+    max_torque = std::max(max_torque, m);
+    saturated += m >= rig.servo().torque_limit ? 1 : 0;
+  }
+  j.begin_object()
+      .field("max_error_total", r.total.max)
+      .field("max_error_twist_only", r.twist_only.max)
+      .field("max_error_tracking_only", r.tracking_only.max)
+      .field("rms_error_total", r.total.rms)
+      .field("rms_error_twist_only", r.twist_only.rms)
+      .field("rms_error_tracking_only", r.tracking_only.rms)
+      .field("max_torque", max_torque)
+      .field("saturated_ticks", static_cast<int>(saturated))
+      .end_object();
+}
+
+std::string summary_json(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests) {
+  JsonWriter j;
+  j.begin_object()
+      .field("command", o.command)
+      .field("model", rig.model().spec().name)
+      .field("config", o.config_source)
+      .field("control_rate", rig.simulation().control_rate)
+      .field("plant_step", rig.plant_step());
+  j.key("observation_point").vector(rig.model().spec().observation_P);
+  j.key("tests").begin_array(true);
+  for (const ReportedTest& t : tests) {
+    j.begin_object().field("name", t.name).field("description", t.description);
+    j.key("coordinate");
+    t.coordinate >= 0 ? j.value(kCoordinateNames[t.coordinate]) : j.null();
+    j.field("duration", t.trajectory.duration()).field("samples", static_cast<int>(t.trajectory.poses.size()));
+    j.key("conventional");
+    stats_json(j, t.run.conventional, rig);
+    j.key("compensated");
+    stats_json(j, t.run.compensated, rig);
+    j.end_object();
+  }
+  j.end_array().end_object();
+  return j.str();
+}
+
+std::string mm(double m) { return fmt::format("{:.4f}", 1e3 * m); }
+
+std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests) {
+  std::string s = fmt::format("# hexatwist {}: observation-point error\n\n", o.command);
+  s += fmt::format("Platform: {} (from {}). Control rate {} Hz, plant step {} s. Observation point ({}, {}, {}) m in "
+                   "the platform frame.\n\n",
+                   rig.model().spec().name, o.config_source, rig.simulation().control_rate, rig.plant_step(),
+                   rig.model().spec().observation_P.x(), rig.model().spec().observation_P.y(),
+                   rig.model().spec().observation_P.z());
+  s += "Errors in mm. **total**: the closed loop as simulated; **twist only**: perfect servos, what the twist alone "
+       "does; **tracking only**: the same servos with no twist in the plant (one run, the same for both strategies).\n\n";
+  s += "| strategy | error |";
+  for (const ReportedTest& t : tests) s += fmt::format(" {} max | {} RMS |", t.name, t.name);
+  s += "\n|---|---|";
+  for (std::size_t i = 0; i < tests.size(); ++i) s += "---:|---:|";
+  s += "\n";
+  for (const bool comp : {false, true})
+    for (int e = 0; e < 3; ++e) {
+      s += fmt::format("| {} | {} |", comp ? "compensated" : "conventional",
+                       e == 0 ? "total" : e == 1 ? "twist only" : "tracking only");
+      for (const ReportedTest& t : tests) {
+        const StrategyRun& r = comp ? t.run.compensated : t.run.conventional;
+        const ErrorStats& st = e == 0 ? r.total : e == 1 ? r.twist_only : r.tracking_only;
+        s += fmt::format(" {} | {} |", mm(st.max), mm(st.rms));
+      }
+      s += "\n";
+    }
+  s += "\nTests:\n\n";
+  for (const ReportedTest& t : tests)
+    s += fmt::format("- **{}**: {}, {:.2f} s; `{}_conventional.csv`, `{}_compensated.csv`; figures `{}_error.png`, "
+                     "`{}_legs.png` (and .svg)\n",
+                     t.name, t.description, t.trajectory.duration(), t.name, t.name, t.name, t.name);
+  if (o.command == "study") {
+    s += "\nFor comparison, the paper's Table 1 (maximum error, mm; its lead, servo and trajectories are not "
+         "given, so only the orders of magnitude compare):\n\n| | Lz | Lx | Rz | Ry |\n|---|---:|---:|---:|---:|\n";
+    for (const PaperRow& row : kPaperTable1)
+      s += fmt::format("| {} | {} | {} | {} | {} |\n", row.label, row.values[0], row.values[1], row.values[2],
+                       row.values[3]);
+    (void)kPaperColumns;
+  }
+  return s;
+}
+
+std::vector<Figure> figures_of(const fs::path& dir, const ReportedTest& t, const Model& model) {
+  const auto series = [&](const std::string& label, const std::vector<SimulationSample>& samples, auto value,
+                          Series::Style style = Series::Style::Solid) {
+    Series s{label, {}, {}, style};
+    s.x.reserve(samples.size());
+    s.y.reserve(samples.size());
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      s.x.push_back(displacement(t, samples[k]));
+      s.y.push_back(value(k, samples[k]));
+    }
+    return s;
+  };
+  const auto& conv = t.run.conventional.samples;
+  const auto& comp = t.run.compensated.samples;
+  Figure error{(dir / (t.name + "_error")).string(), "", {}};
+  Panel p{fmt::format("{} ({}): observation-point error", t.name, t.description), displacement_label(t),
+          "position error [mm]", {}};
+  p.series.push_back(series("conventional, closed loop", conv, [](std::size_t, const SimulationSample& s) {
+    return 1e3 * s.error;
+  }));
+  p.series.push_back(series("compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) {
+    return 1e3 * s.error;
+  }));
+  p.series.push_back(series("conventional, twist only (perfect servo)", conv,
+                            [](std::size_t, const SimulationSample& s) { return 1e3 * s.error_twist_only; },
+                            Series::Style::Dashed));
+  p.series.push_back(series("servo tracking only (no twist)", conv,
+                            [&](std::size_t k, const SimulationSample&) {
+                              return k < t.run.tracking_only.size() ? 1e3 * t.run.tracking_only[k] : NAN;
+                            },
+                            Series::Style::Dotted));
+  error.panels.push_back(std::move(p));
+  // On the scale of the twist error the compensated strategy is a flat line: zoom in on it.
+  Panel zoom{"Zoom: compensated vs the servo alone", displacement_label(t), "position error [um]", {}};
+  zoom.series.push_back(series("compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) {
+    return 1e6 * s.error;
+  }));
+  zoom.series.push_back(series("servo tracking only (no twist)", comp,
+                               [&](std::size_t k, const SimulationSample&) {
+                                 return k < t.run.tracking_only.size() ? 1e6 * t.run.tracking_only[k] : NAN;
+                               },
+                               Series::Style::Dashed));
+  zoom.series.push_back(series("compensated, twist only (perfect servo)", comp,
+                               [](std::size_t, const SimulationSample& s) { return 1e6 * s.error_twist_only; },
+                               Series::Style::Dotted));
+  error.panels.push_back(std::move(zoom));
+
+  Figure legs{(dir / (t.name + "_legs")).string(), "", {}};
+  Panel twist{fmt::format("{} ({}): twist of each leg (conventional run)", t.name, t.description),
+              displacement_label(t), "twist [deg]", {}};
+  Panel length{"Length error of each leg, real minus motor-side (Eq. 10)", displacement_label(t), "length error [mm]",
+               {}};
+  for (int i = 0; i < kLegs; ++i) {
+    twist.series.push_back(series(fmt::format("leg {}", i + 1), conv, [i](std::size_t, const SimulationSample& s) {
+      return rad2deg(s.twist[i]);
+    }));
+    const double g = model.geometry().twist_gain[i];
+    length.series.push_back(series(fmt::format("leg {}", i + 1), conv, [i, g](std::size_t, const SimulationSample& s) {
+      return 1e3 * g * s.twist[i];
+    }));
+  }
+  legs.panels.push_back(std::move(twist));
+  legs.panels.push_back(std::move(length));
+  return {std::move(error), std::move(legs)};
+}
+
+}  // namespace
+
+std::string summary_table(const std::vector<ReportedTest>& tests) {
+  std::string s = fmt::format("{:<28}", "Max. error [mm]");
+  for (const ReportedTest& t : tests) s += fmt::format(" {:>10}", t.name.substr(0, 10));
+  s += "\n";
+  for (const bool comp : {false, true})
+    for (int e = 0; e < 3; ++e) {
+      s += fmt::format("{:<13} {:<14}", e == 0 ? (comp ? "compensated" : "conventional") : "",
+                       e == 0 ? "total" : e == 1 ? "twist only" : "tracking only");
+      for (const ReportedTest& t : tests) {
+        const StrategyRun& r = comp ? t.run.compensated : t.run.conventional;
+        const ErrorStats& st = e == 0 ? r.total : e == 1 ? r.twist_only : r.tracking_only;
+        s += fmt::format(" {:>10}", mm(st.max));
+      }
+      s += "\n";
+    }
+  return s;
+}
+
+std::vector<std::string> write_report(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests) {
+  const fs::path dir(o.out_dir);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw ExitError(kExitOutputFailed, fmt::format("--out: cannot create the output folder '{}'{}", o.out_dir,
+                                                   ec ? ": " + ec.message() : std::string()));
+  std::vector<std::string> written;
+  const auto put = [&](const fs::path& path, std::string_view content) {
+    write_file(path, content);
+    written.push_back(path.string());
+  };
+  std::vector<Figure> figures;
+  for (const ReportedTest& t : tests) {
+    put(dir / (t.name + "_conventional.csv"), csv(t, t.run.conventional, rig.model()));
+    put(dir / (t.name + "_compensated.csv"), csv(t, t.run.compensated, rig.model()));
+    if (o.figures)
+      for (Figure& f : figures_of(dir, t, rig.model())) figures.push_back(std::move(f));
+  }
+  if (!figures.empty()) {
+    write_figures(figures);
+    for (const Figure& f : figures) {
+      written.push_back(f.stem + ".png");
+      written.push_back(f.stem + ".svg");
+    }
+  }
+  put(dir / "summary.md", summary_md(rig, o, tests));
+  put(dir / "summary.json", summary_json(rig, o, tests));
+  return written;
+}
+
+}  // namespace hexatwist::cli

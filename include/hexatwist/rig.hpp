@@ -1,0 +1,99 @@
+// The platform with its six drives and the load they carry: everything the closed-loop servo
+// simulation needs besides the trajectory (docs/theory.md §9). Immutable and validated, like Model.
+#pragma once
+
+#include "hexatwist/model.hpp"
+
+namespace hexatwist {
+
+/// One leg's drive and position controller (all six legs use the same numbers; the lead comes from
+/// the Model). Defaults: a 3 kW-class AC servo motor on a 10 mm-lead screw of the seed's size
+/// (docs/theory.md §9 says where each number comes from).
+struct ServoSpec {
+  double motor_inertia = 1.2e-3;     ///< rotor inertia [kg m^2]
+  double screw_inertia = 1.0e-3;     ///< screw, coupling and pulleys about the screw axis [kg m^2]
+  double viscous_friction = 2.0e-3;  ///< viscous friction at the motor shaft [N m s/rad]
+  double torque_limit = 28.0;        ///< peak motor torque [N m]
+  double max_speed = 3000.0 * 2.0 * kPi / 60.0;  ///< motor speed limit [rad/s] (3000 rpm)
+  double encoder_counts = 1048576;   ///< encoder counts per motor revolution (20 bit)
+  double gear_ratio = 1.0;           ///< motor revolutions per screw revolution
+  /// Position-loop bandwidth used to derive the PID gains when kp, ki and kd are all 0: the
+  /// closed loop's three poles are placed at -2 pi bandwidth on each leg's nominal inertia [Hz].
+  double bandwidth = 20.0;
+  double kp = 0.0;  ///< proportional gain on the motor angle error [N m/rad]; 0 = from bandwidth
+  double ki = 0.0;  ///< integral gain [N m/(rad s)]; 0 = from bandwidth
+  double kd = 0.0;  ///< derivative gain on the motor speed error [N m s/rad]; 0 = from bandwidth
+  double velocity_feedforward = 1.0;      ///< fraction of the model's viscous torque fed forward [-]
+  double acceleration_feedforward = 1.0;  ///< fraction of the nominal inertia torque fed forward [-]
+};
+
+/// The rigid load on the legs: moving platform plus payload. The legs' own masses are left out.
+struct LoadSpec {
+  double mass = 1500.0;                                   ///< platform + payload [kg]
+  Vector3d center_of_mass_P = Vector3d(0.0, 0.0, 0.15);   ///< centre of mass [m, P]
+  Vector3d inertia = Vector3d(540.0, 540.0, 1080.0);      ///< principal moments about the centre of mass, along P's axes [kg m^2]
+  double gravity = 9.81;                                  ///< gravitational acceleration, along -z of B [m/s^2]
+};
+
+/// Rates of the simulation.
+struct SimulationSpec {
+  double control_rate = 1000.0;  ///< servo (controller) rate [Hz]
+  double plant_step = 1e-4;      ///< largest plant integration step [s]; the control period is split into equal steps no longer than this
+};
+
+/// Everything a Rig is built from.
+struct RigSpec {
+  ModelSpec model;
+  ServoSpec servo;
+  LoadSpec load;
+  SimulationSpec simulation;
+};
+
+/// The validated rig, with the per-leg numbers derived once. Construction throws hexatwist::Error
+/// "servo.kp: what" naming the field at fault.
+class Rig {
+ public:
+  explicit Rig(const RigSpec& spec);
+  /// A rig from an already validated model (the other parts are validated here).
+  Rig(Model model, const ServoSpec& servo, const LoadSpec& load, const SimulationSpec& simulation);
+
+  const Model& model() const noexcept { return model_; }
+  const ServoSpec& servo() const noexcept { return servo_; }
+  const LoadSpec& load() const noexcept { return load_; }
+  const SimulationSpec& simulation() const noexcept { return simulation_; }
+
+  /// Motor-side length per motor radian, lead_i / (2 pi gear_ratio) [m/rad].
+  const Vector6d& motor_gain() const noexcept { return motor_gain_; }
+  /// Inertia of one drive at the motor shaft: rotor + screw / gear_ratio^2 [kg m^2].
+  double drive_inertia() const noexcept { return drive_inertia_; }
+  /// Nominal inertia each motor sees: drive inertia + the load reflected through the leg at home
+  /// (diagonal of the leg-space mass matrix) [kg m^2]. Used for feed-forward and for the gains.
+  const Vector6d& nominal_inertia() const noexcept { return nominal_inertia_; }
+  /// Effective PID gains per leg (given, or derived from the bandwidth).
+  const Vector6d& kp() const noexcept { return kp_; }
+  const Vector6d& ki() const noexcept { return ki_; }
+  const Vector6d& kd() const noexcept { return kd_; }
+  /// Control period [s], plant steps per control period, plant step [s].
+  double control_period() const noexcept { return control_period_; }
+  int substeps() const noexcept { return substeps_; }
+  double plant_step() const noexcept { return control_period_ / substeps_; }
+  /// One encoder count [rad].
+  double encoder_step() const noexcept { return encoder_step_; }
+
+ private:
+  void validate_and_derive();
+
+  Model model_;
+  ServoSpec servo_;
+  LoadSpec load_;
+  SimulationSpec simulation_;
+  Vector6d motor_gain_;
+  Vector6d nominal_inertia_;
+  Vector6d kp_, ki_, kd_;
+  double drive_inertia_ = 0.0;
+  double control_period_ = 0.0;
+  int substeps_ = 1;
+  double encoder_step_ = 0.0;
+};
+
+}  // namespace hexatwist

@@ -1,0 +1,102 @@
+#include "hexatwist/rig.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "hexatwist/dynamics.hpp"
+#include "hexatwist/error.hpp"
+
+namespace hexatwist {
+namespace {
+
+// Messages are "field: what" with the YAML field path (src/config.cpp locates them in the file).
+[[noreturn]] void fail(const char* field, const std::string& what) { throw Error(fmt::format("{}: {}", field, what)); }
+
+void positive(double v, const char* field, const char* unit) {
+  if (!std::isfinite(v) || !(v > 0.0)) fail(field, fmt::format("expected > 0 {}, got {}", unit, v));
+}
+
+void non_negative(double v, const char* field, const char* unit) {
+  if (!std::isfinite(v) || v < 0.0) fail(field, fmt::format("expected >= 0 {}, got {}", unit, v));
+}
+
+// Largest 2 pi bandwidth / control rate for which the derived discrete loop keeps its margins.
+constexpr double kMaxBandwidthRatio = 0.5;
+
+}  // namespace
+
+Rig::Rig(const RigSpec& spec) : Rig(Model(spec.model), spec.servo, spec.load, spec.simulation) {}
+
+Rig::Rig(Model model, const ServoSpec& servo, const LoadSpec& load, const SimulationSpec& simulation)
+    : model_(std::move(model)), servo_(servo), load_(load), simulation_(simulation) {
+  validate_and_derive();
+}
+
+void Rig::validate_and_derive() {
+  const ServoSpec& s = servo_;
+  positive(s.motor_inertia, "servo.motor_inertia", "kg m^2");
+  non_negative(s.screw_inertia, "servo.screw_inertia", "kg m^2");
+  non_negative(s.viscous_friction, "servo.viscous_friction", "N m s/rad");
+  positive(s.torque_limit, "servo.torque_limit", "N m");
+  positive(s.max_speed, "servo.max_speed", "rad/s");
+  if (!std::isfinite(s.encoder_counts) || s.encoder_counts < 1.0 || s.encoder_counts != std::floor(s.encoder_counts))
+    fail("servo.encoder_counts", fmt::format("expected a whole number >= 1 of counts per revolution, got {}", s.encoder_counts));
+  positive(s.gear_ratio, "servo.gear_ratio", "motor revolutions per screw revolution");
+  positive(s.bandwidth, "servo.bandwidth", "Hz");
+  non_negative(s.kp, "servo.kp", "N m/rad");
+  non_negative(s.ki, "servo.ki", "N m/(rad s)");
+  non_negative(s.kd, "servo.kd", "N m s/rad");
+  const bool derive = s.kp == 0.0 && s.ki == 0.0 && s.kd == 0.0;
+  if (!derive && s.kp == 0.0) fail("servo.kp", "expected > 0 when ki or kd is given (or leave all three at 0 to derive them from servo.bandwidth)");
+  non_negative(s.velocity_feedforward, "servo.velocity_feedforward", "(fraction)");
+  non_negative(s.acceleration_feedforward, "servo.acceleration_feedforward", "(fraction)");
+
+  positive(load_.mass, "load.mass", "kg");
+  if (!load_.center_of_mass_P.allFinite()) fail("load.center_of_mass", "expected three finite numbers");
+  for (int i = 0; i < 3; ++i) positive(load_.inertia[i], "load.inertia", "kg m^2 for each principal moment");
+  non_negative(load_.gravity, "load.gravity", "m/s^2");
+
+  positive(simulation_.control_rate, "simulation.control_rate", "Hz");
+  positive(simulation_.plant_step, "simulation.plant_step", "s");
+  control_period_ = 1.0 / simulation_.control_rate;
+  if (simulation_.plant_step > control_period_ * (1.0 + 1e-12))
+    fail("simulation.plant_step", fmt::format("{} s is longer than the control period {} s", simulation_.plant_step, control_period_));
+  substeps_ = static_cast<int>(std::ceil(control_period_ / simulation_.plant_step * (1.0 - 1e-12)));
+  if (substeps_ > 10000) fail("simulation.plant_step", fmt::format("{} s gives more than 10000 steps per control period", simulation_.plant_step));
+
+  for (int i = 0; i < kLegs; ++i) {
+    const double lead = model_.leg(i).lead;
+    if (!(lead > 0.0))
+      throw Error(fmt::format("leg {}: lead: the servo simulation needs a lead screw on every leg (lead > 0)", i + 1));
+    motor_gain_[i] = lead / (2.0 * kPi * s.gear_ratio);
+  }
+  drive_inertia_ = s.motor_inertia + s.screw_inertia / (s.gear_ratio * s.gear_ratio);
+  encoder_step_ = 2.0 * kPi / s.encoder_counts;
+
+  // The load each motor sees at home: the diagonal of the leg-space mass matrix, reflected
+  // through the screw (m = k theta, so the inertia scales with k^2).
+  LegState home;
+  LegDynamics dyn;
+  if (inverse_kinematics(model_, Placement{}, home) != Status::Ok ||
+      leg_dynamics(model_, load_, home, LengthKind::Motor, dyn) != Status::Ok)
+    throw Error("legs: the platform Jacobian is singular at home; cannot size the servo");
+  nominal_inertia_ = Vector6d::Constant(drive_inertia_) + motor_gain_.cwiseAbs2().cwiseProduct(dyn.mass.diagonal());
+
+  if (derive) {
+    const double w = 2.0 * kPi * s.bandwidth;
+    if (w * control_period_ > kMaxBandwidthRatio)
+      fail("servo.bandwidth", fmt::format("{} Hz is too high for the control rate {} Hz (keep 2 pi bandwidth / rate <= {})",
+                                          s.bandwidth, simulation_.control_rate, kMaxBandwidthRatio));
+    // J s^3 + (b + kd) s^2 + kp s + ki = J (s + w)^3: three closed-loop poles at -w (docs/theory.md §9).
+    kp_ = 3.0 * w * w * nominal_inertia_;
+    ki_ = w * w * w * nominal_inertia_;
+    kd_ = (3.0 * w * nominal_inertia_.array() - s.viscous_friction).max(0.0).matrix();
+  } else {
+    kp_.setConstant(s.kp);
+    ki_.setConstant(s.ki);
+    kd_.setConstant(s.kd);
+  }
+}
+
+}  // namespace hexatwist

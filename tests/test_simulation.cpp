@@ -1,0 +1,119 @@
+// The closed loop on short trajectories: a settled start, the plant's length law (Eq. 10), the
+// limit check before anything runs, and what each option changes.
+#include <gtest/gtest.h>
+
+#include "hexatwist/config.hpp"
+#include "hexatwist/simulation.hpp"
+
+namespace hexatwist {
+namespace {
+
+const Config& seed() {
+  static const Config c = default_config();
+  return c;
+}
+
+Trajectory still(const Pose& pose, double seconds) {
+  Trajectory t;
+  t.dt = seed().rig.control_period();
+  t.poses.assign(static_cast<std::size_t>(seconds / t.dt) + 1, pose);
+  return t;
+}
+
+TEST(Simulation, StartsSettledAndStaysPut) {
+  Pose p;
+  p.position = Vector3d(0.1, -0.05, 0.2);
+  p.rpy = Vector3d(0.05, -0.1, 0.2);
+  std::vector<SimulationSample> samples;
+  SimulationIssue issue;
+  ASSERT_EQ(simulate(seed().rig, still(p, 1.0), {}, samples, issue), Status::Ok);
+  ASSERT_EQ(samples.size(), 1001u);
+  double worst = 0.0;
+  for (const SimulationSample& s : samples) worst = std::max(worst, s.error);
+  // Held by the integrators from the first tick: only encoder-count dithering remains.
+  EXPECT_LT(worst, 2e-8);  // measured ~4e-9 m
+}
+
+TEST(Simulation, PlantLengthIsMotorSideLengthPlusTheTwistTerm) {
+  const Rig& rig = seed().rig;
+  const Trajectory t = sweep_trajectory(5, deg2rad(10), {deg2rad(20), deg2rad(60), deg2rad(300)}, 0.05, rig.control_period());
+  for (const bool twist_in_plant : {true, false}) {
+    SimulationOptions o;
+    o.twist_in_plant = twist_in_plant;
+    std::vector<SimulationSample> samples;
+    SimulationIssue issue;
+    ASSERT_EQ(simulate(rig, t, o, samples, issue), Status::Ok);
+    double worst = 0.0, largest_twist = 0.0;
+    for (const SimulationSample& s : samples) {
+      const Vector6d expected = twist_in_plant ? Vector6d(rig.model().geometry().twist_gain.cwiseProduct(s.twist))
+                                               : Vector6d::Zero();
+      worst = std::max(worst, (s.length - s.motor - expected).cwiseAbs().maxCoeff());
+      largest_twist = std::max(largest_twist, s.twist.cwiseAbs().maxCoeff());
+      ASSERT_LE((s.encoder - s.motor).maxCoeff(), 1e-15);  // the encoder rounds down ...
+      ASSERT_LT((s.motor - s.encoder).maxCoeff(), rig.motor_gain().maxCoeff() * rig.encoder_step() * 1.000001);
+    }
+    EXPECT_LT(worst, 1e-11);  // FK tolerance 1e-12 m
+    EXPECT_GT(largest_twist, deg2rad(10));  // the legs really twisted (yaw 10 deg)
+  }
+}
+
+TEST(Simulation, CompensationRemovesTheTwistErrorExactly) {
+  const Rig& rig = seed().rig;
+  const Trajectory t = sweep_trajectory(2, 0.1, {0.2, 0.5, 2.5}, 0.05, rig.control_period());
+  SimulationOptions o;
+  std::vector<SimulationSample> comp, conv;
+  SimulationIssue issue;
+  ASSERT_EQ(simulate(rig, t, o, comp, issue), Status::Ok);
+  o.strategy = Strategy::Conventional;
+  ASSERT_EQ(simulate(rig, t, o, conv, issue), Status::Ok);
+  double comp_twist = 0.0, conv_twist = 0.0;
+  for (std::size_t k = 0; k < t.poses.size(); ++k) {
+    comp_twist = std::max(comp_twist, comp[k].error_twist_only);
+    conv_twist = std::max(conv_twist, conv[k].error_twist_only);
+    // The compensated target differs from the conventional one by exactly the Eq. (10) term.
+    ASSERT_LT((conv[k].command - comp[k].command).norm(), 2e-3);
+  }
+  EXPECT_LT(comp_twist, 1e-9);
+  EXPECT_GT(conv_twist, 2e-5);
+}
+
+TEST(Simulation, NothingRunsOutsideALimit) {
+  const Rig& rig = seed().rig;
+  Trajectory t = sweep_trajectory(2, 0.8, {0.2, 0.5, 2.5}, 0.0, rig.control_period());  // z = +0.8 m: too long
+  SimulationIssue issue;
+  ASSERT_EQ(check_trajectory(rig, t, issue), Status::StrokeAboveMax);
+  EXPECT_GE(issue.limit.leg, 0);
+  EXPECT_GT(issue.limit.value, rig.model().spec().limits.length_max);
+  EXPECT_NEAR(issue.time, t.time(issue.index), 1e-12);
+  // The first sample past the limit, not any later one.
+  CommandReport before;
+  ASSERT_EQ(compute_commands(rig.model(), t.poses[issue.index - 1], before), Status::Ok);
+  std::vector<SimulationSample> samples;
+  SimulationIssue again;
+  EXPECT_EQ(simulate(rig, t, {}, samples, again), Status::StrokeAboveMax);
+  EXPECT_TRUE(samples.empty());
+  EXPECT_EQ(again.index, issue.index);
+}
+
+TEST(Simulation, NothingRunsFasterThanTheMotors) {
+  const Rig& rig = seed().rig;
+  Trajectory t = still(Pose{}, 0.1);
+  t.poses[50].position.z() = 0.01;  // a 10 mm jump in one tick: ~6000 rad/s at the motor
+  SimulationIssue issue;
+  ASSERT_EQ(check_trajectory(rig, t, issue), Status::MotorSpeedAboveMax);
+  EXPECT_EQ(issue.index, 49u);  // the central difference at 49 sees the jump first
+  EXPECT_GT(issue.limit.value, rig.servo().max_speed);
+  EXPECT_EQ(issue.limit.bound, rig.servo().max_speed);
+}
+
+TEST(Simulation, RefusesATrajectoryAtAnotherRate) {
+  Trajectory t = still(Pose{}, 0.01);
+  t.dt = 0.002;
+  std::vector<SimulationSample> samples;
+  SimulationIssue issue;
+  EXPECT_NE(simulate(seed().rig, t, {}, samples, issue), Status::Ok);
+  EXPECT_TRUE(samples.empty());
+}
+
+}  // namespace
+}  // namespace hexatwist

@@ -1,0 +1,83 @@
+// The study's claims on the seed platform's default tests: exact compensation, the compensated
+// loop adds nothing to the servo's own error, and the twist error grows away from home.
+#include <gtest/gtest.h>
+
+#include "hexatwist/config.hpp"
+#include "hexatwist/study.hpp"
+
+namespace hexatwist {
+namespace {
+
+TEST(Study, TheSeedTestsInTableOneOrder) {
+  const auto tests = seed_tests(StudySpec{});
+  ASSERT_EQ(tests.size(), 4u);
+  EXPECT_EQ(tests[0].name, "Lz");
+  EXPECT_EQ(tests[1].name, "Lx");
+  EXPECT_EQ(tests[2].name, "Rz");
+  EXPECT_EQ(tests[3].name, "Ry");
+  EXPECT_EQ(tests[2].coordinate, 5);
+  EXPECT_DOUBLE_EQ(tests[3].amplitude, deg2rad(30));
+}
+
+TEST(Study, ErrorStats) {
+  const ErrorStats s = error_stats({3.0, 4.0, 0.0, 0.0});
+  EXPECT_EQ(s.max, 4.0);
+  EXPECT_DOUBLE_EQ(s.rms, 2.5);
+}
+
+// One default test per parameter (the full seed test: about 0.8 s each).
+class SeedTest : public ::testing::TestWithParam<int> {};
+
+TEST_P(SeedTest, CompensationIsExactAndAddsNothingToTheServoError) {
+  const Config config = default_config();
+  const StudyTest test = seed_tests(config.study)[static_cast<std::size_t>(GetParam())];
+  const Trajectory trajectory = test_trajectory(config.study, test, config.rig.control_period());
+  TestRun run;
+  SimulationIssue issue;
+  ASSERT_EQ(run_test(config.rig, trajectory, run, issue), Status::Ok) << test.name;
+  // Exact compensation: with perfect servos the compensated command puts the point where it belongs.
+  EXPECT_LE(run.compensated.twist_only.max, 1e-9) << test.name;  // measured ~1.5e-12 m
+  // The compensated loop is the servo's own error: within 1 um of the twist-free run, tick by tick.
+  double worst = 0.0;
+  for (std::size_t k = 0; k < run.tracking_only.size(); ++k)
+    worst = std::max(worst, run.compensated.samples[k].error - run.tracking_only[k]);
+  EXPECT_LE(worst, 1e-6) << test.name;
+  EXPECT_LE(run.compensated.total.max - run.compensated.tracking_only.max, 1e-6) << test.name;
+  // The conventional loop carries the twist error, far above the servo's.
+  EXPECT_GT(run.conventional.total.max, 100 * run.conventional.tracking_only.max) << test.name;
+  EXPECT_NEAR(run.conventional.total.max, run.conventional.twist_only.max, 0.02 * run.conventional.twist_only.max);
+  EXPECT_EQ(run.conventional.tracking_only.max, run.compensated.tracking_only.max);
+}
+
+TEST_P(SeedTest, ConventionalTwistErrorGrowsAwayFromHome) {
+  const Config config = default_config();
+  const StudyTest test = seed_tests(config.study)[static_cast<std::size_t>(GetParam())];
+  if (test.coordinate >= 3) GTEST_SKIP() << "the paper states the growth for the linear tests";
+  const Trajectory trajectory = test_trajectory(config.study, test, config.rig.control_period());
+  TestRun run;
+  SimulationIssue issue;
+  ASSERT_EQ(run_test(config.rig, trajectory, run, issue), Status::Ok);
+  // On the way out (home -> +amplitude) and on the way back past home to -amplitude, the
+  // quasi-static twist error rises with the distance from home.
+  const auto& s = run.conventional.samples;
+  double last_d = 0.0, last_e = 0.0;
+  int rising = 0;
+  bool out = true;
+  for (const SimulationSample& x : s) {
+    const double d = std::abs(x.desired[test.coordinate]);
+    if (out && d + 1e-12 < last_d) out = false;  // the first move has ended
+    if (out && d > last_d + 1e-6) {
+      EXPECT_GE(x.error_twist_only, last_e - 1e-12) << "at " << d;
+      rising += x.error_twist_only > last_e ? 1 : 0;
+      last_e = x.error_twist_only;
+      last_d = d;
+    }
+  }
+  EXPECT_GT(rising, 100);
+  EXPECT_GT(run.conventional.twist_only.max, 1e-4);  // 0.1 mm and more at 0.5 m
+}
+
+INSTANTIATE_TEST_SUITE_P(Lz_Lx_Rz_Ry, SeedTest, ::testing::Values(0, 1, 2, 3));
+
+}  // namespace
+}  // namespace hexatwist
