@@ -10,5 +10,6 @@
 #include "hexatwist/model.hpp"
 #include "hexatwist/pose.hpp"
 #include "hexatwist/status.hpp"
+#include "hexatwist/trajectory.hpp"
 #include "hexatwist/twist.hpp"
 #include "hexatwist/types.hpp"
