@@ -8,6 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config     # toolchain
   libeigen3-dev libyaml-cpp-dev libcli11-dev libfmt-dev   # library and CLI
   libgtest-dev libgmock-dev libbenchmark-dev        # tests and benchmarks
+  gnuplot-nox                                       # figures
 )
 
 missing=()
