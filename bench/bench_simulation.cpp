@@ -11,9 +11,8 @@ namespace {
 using namespace hexatwist;
 
 void add_statistics(benchmark::internal::Benchmark* b) {
-  b->Repetitions(5)->ReportAggregatesOnly(true)->ComputeStatistics("max", [](const std::vector<double>& v) {
-    return *std::max_element(v.begin(), v.end());
-  });
+  b->Repetitions(5)->ReportAggregatesOnly(true)->ComputeStatistics(
+      "max", [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); });
   b->Unit(benchmark::kMillisecond);
 }
 

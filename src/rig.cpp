@@ -41,14 +41,17 @@ void Rig::validate_and_derive() {
   positive(s.torque_limit, "servo.torque_limit", "N m");
   positive(s.max_speed, "servo.max_speed", "rad/s");
   if (!std::isfinite(s.encoder_counts) || s.encoder_counts < 1.0 || s.encoder_counts != std::floor(s.encoder_counts))
-    fail("servo.encoder_counts", fmt::format("expected a whole number >= 1 of counts per revolution, got {}", s.encoder_counts));
+    fail("servo.encoder_counts",
+         fmt::format("expected a whole number >= 1 of counts per revolution, got {}", s.encoder_counts));
   positive(s.gear_ratio, "servo.gear_ratio", "motor revolutions per screw revolution");
   positive(s.bandwidth, "servo.bandwidth", "Hz");
   non_negative(s.kp, "servo.kp", "N m/rad");
   non_negative(s.ki, "servo.ki", "N m/(rad s)");
   non_negative(s.kd, "servo.kd", "N m s/rad");
   const bool derive = s.kp == 0.0 && s.ki == 0.0 && s.kd == 0.0;
-  if (!derive && s.kp == 0.0) fail("servo.kp", "expected > 0 when ki or kd is given (or leave all three at 0 to derive them from servo.bandwidth)");
+  if (!derive && s.kp == 0.0)
+    fail("servo.kp",
+         "expected > 0 when ki or kd is given (or leave all three at 0 to derive them from servo.bandwidth)");
   non_negative(s.velocity_feedforward, "servo.velocity_feedforward", "(fraction)");
   non_negative(s.acceleration_feedforward, "servo.acceleration_feedforward", "(fraction)");
 
@@ -61,9 +64,12 @@ void Rig::validate_and_derive() {
   positive(simulation_.plant_step, "simulation.plant_step", "s");
   control_period_ = 1.0 / simulation_.control_rate;
   if (simulation_.plant_step > control_period_ * (1.0 + 1e-12))
-    fail("simulation.plant_step", fmt::format("{} s is longer than the control period {} s", simulation_.plant_step, control_period_));
+    fail("simulation.plant_step",
+         fmt::format("{} s is longer than the control period {} s", simulation_.plant_step, control_period_));
   substeps_ = static_cast<int>(std::ceil(control_period_ / simulation_.plant_step * (1.0 - 1e-12)));
-  if (substeps_ > 10000) fail("simulation.plant_step", fmt::format("{} s gives more than 10000 steps per control period", simulation_.plant_step));
+  if (substeps_ > 10000)
+    fail("simulation.plant_step",
+         fmt::format("{} s gives more than 10000 steps per control period", simulation_.plant_step));
 
   for (int i = 0; i < kLegs; ++i) {
     const double lead = model_.leg(i).lead;
@@ -86,8 +92,9 @@ void Rig::validate_and_derive() {
   if (derive) {
     const double w = 2.0 * kPi * s.bandwidth;
     if (w * control_period_ > kMaxBandwidthRatio)
-      fail("servo.bandwidth", fmt::format("{} Hz is too high for the control rate {} Hz (keep 2 pi bandwidth / rate <= {})",
-                                          s.bandwidth, simulation_.control_rate, kMaxBandwidthRatio));
+      fail("servo.bandwidth",
+           fmt::format("{} Hz is too high for the control rate {} Hz (keep 2 pi bandwidth / rate <= {})", s.bandwidth,
+                       simulation_.control_rate, kMaxBandwidthRatio));
     // J s^3 + (b + kd) s^2 + kp s + ki = J (s + w)^3: three closed-loop poles at -w (docs/theory.md §9).
     kp_ = 3.0 * w * w * nominal_inertia_;
     ki_ = w * w * w * nominal_inertia_;

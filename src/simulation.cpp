@@ -130,7 +130,8 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
       s != Status::Ok)
     return fail(issue, s, 0, trajectory);
   LegDynamics dyn;
-  if (const Status s = leg_dynamics(model, load, fk.legs, kind, dyn); s != Status::Ok) return fail(issue, s, 0, trajectory);
+  if (const Status s = leg_dynamics(model, load, fk.legs, kind, dyn); s != Status::Ok)
+    return fail(issue, s, 0, trajectory);
   // Holding torque: the motor balances the gravity force along its leg (m = k theta).
   const Vector6d load_torque0 = gain.cwiseProduct(dyn.gravity);
   Vector6d measured;

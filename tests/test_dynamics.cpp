@@ -54,7 +54,8 @@ TEST_P(DynamicsTest, GravityIsMinusTheGradientOfThePotential) {
       mp[i] += h;
       mm[i] -= h;
       const double dV = load.mass * load.gravity *
-                        (frame_for(model, load, mp, kind, x).com.z() - frame_for(model, load, mm, kind, x).com.z()) / (2 * h);
+                        (frame_for(model, load, mp, kind, x).com.z() - frame_for(model, load, mm, kind, x).com.z()) /
+                        (2 * h);
       worst = std::max(worst, std::abs(-dV - dyn.gravity[i]) / (load.mass * load.gravity));
     }
   }

@@ -34,7 +34,10 @@ TEST(Rig, RefusesBadNumbersNamingTheField) {
   EXPECT_EQ(error_of([](RigSpec& s) { s.load.mass = -3; }).rfind("load.mass:", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.load.inertia.y() = 0; }).rfind("load.inertia:", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.simulation.control_rate = 0; }).rfind("simulation.control_rate:", 0), 0u);
-  EXPECT_EQ(error_of([](RigSpec& s) { s.simulation.plant_step = 0.002; }).rfind("simulation.plant_step: 0.002 s is longer", 0), 0u);
+  EXPECT_EQ(error_of([](RigSpec& s) {
+              s.simulation.plant_step = 0.002;
+            }).rfind("simulation.plant_step: 0.002 s is longer", 0),
+            0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.model.legs[2].lead = 0; }).rfind("leg 3: lead:", 0), 0u);
 }
 

@@ -12,9 +12,7 @@
 namespace hexatwist {
 namespace {
 
-Rig make_rig(const ServoSpec& servo) {
-  return Rig(default_model(), servo, LoadSpec{}, SimulationSpec{});
-}
+Rig make_rig(const ServoSpec& servo) { return Rig(default_model(), servo, LoadSpec{}, SimulationSpec{}); }
 
 // Runs `ticks` control periods towards a constant reference angle with a constant inertia per leg
 // and no gravity; returns the angle history of leg 0 and the largest |torque| seen.
@@ -109,7 +107,7 @@ TEST(Servo, TorqueNeverExceedsTheLimitAndTheIntegratorDoesNotWindUp) {
   }
   EXPECT_GT(at_limit, 20);  // measured 60
   EXPECT_GT(frozen, 20);
-  EXPECT_LT(peak, 0.8);     // measured 0.715: the saturated approach overshoots, but settles
+  EXPECT_LT(peak, 0.8);  // measured 0.715: the saturated approach overshoots, but settles
   EXPECT_NEAR(d.angle[0], 0.5, 1e-4);
 }
 
@@ -122,9 +120,9 @@ TEST(Servo, EncoderQuantisationIsVisible) {
   const StepRun r = step(rig, 0.1234, 1500, rig.nominal_inertia()[0]);
   for (std::size_t k = 0; k < r.angle.size(); ++k) {
     const double counts = r.measured[k] / q;
-    ASSERT_NEAR(counts, std::round(counts), 1e-9);         // whole counts only
-    ASSERT_LE(r.measured[k], r.angle[k] + 1e-15);          // rounded down ...
-    ASSERT_GT(r.measured[k], r.angle[k] - q - 1e-15);      // ... by less than one count
+    ASSERT_NEAR(counts, std::round(counts), 1e-9);     // whole counts only
+    ASSERT_LE(r.measured[k], r.angle[k] + 1e-15);      // rounded down ...
+    ASSERT_GT(r.measured[k], r.angle[k] - q - 1e-15);  // ... by less than one count
   }
   // The loop can only hold the angle to about a count: the true angle keeps an error of the
   // order of the quantum that a finer encoder would not have.

@@ -36,7 +36,8 @@ TEST(Simulation, StartsSettledAndStaysPut) {
 
 TEST(Simulation, PlantLengthIsMotorSideLengthPlusTheTwistTerm) {
   const Rig& rig = seed().rig;
-  const Trajectory t = sweep_trajectory(5, deg2rad(10), {deg2rad(20), deg2rad(60), deg2rad(300)}, 0.05, rig.control_period());
+  const Trajectory t =
+      sweep_trajectory(5, deg2rad(10), {deg2rad(20), deg2rad(60), deg2rad(300)}, 0.05, rig.control_period());
   for (const bool twist_in_plant : {true, false}) {
     SimulationOptions o;
     o.twist_in_plant = twist_in_plant;
@@ -45,14 +46,14 @@ TEST(Simulation, PlantLengthIsMotorSideLengthPlusTheTwistTerm) {
     ASSERT_EQ(simulate(rig, t, o, samples, issue), Status::Ok);
     double worst = 0.0, largest_twist = 0.0;
     for (const SimulationSample& s : samples) {
-      const Vector6d expected = twist_in_plant ? Vector6d(rig.model().geometry().twist_gain.cwiseProduct(s.twist))
-                                               : Vector6d::Zero();
+      const Vector6d expected =
+          twist_in_plant ? Vector6d(rig.model().geometry().twist_gain.cwiseProduct(s.twist)) : Vector6d::Zero();
       worst = std::max(worst, (s.length - s.motor - expected).cwiseAbs().maxCoeff());
       largest_twist = std::max(largest_twist, s.twist.cwiseAbs().maxCoeff());
       ASSERT_LE((s.encoder - s.motor).maxCoeff(), 1e-15);  // the encoder rounds down ...
       ASSERT_LT((s.motor - s.encoder).maxCoeff(), rig.motor_gain().maxCoeff() * rig.encoder_step() * 1.000001);
     }
-    EXPECT_LT(worst, 1e-11);  // FK tolerance 1e-12 m
+    EXPECT_LT(worst, 1e-11);                // FK tolerance 1e-12 m
     EXPECT_GT(largest_twist, deg2rad(10));  // the legs really twisted (yaw 10 deg)
   }
 }

@@ -14,8 +14,6 @@
 
 namespace hexatwist::cli {
 
-namespace {
-
 // Text typed by the user as it may appear inside a one-line message: control characters escaped.
 std::string printable(std::string_view text) {
   std::string out;
@@ -28,8 +26,6 @@ std::string printable(std::string_view text) {
   }
   return out;
 }
-
-}  // namespace
 
 void add_model_options(CLI::App& app, ModelOptions& opts) {
   app.add_option("--config", opts.config,

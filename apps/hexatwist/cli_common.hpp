@@ -32,6 +32,9 @@ class ExitError : public std::runtime_error {
   int code_;
 };
 
+/// Text typed by the user as it may appear inside a one-line message: control characters escaped.
+std::string printable(std::string_view text);
+
 /// Options every command that needs a platform shares.
 struct ModelOptions {
   std::string config;  ///< YAML file; empty = embedded seed platform

@@ -55,8 +55,8 @@ void run_all(const Rig& rig, std::vector<ReportedTest>& tests) {
   for (const ReportedTest& t : tests) {
     SimulationIssue issue;
     if (check_trajectory(rig, t.trajectory, issue) != Status::Ok)
-      throw ExitError(kExitOutOfLimit, fmt::format("{}: {}; nothing was simulated", where(t, issue),
-                                                   describe_limit(issue.limit)));
+      throw ExitError(kExitOutOfLimit,
+                      fmt::format("{}: {}; nothing was simulated", where(t, issue), describe_limit(issue.limit)));
   }
   std::size_t total = 0;
   for (const ReportedTest& t : tests) total += 3 * t.trajectory.poses.size();
@@ -68,8 +68,9 @@ void run_all(const Rig& rig, std::vector<ReportedTest>& tests) {
                               [&](std::size_t done, std::size_t) { bar.update(before + done, t.name); });
     if (s != Status::Ok) {
       bar.finish();
-      throw ExitError(kExitOutOfLimit, fmt::format("{}: simulation stopped: {}; no report was written", where(t, issue),
-                                                   is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+      throw ExitError(kExitOutOfLimit,
+                      fmt::format("{}: simulation stopped: {}; no report was written", where(t, issue),
+                                  is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
     }
     before += 3 * t.trajectory.poses.size();
   }
@@ -106,7 +107,8 @@ int run_study(const StudyOptions& o) {
     const std::string name = o.tests.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
     const StudyTest* found = nullptr;
     for (const StudyTest& t : all) found = t.name == name ? &t : found;
-    if (found == nullptr) throw ExitError(kExitBadInput, fmt::format("--tests: unknown test '{}'; expected some of Lz,Lx,Rz,Ry", name));
+    if (found == nullptr)
+      throw ExitError(kExitBadInput, fmt::format("--tests: unknown test '{}'; expected some of Lz,Lx,Rz,Ry", name));
     for (const ReportedTest& t : tests)
       if (t.name == name) throw ExitError(kExitBadInput, fmt::format("--tests: '{}' given twice", name));
     ReportedTest& t = tests.emplace_back();
@@ -169,7 +171,8 @@ Command make_simulate_command(CLI::App& root) {
       "simulate",
       "Closed-loop servo simulation of a trajectory from a CSV file, conventional vs compensated, with the same report "
       "as study.\nCSV: a header row t,x,y,z,roll,pitch,yaw, then one row per sample, time strictly increasing. Units: "
-      "t in s, x/y/z in m, roll/pitch/yaw in degrees; a header name may carry a unit suffix instead: _s, _m, _mm, _deg, "
+      "t in s, x/y/z in m, roll/pitch/yaw in degrees; a header name may carry a unit suffix instead: _s, _m, _mm, "
+      "_deg, "
       "_rad (e.g. x_mm, yaw_rad). The trajectory is resampled at the control rate (C1 cubic) and checked against every "
       "limit before anything runs.");
   app->add_option("--trajectory", o->trajectory, "CSV file: t,x,y,z,roll,pitch,yaw (s, m, deg)")->required();

@@ -137,13 +137,14 @@ std::string mm(double m) { return fmt::format("{:.4f}", 1e3 * m); }
 
 std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests) {
   std::string s = fmt::format("# hexatwist {}: observation-point error\n\n", o.command);
-  s += fmt::format("Platform: {} (from {}). Control rate {} Hz, plant step {} s. Observation point ({}, {}, {}) m in "
-                   "the platform frame.\n\n",
-                   rig.model().spec().name, o.config_source, rig.simulation().control_rate, rig.plant_step(),
-                   rig.model().spec().observation_P.x(), rig.model().spec().observation_P.y(),
-                   rig.model().spec().observation_P.z());
+  s += fmt::format(
+      "Platform: {} (from {}). Control rate {} Hz, plant step {} s. Observation point ({}, {}, {}) m in "
+      "the platform frame.\n\n",
+      rig.model().spec().name, o.config_source, rig.simulation().control_rate, rig.plant_step(),
+      rig.model().spec().observation_P.x(), rig.model().spec().observation_P.y(), rig.model().spec().observation_P.z());
   s += "Errors in mm. **total**: the closed loop as simulated; **twist only**: perfect servos, what the twist alone "
-       "does; **tracking only**: the same servos with no twist in the plant (one run, the same for both strategies).\n\n";
+       "does; **tracking only**: the same servos with no twist in the plant (one run, the same for both "
+       "strategies).\n\n";
   s += "| strategy | error |";
   for (const ReportedTest& t : tests) s += fmt::format(" {} max | {} RMS |", t.name, t.name);
   s += "\n|---|---|";
@@ -152,7 +153,9 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
   for (const bool comp : {false, true})
     for (int e = 0; e < 3; ++e) {
       s += fmt::format("| {} | {} |", comp ? "compensated" : "conventional",
-                       e == 0 ? "total" : e == 1 ? "twist only" : "tracking only");
+                       e == 0   ? "total"
+                       : e == 1 ? "twist only"
+                                : "tracking only");
       for (const ReportedTest& t : tests) {
         const StrategyRun& r = comp ? t.run.compensated : t.run.conventional;
         const ErrorStats& st = e == 0 ? r.total : e == 1 ? r.twist_only : r.tracking_only;
@@ -162,9 +165,10 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
     }
   s += "\nTests:\n\n";
   for (const ReportedTest& t : tests)
-    s += fmt::format("- **{}**: {}, {:.2f} s; `{}_conventional.csv`, `{}_compensated.csv`; figures `{}_error.png`, "
-                     "`{}_legs.png` (and .svg)\n",
-                     t.name, t.description, t.trajectory.duration(), t.name, t.name, t.name, t.name);
+    s += fmt::format(
+        "- **{}**: {}, {:.2f} s; `{}_conventional.csv`, `{}_compensated.csv`; figures `{}_error.png`, "
+        "`{}_legs.png` (and .svg)\n",
+        t.name, t.description, t.trajectory.duration(), t.name, t.name, t.name, t.name);
   if (o.command == "study") {
     s += "\nFor comparison, the paper's Table 1 (maximum error, mm; its lead, servo and trajectories are not "
          "given, so only the orders of magnitude compare):\n\n| | Lz | Lx | Rz | Ry |\n|---|---:|---:|---:|---:|\n";
@@ -191,51 +195,55 @@ std::vector<Figure> figures_of(const fs::path& dir, const ReportedTest& t, const
   const auto& conv = t.run.conventional.samples;
   const auto& comp = t.run.compensated.samples;
   Figure error{(dir / (t.name + "_error")).string(), "", {}};
-  Panel p{fmt::format("{} ({}): observation-point error", t.name, t.description), displacement_label(t),
-          "position error [mm]", {}};
-  p.series.push_back(series("conventional, closed loop", conv, [](std::size_t, const SimulationSample& s) {
-    return 1e3 * s.error;
-  }));
-  p.series.push_back(series("compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) {
-    return 1e3 * s.error;
-  }));
-  p.series.push_back(series("conventional, twist only (perfect servo)", conv,
-                            [](std::size_t, const SimulationSample& s) { return 1e3 * s.error_twist_only; },
-                            Series::Style::Dashed));
-  p.series.push_back(series("servo tracking only (no twist)", conv,
-                            [&](std::size_t k, const SimulationSample&) {
-                              return k < t.run.tracking_only.size() ? 1e3 * t.run.tracking_only[k] : NAN;
-                            },
-                            Series::Style::Dotted));
+  Panel p{fmt::format("{} ({}): observation-point error", t.name, t.description),
+          displacement_label(t),
+          "position error [mm]",
+          {}};
+  p.series.push_back(
+      series("conventional, closed loop", conv, [](std::size_t, const SimulationSample& s) { return 1e3 * s.error; }));
+  p.series.push_back(
+      series("compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) { return 1e3 * s.error; }));
+  p.series.push_back(series(
+      "conventional, perfect servo", conv,
+      [](std::size_t, const SimulationSample& s) { return 1e3 * s.error_twist_only; }, Series::Style::Dashed));
+  p.series.push_back(series(
+      "servo alone (no twist)", conv,
+      [&](std::size_t k, const SimulationSample&) {
+        return k < t.run.tracking_only.size() ? 1e3 * t.run.tracking_only[k] : NAN;
+      },
+      Series::Style::Dotted));
   error.panels.push_back(std::move(p));
   // On the scale of the twist error the compensated strategy is a flat line: zoom in on it.
-  Panel zoom{"Zoom: compensated vs the servo alone", displacement_label(t), "position error [um]", {}};
-  zoom.series.push_back(series("compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) {
-    return 1e6 * s.error;
-  }));
-  zoom.series.push_back(series("servo tracking only (no twist)", comp,
-                               [&](std::size_t k, const SimulationSample&) {
-                                 return k < t.run.tracking_only.size() ? 1e6 * t.run.tracking_only[k] : NAN;
-                               },
-                               Series::Style::Dashed));
-  zoom.series.push_back(series("compensated, twist only (perfect servo)", comp,
-                               [](std::size_t, const SimulationSample& s) { return 1e6 * s.error_twist_only; },
-                               Series::Style::Dotted));
+  Panel zoom{"Zoom on the compensated strategy: its error is the servo's own",
+             displacement_label(t),
+             "position error [µm]",
+             {}};
+  zoom.series.push_back(
+      series("compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) { return 1e6 * s.error; }));
+  zoom.series.push_back(series(
+      "servo alone (no twist)", comp,
+      [&](std::size_t k, const SimulationSample&) {
+        return k < t.run.tracking_only.size() ? 1e6 * t.run.tracking_only[k] : NAN;
+      },
+      Series::Style::Dashed));
+  zoom.series.push_back(series(
+      "compensated, perfect servo", comp,
+      [](std::size_t, const SimulationSample& s) { return 1e6 * s.error_twist_only; }, Series::Style::Dotted));
   error.panels.push_back(std::move(zoom));
 
   Figure legs{(dir / (t.name + "_legs")).string(), "", {}};
   Panel twist{fmt::format("{} ({}): twist of each leg (conventional run)", t.name, t.description),
-              displacement_label(t), "twist [deg]", {}};
-  Panel length{"Length error of each leg, real minus motor-side (Eq. 10)", displacement_label(t), "length error [mm]",
-               {}};
+              displacement_label(t),
+              "twist [deg]",
+              {}};
+  Panel length{
+      "Length error of each leg, real minus motor-side (Eq. 10)", displacement_label(t), "length error [mm]", {}};
   for (int i = 0; i < kLegs; ++i) {
-    twist.series.push_back(series(fmt::format("leg {}", i + 1), conv, [i](std::size_t, const SimulationSample& s) {
-      return rad2deg(s.twist[i]);
-    }));
+    twist.series.push_back(series(fmt::format("leg {}", i + 1), conv,
+                                  [i](std::size_t, const SimulationSample& s) { return rad2deg(s.twist[i]); }));
     const double g = model.geometry().twist_gain[i];
-    length.series.push_back(series(fmt::format("leg {}", i + 1), conv, [i, g](std::size_t, const SimulationSample& s) {
-      return 1e3 * g * s.twist[i];
-    }));
+    length.series.push_back(series(fmt::format("leg {}", i + 1), conv,
+                                   [i, g](std::size_t, const SimulationSample& s) { return 1e3 * g * s.twist[i]; }));
   }
   legs.panels.push_back(std::move(twist));
   legs.panels.push_back(std::move(length));
@@ -251,7 +259,9 @@ std::string summary_table(const std::vector<ReportedTest>& tests) {
   for (const bool comp : {false, true})
     for (int e = 0; e < 3; ++e) {
       s += fmt::format("{:<13} {:<14}", e == 0 ? (comp ? "compensated" : "conventional") : "",
-                       e == 0 ? "total" : e == 1 ? "twist only" : "tracking only");
+                       e == 0   ? "total"
+                       : e == 1 ? "twist only"
+                                : "tracking only");
       for (const ReportedTest& t : tests) {
         const StrategyRun& r = comp ? t.run.compensated : t.run.conventional;
         const ErrorStats& st = e == 0 ? r.total : e == 1 ? r.twist_only : r.tracking_only;

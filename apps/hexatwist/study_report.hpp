@@ -20,10 +20,10 @@ struct ReportedTest {
 
 /// Where and how to write.
 struct ReportOptions {
-  std::string out_dir;       ///< created if missing
-  std::string command;       ///< "study" or "simulate", for the summary
-  std::string config_source; ///< where the configuration came from
-  bool figures = true;       ///< draw PNG + SVG figures with gnuplot
+  std::string out_dir;        ///< created if missing
+  std::string command;        ///< "study" or "simulate", for the summary
+  std::string config_source;  ///< where the configuration came from
+  bool figures = true;        ///< draw PNG + SVG figures with gnuplot
 };
 
 /// The Table 1-like table for the terminal [mm].

@@ -10,35 +10,37 @@ namespace hexatwist {
 /// the Model). Defaults: a 3 kW-class AC servo motor on a 10 mm-lead screw of the seed's size
 /// (docs/theory.md §9 says where each number comes from).
 struct ServoSpec {
-  double motor_inertia = 1.2e-3;     ///< rotor inertia [kg m^2]
-  double screw_inertia = 1.0e-3;     ///< screw, coupling and pulleys about the screw axis [kg m^2]
-  double viscous_friction = 2.0e-3;  ///< viscous friction at the motor shaft [N m s/rad]
-  double torque_limit = 28.0;        ///< peak motor torque [N m]
+  double motor_inertia = 1.2e-3;                 ///< rotor inertia [kg m^2]
+  double screw_inertia = 1.0e-3;                 ///< screw, coupling and pulleys about the screw axis [kg m^2]
+  double viscous_friction = 2.0e-3;              ///< viscous friction at the motor shaft [N m s/rad]
+  double torque_limit = 28.0;                    ///< peak motor torque [N m]
   double max_speed = 3000.0 * 2.0 * kPi / 60.0;  ///< motor speed limit [rad/s] (3000 rpm)
-  double encoder_counts = 1048576;   ///< encoder counts per motor revolution (20 bit)
-  double gear_ratio = 1.0;           ///< motor revolutions per screw revolution
+  double encoder_counts = 1048576;               ///< encoder counts per motor revolution (20 bit)
+  double gear_ratio = 1.0;                       ///< motor revolutions per screw revolution
   /// Position-loop bandwidth used to derive the PID gains when kp, ki and kd are all 0: the
   /// closed loop's three poles are placed at -2 pi bandwidth on each leg's nominal inertia [Hz].
   double bandwidth = 20.0;
-  double kp = 0.0;  ///< proportional gain on the motor angle error [N m/rad]; 0 = from bandwidth
-  double ki = 0.0;  ///< integral gain [N m/(rad s)]; 0 = from bandwidth
-  double kd = 0.0;  ///< derivative gain on the motor speed error [N m s/rad]; 0 = from bandwidth
+  double kp = 0.0;                        ///< proportional gain on the motor angle error [N m/rad]; 0 = from bandwidth
+  double ki = 0.0;                        ///< integral gain [N m/(rad s)]; 0 = from bandwidth
+  double kd = 0.0;                        ///< derivative gain on the motor speed error [N m s/rad]; 0 = from bandwidth
   double velocity_feedforward = 1.0;      ///< fraction of the model's viscous torque fed forward [-]
   double acceleration_feedforward = 1.0;  ///< fraction of the nominal inertia torque fed forward [-]
 };
 
 /// The rigid load on the legs: moving platform plus payload. The legs' own masses are left out.
 struct LoadSpec {
-  double mass = 1500.0;                                   ///< platform + payload [kg]
-  Vector3d center_of_mass_P = Vector3d(0.0, 0.0, 0.15);   ///< centre of mass [m, P]
-  Vector3d inertia = Vector3d(540.0, 540.0, 1080.0);      ///< principal moments about the centre of mass, along P's axes [kg m^2]
-  double gravity = 9.81;                                  ///< gravitational acceleration, along -z of B [m/s^2]
+  double mass = 1500.0;                                  ///< platform + payload [kg]
+  Vector3d center_of_mass_P = Vector3d(0.0, 0.0, 0.15);  ///< centre of mass [m, P]
+  Vector3d inertia =
+      Vector3d(540.0, 540.0, 1080.0);  ///< principal moments about the centre of mass, along P's axes [kg m^2]
+  double gravity = 9.81;               ///< gravitational acceleration, along -z of B [m/s^2]
 };
 
 /// Rates of the simulation.
 struct SimulationSpec {
   double control_rate = 1000.0;  ///< servo (controller) rate [Hz]
-  double plant_step = 1e-4;      ///< largest plant integration step [s]; the control period is split into equal steps no longer than this
+  double plant_step =
+      1e-4;  ///< largest plant integration step [s]; the control period is split into equal steps no longer than this
 };
 
 /// Everything a Rig is built from.

@@ -25,17 +25,17 @@ struct SimulationOptions {
 
 /// One control tick. Lengths are absolute [m]; poses are [x, y, z, roll, pitch, yaw] [m, rad].
 struct SimulationSample {
-  double time = 0.0;                       ///< [s]
-  Vector6d desired = Vector6d::Zero();     ///< commanded pose
-  Vector6d actual = Vector6d::Zero();      ///< real pose (twist-aware forward kinematics of the motors)
-  Vector6d command = Vector6d::Zero();     ///< motor-side target of each leg
-  Vector6d encoder = Vector6d::Zero();     ///< motor-side length as the encoder reads it
-  Vector6d motor = Vector6d::Zero();       ///< true motor-side length
-  Vector6d length = Vector6d::Zero();      ///< real leg length, joint to joint
-  Vector6d twist = Vector6d::Zero();       ///< real twist relative to home [rad]
-  Vector6d torque = Vector6d::Zero();      ///< motor torque [N m]
-  double error = 0.0;             ///< distance of the observation point from where it was commanded [m]
-  double error_twist_only = 0.0;  ///< the same with perfect servos (motors exactly at the target) [m]
+  double time = 0.0;                    ///< [s]
+  Vector6d desired = Vector6d::Zero();  ///< commanded pose
+  Vector6d actual = Vector6d::Zero();   ///< real pose (twist-aware forward kinematics of the motors)
+  Vector6d command = Vector6d::Zero();  ///< motor-side target of each leg
+  Vector6d encoder = Vector6d::Zero();  ///< motor-side length as the encoder reads it
+  Vector6d motor = Vector6d::Zero();    ///< true motor-side length
+  Vector6d length = Vector6d::Zero();   ///< real leg length, joint to joint
+  Vector6d twist = Vector6d::Zero();    ///< real twist relative to home [rad]
+  Vector6d torque = Vector6d::Zero();   ///< motor torque [N m]
+  double error = 0.0;                   ///< distance of the observation point from where it was commanded [m]
+  double error_twist_only = 0.0;        ///< the same with perfect servos (motors exactly at the target) [m]
 };
 
 /// Where and why a trajectory cannot be run, or a simulation stopped.

@@ -12,11 +12,11 @@ namespace hexatwist {
 
 /// The tests' motion (defaults: the seed's stated range, speeds of a large motion platform).
 struct StudySpec {
-  double linear_amplitude = 0.5;              ///< sweep amplitude of the translations [m]
-  double angular_amplitude = deg2rad(30.0);   ///< sweep amplitude of the rotations [rad]
-  MotionLimits linear{0.2, 0.5, 2.5};         ///< [m/s, m/s^2, m/s^3]
+  double linear_amplitude = 0.5;                                       ///< sweep amplitude of the translations [m]
+  double angular_amplitude = deg2rad(30.0);                            ///< sweep amplitude of the rotations [rad]
+  MotionLimits linear{0.2, 0.5, 2.5};                                  ///< [m/s, m/s^2, m/s^3]
   MotionLimits angular{deg2rad(15.0), deg2rad(45.0), deg2rad(180.0)};  ///< [rad/s, rad/s^2, rad/s^3]
-  double dwell = 0.5;                         ///< rest before, between and after the moves [s]
+  double dwell = 0.5;                                                  ///< rest before, between and after the moves [s]
 };
 
 /// One of the paper's tests: a sweep of one pose coordinate through +-amplitude.
@@ -43,8 +43,8 @@ ErrorStats error_stats(const std::vector<double>& series) noexcept;
 /// One strategy's run and its three errors.
 struct StrategyRun {
   std::vector<SimulationSample> samples;  ///< the closed loop, tick by tick
-  ErrorStats total;          ///< closed loop as simulated
-  ErrorStats twist_only;     ///< perfect servos, quasi-static: what the twist alone does
+  ErrorStats total;                       ///< closed loop as simulated
+  ErrorStats twist_only;                  ///< perfect servos, quasi-static: what the twist alone does
   ErrorStats tracking_only;  ///< the same servos with no twist in the plant (the same run for both strategies)
 };
 
