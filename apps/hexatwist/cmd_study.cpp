@@ -19,7 +19,7 @@ struct StudyOptions {
   std::string out = "study-out";
   std::string tests = "Lz,Lx,Rz,Ry";
   std::string trajectory;  // simulate only
-  bool figures = true;
+  bool no_figures = false;
 };
 
 // A progress bar on stderr, drawn only on a terminal.
@@ -86,10 +86,11 @@ int finish(const Rig& rig, const StudyOptions& o, const std::string& command, st
     return d;
   }();
   const double sim_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  ReportOptions ro{o.out, command, model_source(o.model), o.figures};
+  ReportOptions ro{o.out, command, model_source(o.model), !o.no_figures};
   const std::vector<std::string> files = write_report(rig, ro, tests);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::string out = summary_table(tests);
+  std::string out = fmt::format("hexatwist {} on {}: {}\n\n", command, model_source(o.model), rig.model().spec().name);
+  out += summary_table(tests);
   out += fmt::format("\n{} s simulated ({} runs) in {:.1f} s; {} files written to {} in {:.1f} s in all\n", simulated,
                      3 * tests.size(), sim_wall, files.size(), o.out, wall);
   std::fputs(out.c_str(), stdout);
@@ -147,7 +148,7 @@ void add_common(CLI::App& app, StudyOptions& o) {
   add_model_options(app, o.model);
   app.add_option("--out", o.out, "Output folder for summary.json, summary.md, CSVs and figures (created if missing)")
       ->capture_default_str();
-  app.add_flag("--no-figures{false}", o.figures, "Skip the PNG/SVG figures (gnuplot)");
+  app.add_flag("--no-figures", o.no_figures, "Skip the PNG/SVG figures (gnuplot)");
 }
 
 }  // namespace

@@ -253,7 +253,7 @@ std::vector<Figure> figures_of(const fs::path& dir, const ReportedTest& t, const
 }  // namespace
 
 std::string summary_table(const std::vector<ReportedTest>& tests) {
-  std::string s = fmt::format("{:<28}", "Max. error [mm]");
+  std::string s = fmt::format("{:<28}", "max. error of point A [mm]");
   for (const ReportedTest& t : tests) s += fmt::format(" {:>10}", t.name.substr(0, 10));
   s += "\n";
   for (const bool comp : {false, true})
