@@ -413,12 +413,16 @@ void read_extras(const Reader& r, const Field& top, Locations& locs, ConfigSpec&
   constexpr double kRpm = 2.0 * kPi / 60.0;
 
   ServoSpec& sv = out.rig.servo;
-  const Field servo = section("servo", {"motor_inertia", "screw_inertia", "viscous_friction", "torque_limit",
+  const Field servo = section("servo", {"motor_inertia", "screw_inertia", "viscous_friction", "coulomb_friction",
+                                        "friction_speed", "torque_time_constant", "torque_limit",
                                         "max_speed_rpm", "encoder_counts", "gear_ratio", "bandwidth_hz", "kp", "ki",
                                         "kd", "velocity_feedforward", "acceleration_feedforward"});
   num(servo, "motor_inertia", "rotor inertia [kg m^2]", Positive, sv.motor_inertia);
   num(servo, "screw_inertia", "screw and coupling inertia [kg m^2]", NonNegative, sv.screw_inertia);
   num(servo, "viscous_friction", "at the motor shaft [N m s/rad]", NonNegative, sv.viscous_friction);
+  num(servo, "coulomb_friction", "dry friction at the motor shaft [N m]", NonNegative, sv.coulomb_friction);
+  num(servo, "friction_speed", "speed over which dry friction changes sign [rad/s]", Positive, sv.friction_speed);
+  num(servo, "torque_time_constant", "current-loop lag [s]; 0 = instant", NonNegative, sv.torque_time_constant);
   num(servo, "torque_limit", "peak motor torque [N m]", Positive, sv.torque_limit);
   num(servo, "max_speed_rpm", "motor speed limit [rpm]", Positive, sv.max_speed, kRpm, "servo.max_speed");
   num(servo, "encoder_counts", "counts per motor revolution", Positive, sv.encoder_counts);

@@ -38,6 +38,9 @@ void Rig::validate_and_derive() {
   positive(s.motor_inertia, "servo.motor_inertia", "kg m^2");
   non_negative(s.screw_inertia, "servo.screw_inertia", "kg m^2");
   non_negative(s.viscous_friction, "servo.viscous_friction", "N m s/rad");
+  non_negative(s.coulomb_friction, "servo.coulomb_friction", "N m");
+  positive(s.friction_speed, "servo.friction_speed", "rad/s");
+  non_negative(s.torque_time_constant, "servo.torque_time_constant", "s");
   positive(s.torque_limit, "servo.torque_limit", "N m");
   positive(s.max_speed, "servo.max_speed", "rad/s");
   if (!std::isfinite(s.encoder_counts) || s.encoder_counts < 1.0 || s.encoder_counts != std::floor(s.encoder_counts))

@@ -46,22 +46,37 @@ void update_controller(const Rig& rig, const ServoReference& reference, const Ve
 
 void integrate_drives(const Rig& rig, const Matrix6d& inverse_inertia, const Vector6d& load_torque,
                       const Vector6d& torque, DriveState& drives) noexcept {
-  // theta' = w, w' = c - B w with c = A^-1 (torque + load) and B = b A^-1, constant over the period.
-  const Vector6d c = inverse_inertia * (torque + load_torque);
-  const Matrix6d B = rig.servo().viscous_friction * inverse_inertia;
+  const ServoSpec& sv = rig.servo();
+  const double b = sv.viscous_friction;
+  const double tc = sv.coulomb_friction;
+  const double inv_wf = 1.0 / sv.friction_speed;
+  const double T = sv.torque_time_constant;
   const double h = rig.plant_step();
+  // State (theta, w, tau_m): theta' = w, w' = A^-1 (tau_m - b w - tc tanh(w / wf) + load),
+  // tau_m' = (torque - tau_m) / T (tau_m = torque when T = 0).
+  struct Rates {
+    Vector6d w, dw, dtau;
+  };
+  const auto rates = [&](const Vector6d& w, const Vector6d& tau) {
+    Rates r;
+    r.w = w;
+    const Vector6d friction = b * w + tc * (w * inv_wf).array().tanh().matrix();
+    r.dw.noalias() = inverse_inertia * (tau - friction + load_torque);
+    r.dtau = T > 0.0 ? Vector6d((torque - tau) / T) : Vector6d::Zero();
+    return r;
+  };
   Vector6d& th = drives.angle;
   Vector6d& w = drives.speed;
+  Vector6d& tau = drives.torque;
+  if (T <= 0.0) tau = torque;
   for (int n = 0; n < rig.substeps(); ++n) {
-    const Vector6d k1w = c - B * w;
-    const Vector6d w2 = w + 0.5 * h * k1w;
-    const Vector6d k2w = c - B * w2;
-    const Vector6d w3 = w + 0.5 * h * k2w;
-    const Vector6d k3w = c - B * w3;
-    const Vector6d w4 = w + h * k3w;
-    const Vector6d k4w = c - B * w4;
-    th += (h / 6.0) * (w + 2.0 * w2 + 2.0 * w3 + w4);
-    w += (h / 6.0) * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+    const Rates k1 = rates(w, tau);
+    const Rates k2 = rates(w + 0.5 * h * k1.dw, tau + 0.5 * h * k1.dtau);
+    const Rates k3 = rates(w + 0.5 * h * k2.dw, tau + 0.5 * h * k2.dtau);
+    const Rates k4 = rates(w + h * k3.dw, tau + h * k3.dtau);
+    th += (h / 6.0) * (k1.w + 2.0 * k2.w + 2.0 * k3.w + k4.w);
+    w += (h / 6.0) * (k1.dw + 2.0 * k2.dw + 2.0 * k3.dw + k4.dw);
+    tau += (h / 6.0) * (k1.dtau + 2.0 * k2.dtau + 2.0 * k3.dtau + k4.dtau);
   }
 }
 

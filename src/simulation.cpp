@@ -137,7 +137,9 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
   Vector6d measured;
   read_encoder(rig, drives.angle, measured);
   ControllerState controller;
-  start_controller(rig, measured, rig.servo().viscous_friction * drives.speed - load_torque0, controller);
+  const Vector6d holding = rig.servo().viscous_friction * drives.speed - load_torque0;
+  start_controller(rig, measured, holding, controller);
+  drives.torque = holding;
 
   Vector6d twist_ref = Vector6d::Zero();
   Vector6d twist_now;

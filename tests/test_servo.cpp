@@ -44,6 +44,8 @@ TEST(Servo, IntegratorMatchesTheExactSolution) {
   // J w' = tau - b w from rest: w(t) = tau/b (1 - exp(-b t / J)), theta = tau/b (t - J/b (1 - exp(-b t/J))).
   ServoSpec s;
   s.viscous_friction = 0.05;
+  s.coulomb_friction = 0.0;
+  s.torque_time_constant = 0.0;
   const Rig rig = make_rig(s);
   const double J = 2e-3, tau = 1.5, b = s.viscous_friction;
   DriveState d;
@@ -57,6 +59,40 @@ TEST(Servo, IntegratorMatchesTheExactSolution) {
   const double e = std::exp(-b * t / J);
   EXPECT_NEAR(d.speed[0], tau / b * (1 - e), 1e-9 * tau / b);
   EXPECT_NEAR(d.angle[0], tau / b * (t - J / b * (1 - e)), 1e-9 * tau / b * t);
+}
+
+TEST(Servo, TorqueLagsTheCommandByTheCurrentLoop) {
+  ServoSpec s;
+  s.torque_time_constant = 0.8e-3;
+  const Rig rig = make_rig(s);
+  DriveState d;
+  const Matrix6d inv = Matrix6d::Identity() / 1e3;  // a huge inertia: only the torque matters here
+  const Vector6d command = Vector6d::Constant(2.0);
+  for (int k = 1; k <= 3; ++k) {
+    integrate_drives(rig, inv, Vector6d::Zero(), command, d);
+    const double t = k * rig.control_period();
+    EXPECT_NEAR(d.torque[0], 2.0 * (1 - std::exp(-t / s.torque_time_constant)), 1e-5) << k;  // RK4, h/T = 1/8: 1.6e-6
+  }
+}
+
+TEST(Servo, DryFrictionTakesItsShareOfTheTorque) {
+  // Constant torque from rest: the speed settles where torque = b w + tc tanh(w / wf), i.e.
+  // w = (torque - tc) / b once w >> wf; a torque below tc barely creeps.
+  ServoSpec s;
+  s.viscous_friction = 0.02;
+  s.coulomb_friction = 0.4;
+  s.torque_time_constant = 0.0;
+  const Rig rig = make_rig(s);
+  const Matrix6d inv = Matrix6d::Identity() / 2e-3;
+  DriveState fast, slow;
+  for (int k = 0; k < 2000; ++k) {
+    integrate_drives(rig, inv, Vector6d::Zero(), Vector6d::Constant(1.0), fast);
+    integrate_drives(rig, inv, Vector6d::Zero(), Vector6d::Constant(0.2), slow);
+  }
+  EXPECT_NEAR(fast.speed[0], (1.0 - 0.4) / 0.02, 1e-6 * 30.0);
+  // Below tc: tanh(w / wf) = 0.2 / 0.4 exactly balances (b w is small): w = wf atanh(0.5) ~ 0.27 rad/s.
+  EXPECT_LT(slow.speed[0], s.friction_speed);
+  EXPECT_GT(slow.speed[0], 0.0);
 }
 
 TEST(Servo, StepResponseSettlesWithoutSteadyStateError) {

@@ -133,7 +133,12 @@ std::string summary_json(const Rig& rig, const ReportOptions& o, const std::vect
   return j.str();
 }
 
-std::string mm(double m) { return fmt::format("{:.4f}", 1e3 * m); }
+// Millimetres with four decimals; values too small for that (the exact compensation) keep two
+// significant digits, so that 1e-9 mm does not read as 0.
+std::string mm(double m) {
+  const double v = 1e3 * m;
+  return v != 0.0 && std::abs(v) < 5e-5 ? fmt::format("{:.1e}", v) : fmt::format("{:.4f}", v);
+}
 
 std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests) {
   std::string s = fmt::format("# hexatwist {}: observation-point error\n\n", o.command);

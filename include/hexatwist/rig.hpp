@@ -10,9 +10,14 @@ namespace hexatwist {
 /// the Model). Defaults: a 3 kW-class AC servo motor on a 10 mm-lead screw of the seed's size
 /// (docs/theory.md §9 says where each number comes from).
 struct ServoSpec {
-  double motor_inertia = 1.2e-3;                 ///< rotor inertia [kg m^2]
-  double screw_inertia = 1.0e-3;                 ///< screw, coupling and pulleys about the screw axis [kg m^2]
-  double viscous_friction = 2.0e-3;              ///< viscous friction at the motor shaft [N m s/rad]
+  double motor_inertia = 1.2e-3;     ///< rotor inertia [kg m^2]
+  double screw_inertia = 1.0e-3;     ///< screw, coupling and pulleys about the screw axis [kg m^2]
+  double viscous_friction = 2.0e-3;  ///< viscous friction at the motor shaft [N m s/rad]
+  /// Coulomb (dry) friction of screw, nut and bearings at the motor shaft, smoothed as
+  /// coulomb_friction * tanh(speed / friction_speed) [N m].
+  double coulomb_friction = 0.3;
+  double friction_speed = 0.5;                   ///< speed over which the dry friction changes sign [rad/s]
+  double torque_time_constant = 0.5e-3;          ///< current loop: first-order lag of the torque [s]; 0 = instant
   double torque_limit = 28.0;                    ///< peak motor torque [N m]
   double max_speed = 3000.0 * 2.0 * kPi / 60.0;  ///< motor speed limit [rad/s] (3000 rpm)
   double encoder_counts = 1048576;               ///< encoder counts per motor revolution (20 bit)

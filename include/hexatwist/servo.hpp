@@ -8,8 +8,9 @@ namespace hexatwist {
 
 /// The six drives: motor angles relative to home and their speeds (the plant's state).
 struct DriveState {
-  Vector6d angle = Vector6d::Zero();  ///< motor angle; motor-side length = home length + motor_gain * angle [rad]
-  Vector6d speed = Vector6d::Zero();  ///< motor speed [rad/s]
+  Vector6d angle = Vector6d::Zero();   ///< motor angle; motor-side length = home length + motor_gain * angle [rad]
+  Vector6d speed = Vector6d::Zero();   ///< motor speed [rad/s]
+  Vector6d torque = Vector6d::Zero();  ///< torque the motor produces (lags the command by the current loop) [N m]
 };
 
 /// What the controller is asked to follow at one tick, at the motor shaft.
@@ -42,9 +43,10 @@ void start_controller(const Rig& rig, const Vector6d& measured, const Vector6d& 
 void update_controller(const Rig& rig, const ServoReference& reference, const Vector6d& measured,
                        ControllerState& state, Vector6d& torque) noexcept;
 
-/// Advances the drives by one control period (rig.substeps() RK4 steps) under a constant motor
-/// torque and load: A theta'' = torque - b theta' + load_torque, with `inverse_inertia` = A^-1
-/// (drive inertia on the diagonal plus the reflected load, held over the period) [1/(kg m^2)].
+/// Advances the drives by one control period (rig.substeps() RK4 steps) under a constant torque
+/// command and load: A theta'' = tau_m - b theta' - tau_c tanh(theta'/w_f) + load_torque, with the
+/// motor torque tau_m following the command with the current loop's lag, and `inverse_inertia` =
+/// A^-1 (drive inertia on the diagonal plus the reflected load, held over the period) [1/(kg m^2)].
 void integrate_drives(const Rig& rig, const Matrix6d& inverse_inertia, const Vector6d& load_torque,
                       const Vector6d& torque, DriveState& drives) noexcept;
 
