@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
-# The main job: set up, build, and run hexatwist. Arguments go to hexatwist (default: `study`, the
-# paper's four tests on the seed platform, written to study-out/). Example: bash scripts/run.sh ik --pose=0,0,0.1,0,0,30
+# The main job: set up, build, and run hexatwist. Arguments go to hexatwist; the default is
+# `study`: the paper's four tests on the seed platform, written to ./study-out/ in the folder you
+# run this from. Example: bash scripts/run.sh ik --pose=0,0,0.1,0,0,30
+# Paths you give (--config, --trajectory, --out) are taken relative to where you are.
 set -euo pipefail
-cd "$(dirname "$0")/.."
-bash scripts/build.sh >/dev/null
+root="$(cd "$(dirname "$0")/.." && pwd)"
+# Build progress goes to stderr (the first build takes several minutes); stdout is hexatwist's.
+bash "$root/scripts/build.sh" >&2
 if [ $# -eq 0 ]; then set -- study; fi
-exec ./build/hexatwist "$@"
+exec "$root/build/hexatwist" "$@"

@@ -415,7 +415,7 @@ void read_extras(const Reader& r, const Field& top, Locations& locs, ConfigSpec&
   ServoSpec& sv = out.rig.servo;
   const Field servo = section("servo", {"motor_inertia", "screw_inertia", "viscous_friction", "coulomb_friction",
                                         "friction_speed", "torque_time_constant", "torque_limit",
-                                        "max_speed_rpm", "encoder_counts", "gear_ratio", "bandwidth_hz", "kp", "ki",
+                                        "max_speed_rpm", "encoder_counts", "gear_ratio", "pole_frequency_hz", "kp", "ki",
                                         "kd", "velocity_feedforward", "acceleration_feedforward"});
   num(servo, "motor_inertia", "rotor inertia [kg m^2]", Positive, sv.motor_inertia);
   num(servo, "screw_inertia", "screw and coupling inertia [kg m^2]", NonNegative, sv.screw_inertia);
@@ -427,10 +427,10 @@ void read_extras(const Reader& r, const Field& top, Locations& locs, ConfigSpec&
   num(servo, "max_speed_rpm", "motor speed limit [rpm]", Positive, sv.max_speed, kRpm, "servo.max_speed");
   num(servo, "encoder_counts", "counts per motor revolution", Positive, sv.encoder_counts);
   num(servo, "gear_ratio", "motor revolutions per screw revolution", Positive, sv.gear_ratio);
-  num(servo, "bandwidth_hz", "position-loop bandwidth [Hz]", Positive, sv.bandwidth, 1.0, "servo.bandwidth");
-  num(servo, "kp", "[N m/rad]; 0 = from bandwidth_hz", NonNegative, sv.kp);
-  num(servo, "ki", "[N m/(rad s)]; 0 = from bandwidth_hz", NonNegative, sv.ki);
-  num(servo, "kd", "[N m s/rad]; 0 = from bandwidth_hz", NonNegative, sv.kd);
+  num(servo, "pole_frequency_hz", "closed-loop pole frequency of the position loop [Hz]", Positive, sv.pole_frequency, 1.0, "servo.pole_frequency");
+  num(servo, "kp", "[N m/rad]; 0 = from pole_frequency_hz", NonNegative, sv.kp);
+  num(servo, "ki", "[N m/(rad s)]; 0 = from pole_frequency_hz", NonNegative, sv.ki);
+  num(servo, "kd", "[N m s/rad]; 0 = from pole_frequency_hz", NonNegative, sv.kd);
   num(servo, "velocity_feedforward", "fraction of the viscous torque", NonNegative, sv.velocity_feedforward);
   num(servo, "acceleration_feedforward", "fraction of the inertia torque", NonNegative, sv.acceleration_feedforward);
 

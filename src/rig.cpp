@@ -21,7 +21,7 @@ void non_negative(double v, const char* field, const char* unit) {
   if (!std::isfinite(v) || v < 0.0) fail(field, fmt::format("expected >= 0 {}, got {}", unit, v));
 }
 
-// Largest 2 pi bandwidth / control rate for which the derived discrete loop keeps its margins.
+// Largest 2 pi pole_frequency / control rate for which the derived discrete loop keeps its margins.
 constexpr double kMaxBandwidthRatio = 0.5;
 
 }  // namespace
@@ -47,14 +47,14 @@ void Rig::validate_and_derive() {
     fail("servo.encoder_counts",
          fmt::format("expected a whole number >= 1 of counts per revolution, got {}", s.encoder_counts));
   positive(s.gear_ratio, "servo.gear_ratio", "motor revolutions per screw revolution");
-  positive(s.bandwidth, "servo.bandwidth", "Hz");
+  positive(s.pole_frequency, "servo.pole_frequency", "Hz");
   non_negative(s.kp, "servo.kp", "N m/rad");
   non_negative(s.ki, "servo.ki", "N m/(rad s)");
   non_negative(s.kd, "servo.kd", "N m s/rad");
   const bool derive = s.kp == 0.0 && s.ki == 0.0 && s.kd == 0.0;
   if (!derive && s.kp == 0.0)
     fail("servo.kp",
-         "expected > 0 when ki or kd is given (or leave all three at 0 to derive them from servo.bandwidth)");
+         "expected > 0 when ki or kd is given (or leave all three at 0 to derive them from servo.pole_frequency)");
   non_negative(s.velocity_feedforward, "servo.velocity_feedforward", "(fraction)");
   non_negative(s.acceleration_feedforward, "servo.acceleration_feedforward", "(fraction)");
 
@@ -93,10 +93,10 @@ void Rig::validate_and_derive() {
   nominal_inertia_ = Vector6d::Constant(drive_inertia_) + motor_gain_.cwiseAbs2().cwiseProduct(dyn.mass.diagonal());
 
   if (derive) {
-    const double w = 2.0 * kPi * s.bandwidth;
+    const double w = 2.0 * kPi * s.pole_frequency;
     if (w * control_period_ > kMaxBandwidthRatio)
-      fail("servo.bandwidth",
-           fmt::format("{} Hz is too high for the control rate {} Hz (keep 2 pi bandwidth / rate <= {})", s.bandwidth,
+      fail("servo.pole_frequency",
+           fmt::format("{} Hz is too high for the control rate {} Hz (keep 2 pi pole_frequency / rate <= {})", s.pole_frequency,
                        simulation_.control_rate, kMaxBandwidthRatio));
     // J s^3 + (b + kd) s^2 + kp s + ki = J (s + w)^3: three closed-loop poles at -w (docs/theory.md §9).
     kp_ = 3.0 * w * w * nominal_inertia_;

@@ -39,10 +39,26 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   const bool compensated = twist_in_plant && strategy == Strategy::Compensated;
   std::vector<Vector6d> command(n);
   CommandReport report;
+  LegDynamics dyn;
+  const double torque_limit = rig.servo().torque_limit;
   for (std::size_t k = 0; k < n; ++k) {
     if (const Status s = compute_commands(model, trajectory.poses[k], report); s != Status::Ok)
       return fail(issue, s, k, trajectory, report.limit);
     command[k] = compensated ? report.compensated : report.conventional;
+    // Every motor must at least be able to hold the load standing still at every pose.
+    if (const Status s = leg_dynamics(model, rig.load(), report.legs, LengthKind::Motor, dyn); s != Status::Ok)
+      return fail(issue, s, k, trajectory);
+    for (int i = 0; i < kLegs; ++i) {
+      const double hold = std::abs(rig.motor_gain()[i] * dyn.gravity[i]);
+      if (hold > torque_limit) {
+        LimitReport limit;
+        limit.status = Status::TorqueAboveMax;
+        limit.leg = i;
+        limit.value = hold;
+        limit.bound = torque_limit;
+        return fail(issue, Status::TorqueAboveMax, k, trajectory, limit);
+      }
+    }
   }
   // Motor speed by central differences of the targets (one-sided at the ends).
   const double T = trajectory.dt;

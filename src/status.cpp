@@ -15,6 +15,7 @@ std::string_view to_string(Status s) noexcept {
     case Status::NoConvergence: return "no_convergence";
     case Status::SingularJacobian: return "singular_jacobian";
     case Status::MotorSpeedAboveMax: return "motor_speed_above_max";
+    case Status::TorqueAboveMax: return "torque_above_max";
   }
   return "unknown";
 }
@@ -32,6 +33,7 @@ std::string_view describe(Status s) noexcept {
     case Status::NoConvergence: return "forward kinematics did not converge";
     case Status::SingularJacobian: return "forward kinematics met a singular platform Jacobian";
     case Status::MotorSpeedAboveMax: return "a motor would have to turn faster than its speed limit";
+    case Status::TorqueAboveMax: return "holding the load would take more torque than a motor's limit";
   }
   return "unknown status";
 }

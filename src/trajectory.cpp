@@ -435,8 +435,11 @@ Trajectory resample(const TimedPoses& samples, double dt) {
     q[i] = samples.poses[i].to_vector();
   }
 
-  // Slopes: derivative at each sample of the parabola through it and its two neighbours (the
-  // first or last three at the ends, the secant for two samples). Exact for quadratics.
+  // Slopes (Fritsch-Carlson monotone cubic, "PCHIP", per coordinate): a weighted harmonic mean
+  // of the two neighbouring secants where they agree in sign, else 0; at the ends, the three-point
+  // one-sided slope, limited the same way. The curve then never overshoots the samples: a hold
+  // stays a hold and a move does not swing past its end (waypoint files are common input).
+  // Lines are reproduced exactly.
   std::vector<Vector6d> slope(m);
   const auto secant = [&](std::size_t i) -> Vector6d { return (q[i + 1] - q[i]) / (t[i + 1] - t[i]); };
   if (m == 2) {
@@ -444,17 +447,20 @@ Trajectory resample(const TimedPoses& samples, double dt) {
   } else {
     for (std::size_t i = 1; i + 1 < m; ++i) {
       const double h0 = t[i] - t[i - 1], h1 = t[i + 1] - t[i];
-      slope[i] = (h1 * secant(i - 1) + h0 * secant(i)) / (h0 + h1);
+      const Vector6d d0 = secant(i - 1), d1 = secant(i);
+      const double w0 = 2.0 * h1 + h0, w1 = h1 + 2.0 * h0;
+      for (int c = 0; c < 6; ++c) slope[i][c] = d0[c] * d1[c] > 0.0 ? (w0 + w1) / (w0 / d0[c] + w1 / d1[c]) : 0.0;
     }
-    {
-      const double h0 = t[1] - t[0], h1 = t[2] - t[1];
-      const Vector6d curvature = (secant(1) - secant(0)) / (h0 + h1);  // half the second derivative
-      slope[0] = secant(0) - h0 * curvature;
-    }
-    {
-      const double h0 = t[m - 2] - t[m - 3], h1 = t[m - 1] - t[m - 2];
-      const Vector6d curvature = (secant(m - 2) - secant(m - 3)) / (h0 + h1);
-      slope[m - 1] = secant(m - 2) + h1 * curvature;
+    const auto end_slope = [](double h0, double h1, double d0, double d1) {
+      double e = ((2.0 * h0 + h1) * d0 - h0 * d1) / (h0 + h1);
+      if (e * d0 <= 0.0) return 0.0;
+      if (d0 * d1 <= 0.0 && std::abs(e) > 3.0 * std::abs(d0)) e = 3.0 * d0;
+      return e;
+    };
+    const Vector6d a0 = secant(0), a1 = secant(1), z0 = secant(m - 2), z1 = secant(m - 3);
+    for (int c = 0; c < 6; ++c) {
+      slope[0][c] = end_slope(t[1] - t[0], t[2] - t[1], a0[c], a1[c]);
+      slope[m - 1][c] = end_slope(t[m - 1] - t[m - 2], t[m - 2] - t[m - 3], z0[c], z1[c]);
     }
   }
 

@@ -252,16 +252,15 @@ TEST(Cli, FkOfIkLengthsReturnsThePose) {
 TEST(Cli, FkWithImpossibleLengthsFailsWithExitThree) {
   const Outcome r = run({"fk", "--lengths=1,1,1,1,1,1", "--json"});
   expect_error(r, 3, {"forward kinematics failed"});
-  EXPECT_TRUE(r.err.find("no_convergence") != std::string::npos || r.err.find("singular") != std::string::npos) << r.err;
+  EXPECT_TRUE(r.err.find("no_convergence") != std::string::npos || r.err.find("singular") != std::string::npos)
+      << r.err;
   const YAML::Node j = json(r);
   const std::string status = j["status"].as<std::string>();
   EXPECT_TRUE(status == "no_convergence" || status.rfind("singular", 0) == 0) << status;
   EXPECT_TRUE(j["pose"].IsNull());
 }
 
-TEST(Cli, FkRejectsFiveLengths) {
-  expect_error(run({"fk", "--lengths=1.9,1.9,1.9,1.9,1.9"}), 2, {"--lengths", "6"});
-}
+TEST(Cli, FkRejectsFiveLengths) { expect_error(run({"fk", "--lengths=1.9,1.9,1.9,1.9,1.9"}), 2, {"--lengths", "6"}); }
 
 TEST(Cli, FkRejectsLengthsThatAreNotLengths) {
   expect_error(run({"fk", "--lengths=1.9,1.9,-1.9,1.9,1.9,1.9"}), 2, {"--lengths", "value 3", "> 0"});
@@ -327,9 +326,7 @@ TEST(Cli, NanOrInfInPoseIsBadInput) {
   expect_error(run({"ik", "--pose=1e999,0,0,0,0,0"}), 2, {"--pose", "range"});
 }
 
-TEST(Cli, NewlineInAnArgumentStillGivesOneLine) {
-  expect_error(run({"ik", "--pose=0,0\n,0,0,0,0"}), 2, {"--pose"});
-}
+TEST(Cli, NewlineInAnArgumentStillGivesOneLine) { expect_error(run({"ik", "--pose=0,0\n,0,0,0,0"}), 2, {"--pose"}); }
 
 TEST(Cli, MissingConfigFileIsBadInput) {
   const std::string missing = (temp_dir() / "does_not_exist.yaml").string();
@@ -456,8 +453,8 @@ TEST(Cli, SimulateWritesTheWholeReport) {
   EXPECT_GT(conv_twist, 1e-5);  // 5 deg of yaw: ~0.24 mm at the edge
   EXPECT_LE(t["compensated"]["max_error_total"].as<double>() - t["compensated"]["max_error_tracking_only"].as<double>(),
             1e-6);
-  for (const char* f : {"heave_conventional.csv", "heave_compensated.csv", "summary.md", "heave_error.svg",
-                        "heave_legs.svg"})
+  for (const char* f :
+       {"heave_conventional.csv", "heave_compensated.csv", "summary.md", "heave_error.svg", "heave_legs.svg"})
     EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
   EXPECT_TRUE(is_png(out / "heave_error.png"));
   EXPECT_TRUE(is_png(out / "heave_legs.png"));
@@ -487,13 +484,13 @@ TEST(Cli, SimulateOutsideALimitRunsNothing) {
   const std::string csv = write_file("high.csv", heave_csv(900.0));  // z = 0.9 m: legs too long
   const std::filesystem::path out = temp_dir() / "high-out";
   const Outcome r = run({"simulate", "--trajectory", csv, "--out", out.string()});
-  expect_error(r, 3, {"high: t = ", "leg ", "above the maximum", "nothing was simulated"});
+  expect_error(r, 3, {csv + ": t = 0.917 s", "leg 2", "above the maximum", "nothing was simulated"});
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 TEST(Cli, StudyRunsTheChosenTestsAndRefusesUnknownOnes) {
   const std::filesystem::path out = temp_dir() / "study-out";
-  const Outcome r = run({"study", "--tests", "Rz", "--no-figures", "--out", out.string()});
+  const Outcome r = run({"study", "--tests", "Rz", "--no-figures", "--no-csv", "--out", out.string()});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("Rz"), std::string::npos);
   const YAML::Node s = YAML::LoadFile((out / "summary.json").string());
@@ -503,8 +500,17 @@ TEST(Cli, StudyRunsTheChosenTestsAndRefusesUnknownOnes) {
   EXPECT_GT(conv["max_error_twist_only"].as<double>(), 1.3e-3);
   EXPECT_LT(conv["max_error_twist_only"].as<double>(), 1.5e-3);
   EXPECT_FALSE(std::filesystem::exists(out / "Rz_error.png"));
+  EXPECT_FALSE(std::filesystem::exists(out / "Rz_compensated.csv"));
+  EXPECT_TRUE(std::filesystem::exists(out / "summary.md"));
   std::filesystem::remove_all(out);
   expect_error(run({"study", "--tests", "Lq"}), 2, {"--tests", "'Lq'"});
+  // A motor that cannot hold the load: refused before anything runs.
+  const std::string weak =
+      write_file("weak.yaml", std::string(hexatwist::test::kSymmetricYaml) + "servo:\n  torque_limit: 3\n");
+  expect_error(
+      run({"study", "--config", weak, "--out", out.string()}), 3,
+      {"Lz: t = 0.000 s", "leg 1", "holding the load takes 4.9", "servo.torque_limit", "nothing was simulated"});
+  EXPECT_FALSE(std::filesystem::exists(out));
   const std::string file = write_file("blocked", "a file, not a folder");
   expect_error(run({"study", "--tests", "Rz", "--no-figures", "--out", file}), 4, {"--out", file});
 }

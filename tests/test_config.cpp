@@ -464,7 +464,7 @@ TEST(Config, SeedFileSpellsOutTheDefaults) {
   EXPECT_EQ(c.rig.servo().torque_limit, d.torque_limit);
   EXPECT_NEAR(c.rig.servo().max_speed, d.max_speed, 1e-12);
   EXPECT_EQ(c.rig.servo().encoder_counts, d.encoder_counts);
-  EXPECT_EQ(c.rig.servo().bandwidth, d.bandwidth);
+  EXPECT_EQ(c.rig.servo().pole_frequency, d.pole_frequency);
   EXPECT_EQ(c.rig.load().mass, LoadSpec{}.mass);
   EXPECT_EQ(c.rig.load().center_of_mass_P, LoadSpec{}.center_of_mass_P);
   EXPECT_EQ(c.rig.load().inertia, LoadSpec{}.inertia);

@@ -30,7 +30,7 @@ TEST(Rig, RefusesBadNumbersNamingTheField) {
   EXPECT_EQ(error_of([](RigSpec& s) { s.servo.encoder_counts = 1000.5; }).rfind("servo.encoder_counts:", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.servo.gear_ratio = 0; }).rfind("servo.gear_ratio:", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.servo.ki = 10; }).rfind("servo.kp: expected > 0 when", 0), 0u);
-  EXPECT_EQ(error_of([](RigSpec& s) { s.servo.bandwidth = 200; }).rfind("servo.bandwidth: 200 Hz is too high", 0), 0u);
+  EXPECT_EQ(error_of([](RigSpec& s) { s.servo.pole_frequency = 200; }).rfind("servo.pole_frequency: 200 Hz is too high", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.load.mass = -3; }).rfind("load.mass:", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.load.inertia.y() = 0; }).rfind("load.inertia:", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.simulation.control_rate = 0; }).rfind("simulation.control_rate:", 0), 0u);

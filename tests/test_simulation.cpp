@@ -107,6 +107,18 @@ TEST(Simulation, NothingRunsFasterThanTheMotors) {
   EXPECT_EQ(issue.limit.bound, rig.servo().max_speed);
 }
 
+TEST(Simulation, NothingRunsIfAMotorCannotHoldTheLoad) {
+  const Model& model = seed().rig.model();
+  ServoSpec weak;
+  weak.torque_limit = 3.0;  // the seed's load takes about 4.9 N m per motor at home
+  const Rig rig(model, weak, LoadSpec{}, SimulationSpec{});
+  SimulationIssue issue;
+  ASSERT_EQ(check_trajectory(rig, still(Pose{}, 0.01), issue), Status::TorqueAboveMax);
+  EXPECT_EQ(issue.index, 0u);
+  EXPECT_NEAR(issue.limit.value, 4.92, 0.01);
+  EXPECT_EQ(issue.limit.bound, 3.0);
+}
+
 TEST(Simulation, RefusesATrajectoryAtAnotherRate) {
   Trajectory t = still(Pose{}, 0.01);
   t.dt = 0.002;

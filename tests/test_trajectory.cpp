@@ -597,34 +597,57 @@ std::vector<double> random_times(std::mt19937_64& rng, int n) {
   return t;
 }
 
-TEST(Trajectory, ResampleReproducesLinesAndParabolas) {
-  // Uneven random times. The three-point slopes are exact for a parabola, so the Hermite cubic is
-  // the parabola itself: measured worst error 8.9e-16 (line), 1.3e-15 (parabola), with values up
-  // to ~15; allowed 1e-14 and 1.5e-14.
+TEST(Trajectory, ResampleReproducesLines) {
+  // Uneven random times: the harmonic mean of equal secants is the secant, so the cubic is the
+  // line itself. Measured worst error 8.9e-16 with values up to ~15; allowed 1e-14.
   std::mt19937_64 rng(kSeed + 207);
-  double worst[3] = {0.0, 0.0, 0.0};
+  double worst = 0.0;
   for (int n = 0; n < stress(200); ++n) {
-    for (const int degree : {1, 2}) {
-      const int count = degree == 1 && n % 5 == 0 ? 2 : 3 + n % 20;  // two samples: the secant
-      const TimedPoses tp = polynomial_samples(random_times(rng, count), degree);
-      const double dt = uniform(rng, 0.001, 0.1);
-      const Trajectory tr = resample(tp, dt);
-      ASSERT_EQ(tr.t0, tp.t.front());
-      ASSERT_EQ(tr.dt, dt);
-      for (std::size_t k = 0; k < tr.poses.size(); ++k) {
-        const double e = (tr.poses[k].to_vector() - polynomial_at(tr.time(k), degree)).cwiseAbs().maxCoeff();
-        worst[degree] = std::max(worst[degree], e);
-        ASSERT_LT(e, degree == 1 ? 1e-14 : 1.5e-14) << "degree " << degree << " sample " << k << " t " << tr.time(k);
+    const int count = n % 5 == 0 ? 2 : 3 + n % 20;  // two samples: the secant
+    const TimedPoses tp = polynomial_samples(random_times(rng, count), 1);
+    const double dt = uniform(rng, 0.001, 0.1);
+    const Trajectory tr = resample(tp, dt);
+    ASSERT_EQ(tr.t0, tp.t.front());
+    ASSERT_EQ(tr.dt, dt);
+    for (std::size_t k = 0; k < tr.poses.size(); ++k) {
+      const double e = (tr.poses[k].to_vector() - polynomial_at(tr.time(k), 1)).cwiseAbs().maxCoeff();
+      worst = std::max(worst, e);
+      ASSERT_LT(e, 1e-14) << "sample " << k << " t " << tr.time(k);
+    }
+  }
+  report("resampled line error", worst);
+}
+
+TEST(Trajectory, ResampleNeverOvershootsTheSamples) {
+  // Waypoints: rest, a move, a hold, a move back, uneven spacing, random heights. On every
+  // interval the curve stays between its two samples (a hold stays exactly flat).
+  std::mt19937_64 rng(kSeed + 209);
+  for (int n = 0; n < stress(100); ++n) {
+    TimedPoses tp;
+    double t = 0.0;
+    for (int k = 0; k < 12; ++k) {
+      tp.t.push_back(t);
+      Vector6d q;
+      for (int c = 0; c < 6; ++c) q[c] = (k % 4 == 1 || k % 4 == 2) ? uniform(rng, -1.0, 1.0) : 0.0;
+      if (k % 4 == 2) q = tp.poses.back().to_vector();  // hold
+      tp.poses.push_back(Pose::from_vector(q));
+      t += uniform(rng, 0.02, 3.0);
+    }
+    const Trajectory tr = resample(tp, 0.01);
+    std::size_t i = 0;
+    for (std::size_t k = 0; k < tr.poses.size(); ++k) {
+      while (i + 2 < tp.t.size() && tp.t[i + 1] <= tr.time(k)) ++i;
+      const Vector6d a = tp.poses[i].to_vector(), b = tp.poses[i + 1].to_vector(), x = tr.poses[k].to_vector();
+      for (int c = 0; c < 6; ++c) {
+        ASSERT_GE(x[c], std::min(a[c], b[c]) - 1e-15) << n << " " << k << " " << c;
+        ASSERT_LE(x[c], std::max(a[c], b[c]) + 1e-15) << n << " " << k << " " << c;
       }
     }
   }
-  report("resampled line error", worst[1]);
-  report("resampled parabola error", worst[2]);
 }
 
 TEST(Trajectory, ResampleDoesNotReproduceACubic) {
-  // The method is second order: a cubic is only approximated (this proves the parabola test
-  // above is not trivially exact). Error of t^3 on spacing 0.5: about h^3 / 24 ~ 5e-3.
+  // A cubic is only approximated (this proves the line test above is not trivially exact).
   TimedPoses tp;
   for (int k = 0; k <= 8; ++k) {
     const double t = 0.5 * k;

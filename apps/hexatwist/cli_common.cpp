@@ -125,12 +125,16 @@ std::string describe_limit(const LimitReport& r) {
                          r.status == Status::BendBase ? "base" : "platform", rad2deg(r.value), rad2deg(r.bound));
     case Status::SingularBase:
     case Status::SingularPlatform:
-      return fmt::format("{}leg is {:.3f} deg from the {} U-joint's fixed axis, inside the singularity margin {:.3f} deg "
-                         "(limits.singularity_margin_deg)",
-                         leg, rad2deg(r.value), r.status == Status::SingularBase ? "base" : "platform", rad2deg(r.bound));
+      return fmt::format(
+          "{}leg is {:.3f} deg from the {} U-joint's fixed axis, inside the singularity margin {:.3f} deg "
+          "(limits.singularity_margin_deg)",
+          leg, rad2deg(r.value), r.status == Status::SingularBase ? "base" : "platform", rad2deg(r.bound));
     case Status::MotorSpeedAboveMax:
       return fmt::format("{}motor speed {:.0f} rpm is above the limit {:.0f} rpm (servo.max_speed_rpm)", leg,
                          r.value * 60.0 / (2.0 * kPi), r.bound * 60.0 / (2.0 * kPi));
+    case Status::TorqueAboveMax:
+      return fmt::format("{}holding the load takes {:.2f} N m, above the motor's limit {:.2f} N m (servo.torque_limit)",
+                         leg, r.value, r.bound);
     default:
       return leg + std::string(describe(r.status));
   }

@@ -17,8 +17,8 @@ namespace hexatwist::cli {
 /// Exit codes of the tool.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitBadInput = 2,    ///< malformed input, bad configuration, unreadable file
-  kExitOutOfLimit = 3,  ///< a pose outside a limit, or a forward-kinematics failure
+  kExitBadInput = 2,      ///< malformed input, bad configuration, unreadable file
+  kExitOutOfLimit = 3,    ///< a pose outside a limit, or a forward-kinematics failure
   kExitOutputFailed = 4,  ///< an output file or figure could not be written
 };
 

@@ -16,11 +16,14 @@ struct ConfigOptions {
   bool yaml = false;
 };
 
-std::string v3(const Vector3d& v) { return fmt::format("[{:.6f}, {:.6f}, {:.6f}]", tidy(v.x()), tidy(v.y()), tidy(v.z())); }
+std::string v3(const Vector3d& v) {
+  return fmt::format("[{:.6f}, {:.6f}, {:.6f}]", tidy(v.x()), tidy(v.y()), tidy(v.z()));
+}
 
 int run_config(const ConfigOptions& o) {
   if (o.yaml) {
-    if (!o.model.config.empty()) throw ExitError(kExitBadInput, "--yaml prints the embedded seed config; drop --config");
+    if (!o.model.config.empty())
+      throw ExitError(kExitBadInput, "--yaml prints the embedded seed config; drop --config");
     std::fputs(std::string(seed_config_yaml()).c_str(), stdout);
     return kExitOk;
   }
@@ -68,7 +71,8 @@ int run_config(const ConfigOptions& o) {
     out += fmt::format("leg {}:\n  base joint      {} m [B]\n  platform joint  {} m [P]\n", i + 1, v3(l.base_B),
                        v3(l.platform_P));
     if (!std::isnan(l.theta_home))
-      out += fmt::format("  base axis ja    {} [B]\n  platform axis jd {} [P]\n", v3(l.axis_base_B), v3(l.axis_platform_P));
+      out += fmt::format("  base axis ja    {} [B]\n  platform axis jd {} [P]\n", v3(l.axis_base_B),
+                         v3(l.axis_platform_P));
     out += fmt::format("  lead {:.4g} mm, {}-hand thread, driven at the {}; twist gain {:+.6g} mm/rad\n", 1e3 * l.lead,
                        l.thread == ThreadSense::Right ? "right" : "left",
                        l.driven == DrivenSide::Base ? "base" : "platform", 1e3 * l.twist_gain);

@@ -26,8 +26,8 @@ int run_fk(const FkOptionsCli& o) {
   for (int i = 0; i < kLegs; ++i) {
     lengths[i] = v[static_cast<std::size_t>(i)];
     if (!(lengths[i] > 0.0))
-      throw ExitError(kExitBadInput, fmt::format("--lengths: value {} ({}) is not a length; expected > 0 m", i + 1,
-                                                 lengths[i]));
+      throw ExitError(kExitBadInput,
+                      fmt::format("--lengths: value {} ({}) is not a length; expected > 0 m", i + 1, lengths[i]));
   }
   const Pose guess = parse_pose_m_deg(o.guess, "--guess");
   const LengthKind kind = o.motor ? LengthKind::Motor : LengthKind::Geometric;
@@ -58,7 +58,8 @@ int run_fk(const FkOptionsCli& o) {
       out += fmt::format("pose: x={:.9f} y={:.9f} z={:.9f} m, roll={:.9f} pitch={:.9f} yaw={:.9f} deg\n", tidy(q[0]),
                          tidy(q[1]), tidy(q[2]), rad2deg(tidy(q[3])), rad2deg(tidy(q[4])), rad2deg(tidy(q[5])));
     out += fmt::format("iterations: {}, residual: {:.3g} m\n", result->iterations, result->residual);
-    out += fmt::format("status: {}\n", final_status == Status::Ok ? std::string("ok") : std::string(to_string(final_status)));
+    out += fmt::format("status: {}\n",
+                       final_status == Status::Ok ? std::string("ok") : std::string(to_string(final_status)));
     std::fputs(out.c_str(), stdout);
   }
   if (status != Status::Ok) {

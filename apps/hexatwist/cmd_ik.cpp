@@ -28,8 +28,8 @@ int run_ik(const IkOptions& o) {
   // other limits; compute_commands leaves them unspecified otherwise.
   LegState legs_check;
   Vector6d twist_check;
-  const bool have_twist = inverse_kinematics(model, pose, legs_check) == Status::Ok &&
-                          twist(model, legs_check, twist_check) == Status::Ok;
+  const bool have_twist =
+      inverse_kinematics(model, pose, legs_check) == Status::Ok && twist(model, legs_check, twist_check) == Status::Ok;
   Vector6d bend_base, bend_platform, theta;
   bend_angles(model, report->legs, bend_base, bend_platform);
   const bool have_abs = twist_absolute(model, report->legs, theta) == Status::Ok;
@@ -63,16 +63,21 @@ int run_ik(const IkOptions& o) {
     out += fmt::format("pose: x={:.6g} y={:.6g} z={:.6g} m, roll={:.6g} pitch={:.6g} yaw={:.6g} deg\n",
                        pose.position.x(), pose.position.y(), pose.position.z(), rad2deg(pose.rpy[0]),
                        rad2deg(pose.rpy[1]), rad2deg(pose.rpy[2]));
-    out += "leg  length[m]  twist[deg]  length_error[mm]  command_conv[m]  command_comp[m]  bend_base[deg]  bend_platform[deg]\n";
+    out +=
+        "leg  length[m]  twist[deg]  length_error[mm]  command_conv[m]  command_comp[m]  bend_base[deg]  "
+        "bend_platform[deg]\n";
     for (int i = 0; i < kLegs; ++i) {
-      const std::string tw = have_twist ? fmt::format("{:10.4f}", rad2deg(tidy(report->twist[i]))) : fmt::format("{:>10}", "-");
-      const std::string le = have_twist ? fmt::format("{:16.4f}", 1e3 * tidy(report->length_error[i])) : fmt::format("{:>16}", "-");
+      const std::string tw =
+          have_twist ? fmt::format("{:10.4f}", rad2deg(tidy(report->twist[i]))) : fmt::format("{:>10}", "-");
+      const std::string le =
+          have_twist ? fmt::format("{:16.4f}", 1e3 * tidy(report->length_error[i])) : fmt::format("{:>16}", "-");
       const std::string cc = ok ? fmt::format("{:15.6f}", report->conventional[i]) : fmt::format("{:>15}", "-");
       const std::string cp = ok ? fmt::format("{:15.6f}", report->compensated[i]) : fmt::format("{:>15}", "-");
-      out += fmt::format("{:>3}  {:9.6f}  {}  {}  {}  {}  {:14.3f}  {:18.3f}\n", i + 1, report->legs.length[i], tw, le, cc,
-                         cp, rad2deg(bend_base[i]), rad2deg(bend_platform[i]));
+      out += fmt::format("{:>3}  {:9.6f}  {}  {}  {}  {}  {:14.3f}  {:18.3f}\n", i + 1, report->legs.length[i], tw, le,
+                         cc, cp, rad2deg(bend_base[i]), rad2deg(bend_platform[i]));
     }
-    out += fmt::format("status: {}\n", ok ? "ok" : std::string(to_string(status)) + ": " + describe_limit(report->limit));
+    out +=
+        fmt::format("status: {}\n", ok ? "ok" : std::string(to_string(status)) + ": " + describe_limit(report->limit));
     std::fputs(out.c_str(), stdout);
   }
   if (!ok) {

@@ -20,6 +20,7 @@ struct StudyOptions {
   std::string tests = "Lz,Lx,Rz,Ry";
   std::string trajectory;  // simulate only
   bool no_figures = false;
+  bool no_csv = false;
 };
 
 // A progress bar on stderr, drawn only on a terminal.
@@ -47,17 +48,19 @@ class Progress {
 };
 
 std::string where(const ReportedTest& t, const SimulationIssue& issue) {
-  return fmt::format("{}: t = {:.3f} s", t.name, issue.time);
+  return fmt::format("{}: t = {:.3f} s", t.label, issue.time);
 }
 
 // Checks every trajectory against the limits first (nothing runs if one fails), then simulates.
-void run_all(const Rig& rig, std::vector<ReportedTest>& tests) {
+void run_all(const Rig& rig, std::vector<ReportedTest>& tests, const std::string& out_dir) {
   for (const ReportedTest& t : tests) {
     SimulationIssue issue;
-    if (check_trajectory(rig, t.trajectory, issue) != Status::Ok)
+    if (const Status s = check_trajectory(rig, t.trajectory, issue); s != Status::Ok)
       throw ExitError(kExitOutOfLimit,
-                      fmt::format("{}: {}; nothing was simulated", where(t, issue), describe_limit(issue.limit)));
+                      fmt::format("{}: {}; nothing was simulated", where(t, issue),
+                                  is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
   }
+  prepare_output_folder(out_dir);
   std::size_t total = 0;
   for (const ReportedTest& t : tests) total += 3 * t.trajectory.poses.size();
   Progress bar(total);
@@ -79,20 +82,21 @@ void run_all(const Rig& rig, std::vector<ReportedTest>& tests) {
 
 int finish(const Rig& rig, const StudyOptions& o, const std::string& command, std::vector<ReportedTest>& tests,
            std::chrono::steady_clock::time_point start) {
-  run_all(rig, tests);
+  run_all(rig, tests, o.out);
   const double simulated = [&] {
     double d = 0.0;
     for (const ReportedTest& t : tests) d += 3.0 * t.trajectory.duration();
     return d;
   }();
   const double sim_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  ReportOptions ro{o.out, command, model_source(o.model), !o.no_figures};
+  ReportOptions ro{o.out, command, model_source(o.model), !o.no_figures, !o.no_csv};
   const std::vector<std::string> files = write_report(rig, ro, tests);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::string out = fmt::format("hexatwist {} on {}: {}\n\n", command, model_source(o.model), rig.model().spec().name);
   out += summary_table(tests);
-  out += fmt::format("\n{} s simulated ({} runs) in {:.1f} s; {} files written to {} in {:.1f} s in all\n", simulated,
-                     3 * tests.size(), sim_wall, files.size(), o.out, wall);
+  out += report_notes(rig, tests);
+  out += fmt::format("\n{:.1f} s simulated ({} runs) in {:.1f} s; {} files written to {} in {:.1f} s in all\n",
+                     simulated, 3 * tests.size(), sim_wall, files.size(), o.out, wall);
   std::fputs(out.c_str(), stdout);
   return kExitOk;
 }
@@ -114,6 +118,7 @@ int run_study(const StudyOptions& o) {
       if (t.name == name) throw ExitError(kExitBadInput, fmt::format("--tests: '{}' given twice", name));
     ReportedTest& t = tests.emplace_back();
     t.name = found->name;
+    t.label = found->name;
     t.description = fmt::format("{}, +-{:g} {}", found->description,
                                 found->coordinate < 3 ? found->amplitude : rad2deg(found->amplitude),
                                 found->coordinate < 3 ? "m" : "deg");
@@ -141,6 +146,7 @@ int run_simulate(const StudyOptions& o) {
     t.name += (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_') ? c : '_';
   if (t.name.empty()) t.name = "trajectory";
   t.description = fmt::format("trajectory {}", std::filesystem::path(o.trajectory).filename().string());
+  t.label = printable(o.trajectory);
   return finish(config.rig, o, "simulate", tests, start);
 }
 
@@ -149,6 +155,7 @@ void add_common(CLI::App& app, StudyOptions& o) {
   app.add_option("--out", o.out, "Output folder for summary.json, summary.md, CSVs and figures (created if missing)")
       ->capture_default_str();
   app.add_flag("--no-figures", o.no_figures, "Skip the PNG/SVG figures (gnuplot)");
+  app.add_flag("--no-csv", o.no_csv, "Skip the per-tick CSVs (about 9 MB per test and strategy at 1 kHz)");
 }
 
 }  // namespace
@@ -174,8 +181,9 @@ Command make_simulate_command(CLI::App& root) {
       "as study.\nCSV: a header row t,x,y,z,roll,pitch,yaw, then one row per sample, time strictly increasing. Units: "
       "t in s, x/y/z in m, roll/pitch/yaw in degrees; a header name may carry a unit suffix instead: _s, _m, _mm, "
       "_deg, "
-      "_rad (e.g. x_mm, yaw_rad). The trajectory is resampled at the control rate (C1 cubic) and checked against every "
-      "limit before anything runs.");
+      "_rad (e.g. x_mm, yaw_rad). Poses are relative to home (R = Rz*Ry*Rx). The trajectory is resampled at the "
+      "control rate (monotone cubic: no overshoot between samples) and checked against every limit before anything "
+      "runs; the simulation starts settled at the first sample.");
   app->add_option("--trajectory", o->trajectory, "CSV file: t,x,y,z,roll,pitch,yaw (s, m, deg)")->required();
   add_common(*app, *o);
   return {app, [o] { return run_simulate(*o); }};

@@ -44,11 +44,12 @@ constexpr double kLeftLabelSpace = 52;    // the y label, the tick marks and the
 constexpr double kDigitWidth = 7.3;       // of a tick label character
 constexpr double kRightSpace = 16;        // right of the key (or of the plot area without a key)
 constexpr double kKeySampleWidth = 64;    // line sample and gaps of a key entry
-constexpr double kCharWidth = 8.0;        // width of a character of a key label (generous: lower-case text of the study measured 7.5)
-constexpr double kMaxKeyWidth = 340;      // a wider key goes under the plot
-constexpr double kKeyGap = 12;            // between the plot area and a key right of it
-constexpr double kKeyLineHeight = 19.5;   // of a key entry
-constexpr double kKeyBelowGap = 8;        // under a key below the plot
+constexpr double kCharWidth =
+    8.0;  // width of a character of a key label (generous: lower-case text of the study measured 7.5)
+constexpr double kMaxKeyWidth = 340;     // a wider key goes under the plot
+constexpr double kKeyGap = 12;           // between the plot area and a key right of it
+constexpr double kKeyLineHeight = 19.5;  // of a key entry
+constexpr double kKeyBelowGap = 8;       // under a key below the plot
 constexpr const char* kFont = "sans,11";
 constexpr const char* kTitleFont = "sans,13";
 constexpr double kLineWidth = 1.5;
@@ -56,7 +57,6 @@ constexpr double kLineWidth = 1.5;
 // Six colours that differ in hue and, in this order, alternately much in lightness (CIE L* 0, 49,
 // 24, 74, 37, 60; luma 0, 42, 17, 69, 28, 58 %), so that any two stay apart in greyscale print.
 constexpr std::array<const char*, 6> kPalette{"#000000", "#306fe8", "#730d0d", "#ff9f2e", "#1b6619", "#d968ba"};
-
 
 // A gnuplot single-quoted string: no escapes are processed inside except '' for a quote; control
 // characters (a newline would end the command) become spaces.

@@ -88,14 +88,29 @@ std::string csv(const ReportedTest& t, const StrategyRun& run, const Model& mode
   return fmt::to_string(b);
 }
 
-void stats_json(JsonWriter& j, const StrategyRun& r, const Rig& rig) {
-  double max_torque = 0.0;
-  std::size_t saturated = 0;
+// What a run did besides the three errors.
+struct RunFigures {
+  double max_torque = 0.0;             // [N m]
+  std::size_t saturated = 0;           // ticks with some torque at the limit
+  double max_following_error = 0.0;    // largest |target - true motor-side length| [m]
+  double max_orientation_error = 0.0;  // largest angle between real and commanded orientation [rad]
+};
+
+RunFigures run_figures(const Rig& rig, const StrategyRun& r) {
+  RunFigures f;
   for (const SimulationSample& s : r.samples) {
     const double m = s.torque.cwiseAbs().maxCoeff();
-    max_torque = std::max(max_torque, m);
-    saturated += m >= rig.servo().torque_limit ? 1 : 0;
+    f.max_torque = std::max(f.max_torque, m);
+    f.saturated += m >= rig.servo().torque_limit ? 1 : 0;
+    f.max_following_error = std::max(f.max_following_error, (s.command - s.motor).cwiseAbs().maxCoeff());
+    const Matrix3d dR = rotation_from_rpy(s.actual.tail<3>()) * rotation_from_rpy(s.desired.tail<3>()).transpose();
+    f.max_orientation_error = std::max(f.max_orientation_error, Eigen::AngleAxisd(dR).angle());
   }
+  return f;
+}
+
+void stats_json(JsonWriter& j, const StrategyRun& r, const Rig& rig) {
+  const RunFigures f = run_figures(rig, r);
   j.begin_object()
       .field("max_error_total", r.total.max)
       .field("max_error_twist_only", r.twist_only.max)
@@ -103,8 +118,10 @@ void stats_json(JsonWriter& j, const StrategyRun& r, const Rig& rig) {
       .field("rms_error_total", r.total.rms)
       .field("rms_error_twist_only", r.twist_only.rms)
       .field("rms_error_tracking_only", r.tracking_only.rms)
-      .field("max_torque", max_torque)
-      .field("saturated_ticks", static_cast<int>(saturated))
+      .field("max_orientation_error", f.max_orientation_error)
+      .field("max_following_error", f.max_following_error)
+      .field("max_torque", f.max_torque)
+      .field("saturated_ticks", static_cast<int>(f.saturated))
       .end_object();
 }
 
@@ -168,6 +185,7 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
       }
       s += "\n";
     }
+  if (const std::string notes = report_notes(rig, tests); !notes.empty()) s += "\n" + notes;
   s += "\nTests:\n\n";
   for (const ReportedTest& t : tests)
     s += fmt::format(
@@ -186,16 +204,22 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
 }
 
 std::vector<Figure> figures_of(const fs::path& dir, const ReportedTest& t, const Model& model) {
+  // x: the swept coordinate (or time) by default; time for the transients of the servo.
   const auto series = [&](const std::string& label, const std::vector<SimulationSample>& samples, auto value,
-                          Series::Style style = Series::Style::Solid) {
+                          Series::Style style = Series::Style::Solid, bool against_time = false) {
     Series s{label, {}, {}, style};
     s.x.reserve(samples.size());
     s.y.reserve(samples.size());
     for (std::size_t k = 0; k < samples.size(); ++k) {
-      s.x.push_back(displacement(t, samples[k]));
+      s.x.push_back(against_time ? samples[k].time : displacement(t, samples[k]));
       s.y.push_back(value(k, samples[k]));
     }
     return s;
+  };
+  const auto tracking = [&](double scale) {
+    return [&t, scale](std::size_t k, const SimulationSample&) {
+      return k < t.run.tracking_only.size() ? scale * t.run.tracking_only[k] : NAN;
+    };
   };
   const auto& conv = t.run.conventional.samples;
   const auto& comp = t.run.compensated.samples;
@@ -206,36 +230,39 @@ std::vector<Figure> figures_of(const fs::path& dir, const ReportedTest& t, const
           {}};
   p.series.push_back(
       series("conventional, closed loop", conv, [](std::size_t, const SimulationSample& s) { return 1e3 * s.error; }));
-  p.series.push_back(
-      series("compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) { return 1e3 * s.error; }));
   p.series.push_back(series(
       "conventional, perfect servo", conv,
       [](std::size_t, const SimulationSample& s) { return 1e3 * s.error_twist_only; }, Series::Style::Dashed));
-  p.series.push_back(series(
-      "servo alone (no twist)", conv,
-      [&](std::size_t k, const SimulationSample&) {
-        return k < t.run.tracking_only.size() ? 1e3 * t.run.tracking_only[k] : NAN;
-      },
-      Series::Style::Dotted));
+  p.series.push_back(
+      series("compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) { return 1e3 * s.error; }));
   error.panels.push_back(std::move(p));
-  // On the scale of the twist error the compensated strategy is a flat line: zoom in on it.
-  Panel zoom{"Zoom on the compensated strategy: its error is the servo's own",
-             displacement_label(t),
+  // On the scale of the twist error the compensated strategy is a flat line: zoom in on it,
+  // against time, where the servo's transients (starts, stops, reversals) are apart.
+  Panel zoom{fmt::format("Compensated, zoomed: the servo's own error (with perfect servos it is {:.1e} µm)",
+                         1e6 * t.run.compensated.twist_only.max),
+             "time [s]",
              "position error [µm]",
              {}};
-  zoom.series.push_back(
-      series("compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) { return 1e6 * s.error; }));
   zoom.series.push_back(series(
-      "servo alone (no twist)", comp,
-      [&](std::size_t k, const SimulationSample&) {
-        return k < t.run.tracking_only.size() ? 1e6 * t.run.tracking_only[k] : NAN;
-      },
-      Series::Style::Dashed));
-  zoom.series.push_back(series(
-      "compensated, perfect servo", comp,
-      [](std::size_t, const SimulationSample& s) { return 1e6 * s.error_twist_only; }, Series::Style::Dotted));
+      "compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) { return 1e6 * s.error; },
+      Series::Style::Solid, true));
+  zoom.series.push_back(series("servo alone (no twist)", comp, tracking(1e6), Series::Style::Dashed, true));
   error.panels.push_back(std::move(zoom));
 
+  // Legs that move alike (symmetry) would hide each other: say so in the legend.
+  std::array<int, kLegs> same{};
+  for (int i = 0; i < kLegs; ++i) {
+    same[static_cast<std::size_t>(i)] = -1;
+    for (int j = 0; j < i && same[static_cast<std::size_t>(i)] < 0; ++j) {
+      double d = 0.0;
+      for (const SimulationSample& s : conv) d = std::max(d, std::abs(s.twist[i] - s.twist[j]));
+      if (d < 1e-6) same[static_cast<std::size_t>(i)] = j;
+    }
+  }
+  const auto leg_label = [&](int i) {
+    const int j = same[static_cast<std::size_t>(i)];
+    return j < 0 ? fmt::format("leg {}", i + 1) : fmt::format("leg {} (= leg {})", i + 1, j + 1);
+  };
   Figure legs{(dir / (t.name + "_legs")).string(), "", {}};
   Panel twist{fmt::format("{} ({}): twist of each leg (conventional run)", t.name, t.description),
               displacement_label(t),
@@ -244,11 +271,11 @@ std::vector<Figure> figures_of(const fs::path& dir, const ReportedTest& t, const
   Panel length{
       "Length error of each leg, real minus motor-side (Eq. 10)", displacement_label(t), "length error [mm]", {}};
   for (int i = 0; i < kLegs; ++i) {
-    twist.series.push_back(series(fmt::format("leg {}", i + 1), conv,
-                                  [i](std::size_t, const SimulationSample& s) { return rad2deg(s.twist[i]); }));
+    twist.series.push_back(
+        series(leg_label(i), conv, [i](std::size_t, const SimulationSample& s) { return rad2deg(s.twist[i]); }));
     const double g = model.geometry().twist_gain[i];
-    length.series.push_back(series(fmt::format("leg {}", i + 1), conv,
-                                   [i, g](std::size_t, const SimulationSample& s) { return 1e3 * g * s.twist[i]; }));
+    length.series.push_back(
+        series(leg_label(i), conv, [i, g](std::size_t, const SimulationSample& s) { return 1e3 * g * s.twist[i]; }));
   }
   legs.panels.push_back(std::move(twist));
   legs.panels.push_back(std::move(length));
@@ -277,13 +304,30 @@ std::string summary_table(const std::vector<ReportedTest>& tests) {
   return s;
 }
 
+void prepare_output_folder(const std::string& out_dir) {
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec || !fs::is_directory(out_dir))
+    throw ExitError(kExitOutputFailed, fmt::format("--out: cannot create the output folder '{}'{}", printable(out_dir),
+                                                   ec ? ": " + ec.message() : std::string()));
+}
+
+std::string report_notes(const Rig& rig, const std::vector<ReportedTest>& tests) {
+  std::string s;
+  for (const ReportedTest& t : tests)
+    for (const bool comp : {false, true}) {
+      const RunFigures f = run_figures(rig, comp ? t.run.compensated : t.run.conventional);
+      if (f.saturated > 0)
+        s += fmt::format("note: {} {}: the torque limit {:g} N m was reached on {} of {} ticks\n", t.label,
+                         comp ? "compensated" : "conventional", rig.servo().torque_limit, f.saturated,
+                         (comp ? t.run.compensated : t.run.conventional).samples.size());
+    }
+  return s;
+}
+
 std::vector<std::string> write_report(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests) {
   const fs::path dir(o.out_dir);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir))
-    throw ExitError(kExitOutputFailed, fmt::format("--out: cannot create the output folder '{}'{}", o.out_dir,
-                                                   ec ? ": " + ec.message() : std::string()));
+  prepare_output_folder(o.out_dir);
   std::vector<std::string> written;
   const auto put = [&](const fs::path& path, std::string_view content) {
     write_file(path, content);
@@ -291,8 +335,10 @@ std::vector<std::string> write_report(const Rig& rig, const ReportOptions& o, co
   };
   std::vector<Figure> figures;
   for (const ReportedTest& t : tests) {
-    put(dir / (t.name + "_conventional.csv"), csv(t, t.run.conventional, rig.model()));
-    put(dir / (t.name + "_compensated.csv"), csv(t, t.run.compensated, rig.model()));
+    if (o.csv) {
+      put(dir / (t.name + "_conventional.csv"), csv(t, t.run.conventional, rig.model()));
+      put(dir / (t.name + "_compensated.csv"), csv(t, t.run.compensated, rig.model()));
+    }
     if (o.figures)
       for (Figure& f : figures_of(dir, t, rig.model())) figures.push_back(std::move(f));
   }

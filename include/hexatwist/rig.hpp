@@ -22,12 +22,13 @@ struct ServoSpec {
   double max_speed = 3000.0 * 2.0 * kPi / 60.0;  ///< motor speed limit [rad/s] (3000 rpm)
   double encoder_counts = 1048576;               ///< encoder counts per motor revolution (20 bit)
   double gear_ratio = 1.0;                       ///< motor revolutions per screw revolution
-  /// Position-loop bandwidth used to derive the PID gains when kp, ki and kd are all 0: the
-  /// closed loop's three poles are placed at -2 pi bandwidth on each leg's nominal inertia [Hz].
-  double bandwidth = 20.0;
-  double kp = 0.0;                        ///< proportional gain on the motor angle error [N m/rad]; 0 = from bandwidth
-  double ki = 0.0;                        ///< integral gain [N m/(rad s)]; 0 = from bandwidth
-  double kd = 0.0;                        ///< derivative gain on the motor speed error [N m s/rad]; 0 = from bandwidth
+  /// Frequency of the closed-loop poles from which the PID gains are derived when kp, ki and kd
+  /// are all 0: all three poles at -2 pi pole_frequency on each leg's nominal inertia [Hz]. The
+  /// loop's -3 dB bandwidth is then about 3.9 times this (docs/theory.md §9).
+  double pole_frequency = 10.0;
+  double kp = 0.0;                        ///< proportional gain on the motor angle error [N m/rad]; 0 = from pole_frequency
+  double ki = 0.0;                        ///< integral gain [N m/(rad s)]; 0 = from pole_frequency
+  double kd = 0.0;                        ///< derivative gain on the motor speed error [N m s/rad]; 0 = from pole_frequency
   double velocity_feedforward = 1.0;      ///< fraction of the model's viscous torque fed forward [-]
   double acceleration_feedforward = 1.0;  ///< fraction of the nominal inertia torque fed forward [-]
 };
@@ -76,7 +77,7 @@ class Rig {
   /// Nominal inertia each motor sees: drive inertia + the load reflected through the leg at home
   /// (diagonal of the leg-space mass matrix) [kg m^2]. Used for feed-forward and for the gains.
   const Vector6d& nominal_inertia() const noexcept { return nominal_inertia_; }
-  /// Effective PID gains per leg (given, or derived from the bandwidth).
+  /// Effective PID gains per leg (given, or derived from pole_frequency).
   const Vector6d& kp() const noexcept { return kp_; }
   const Vector6d& ki() const noexcept { return ki_; }
   const Vector6d& kd() const noexcept { return kd_; }

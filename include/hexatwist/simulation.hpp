@@ -40,14 +40,15 @@ struct SimulationSample {
 
 /// Where and why a trajectory cannot be run, or a simulation stopped.
 struct SimulationIssue {
-  Status status = Status::Ok;  ///< a limit, MotorSpeedAboveMax, or a numerical failure
+  Status status = Status::Ok;  ///< a limit (MotorSpeedAboveMax, TorqueAboveMax included), or a numerical failure
   std::size_t index = 0;       ///< sample of the trajectory
   double time = 0.0;           ///< its time [s]
-  LimitReport limit;           ///< leg, value and bound (for limits and the motor speed [rad/s])
+  LimitReport limit;           ///< leg, value and bound (limits; motor speed [rad/s]; holding torque [N m])
 };
 
 /// Checks the whole trajectory before anything runs: every pose inside the limits, both
-/// commands inside the stroke, no motor faster than servo.max_speed. Returns the first
+/// commands inside the stroke, no motor faster than servo.max_speed, and no motor that could not
+/// even hold the load standing still (static torque above servo.torque_limit). Returns the first
 /// violation (Ok if none). Nothing is simulated.
 [[nodiscard]] Status check_trajectory(const Rig& rig, const Trajectory& trajectory, SimulationIssue& issue);
 

@@ -18,13 +18,14 @@ enum class Status : int {
   NoConvergence,     ///< forward kinematics did not reach its tolerance
   SingularJacobian,  ///< forward kinematics met a singular platform Jacobian
   MotorSpeedAboveMax,  ///< a trajectory needs a motor faster than its speed limit
+  TorqueAboveMax,      ///< holding the load at a pose needs more torque than a motor's limit
 };
 
 /// True for the statuses that mean "this pose is outside a limit".
 constexpr bool is_limit(Status s) noexcept {
   return s == Status::StrokeBelowMin || s == Status::StrokeAboveMax || s == Status::BendBase ||
          s == Status::BendPlatform || s == Status::SingularBase || s == Status::SingularPlatform ||
-         s == Status::MotorSpeedAboveMax;
+         s == Status::MotorSpeedAboveMax || s == Status::TorqueAboveMax;
 }
 
 /// Stable snake_case name of a status, as written in JSON (`"stroke_above_max"`).

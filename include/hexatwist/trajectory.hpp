@@ -117,14 +117,15 @@ struct TimedPoses {
 TimedPoses parse_trajectory_csv(std::string_view text, std::string_view source);
 
 /// Resamples every `dt` [s] from t.front() to t.back() (t0 = t.front(); the last sample at, or
-/// within dt before, t.back()) with C1 piecewise-cubic Hermite interpolation per coordinate. The
-/// slope at each sample is the derivative of the parabola through it and its two neighbours
-/// (one-sided, through the first or last three samples, at the ends; the secant for 2 samples),
-/// so linear and quadratic motions are reproduced exactly. A grid time within 1e-9 dt of an input
-/// time gives that input pose exactly. Angles are interpolated as given (no wrapping at ±pi).
-/// Throws hexatwist::Error if dt <= 0 or non-finite, fewer than 2 samples, t and poses differ in
-/// size, times are not finite and strictly increasing, a pose is not finite, or more than 1e8
-/// samples would result.
+/// within dt before, t.back()) with the monotone piecewise-cubic Hermite interpolation of
+/// Fritsch and Carlson ("PCHIP") per coordinate: C1, and never beyond the samples (a hold stays
+/// flat, a move does not overshoot its end), so waypoint files are safe. Lines are reproduced
+/// exactly; the acceleration jumps at the samples, so sparse files show up in the servo's
+/// acceleration feed-forward (give samples at the control rate for the smoothest run). A grid
+/// time within 1e-9 dt of an input time gives that input pose exactly. Angles are interpolated as
+/// given (no wrapping at ±pi). Throws hexatwist::Error if dt <= 0 or non-finite, fewer than 2
+/// samples, t and poses differ in size, times are not finite and strictly increasing, a pose is
+/// not finite, or more than 1e8 samples would result.
 Trajectory resample(const TimedPoses& samples, double dt);
 
 }  // namespace hexatwist
