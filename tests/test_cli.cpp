@@ -280,6 +280,18 @@ TEST(Cli, ConfigJsonListsSixLegs) {
     EXPECT_NEAR(j["legs"][i]["length_home"].as<double>(), 1.910247, 5e-7);
     EXPECT_EQ(j["legs"][i]["base"].size(), 3u);
   }
+  // The servo numbers study/simulate use: gains from the 10 Hz poles, kp = 3 J w^2.
+  const YAML::Node sv = j["servo"];
+  ASSERT_TRUE(sv.IsMap());
+  const double J = sv["nominal_inertia"][0].as<double>(), w = 2 * kPi * 10.0;
+  EXPECT_NEAR(sv["kp"][0].as<double>(), 3 * J * w * w, 1e-9 * sv["kp"][0].as<double>());
+  EXPECT_NEAR(sv["holding_torque_home"][0].as<double>(), 4.92, 0.01);
+  // A plain Stewart platform (lead 0) has no servo to simulate, and says why.
+  const std::string plain = write_file("plain.yaml", replace_line(kSymmetric, 9, "  lead: 0"));
+  const Outcome p = run({"config", "--config", plain});
+  ASSERT_EQ(p.code, 0) << p.err;
+  EXPECT_NE(p.out.find("servo (study, simulate): not usable:"), std::string::npos) << p.out;
+  EXPECT_NE(p.out.find("needs a lead screw"), std::string::npos) << p.out;
 }
 
 TEST(Cli, ConfigFileInLegsFormGivesTheDefaultIk) {

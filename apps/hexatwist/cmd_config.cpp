@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "cli_common.hpp"
 #include "json.hpp"
@@ -18,6 +19,30 @@ struct ConfigOptions {
 
 std::string v3(const Vector3d& v) {
   return fmt::format("[{:.6f}, {:.6f}, {:.6f}]", tidy(v.x()), tidy(v.y()), tidy(v.z()));
+}
+
+// The servo numbers derived from the config (study, simulate), or why there are none.
+struct ServoView {
+  std::optional<Config> config;
+  std::string why_not;
+  Vector6d holding = Vector6d::Zero();  // torque holding the load at home [N m]
+};
+
+ServoView servo_view(const ModelOptions& opts) {
+  ServoView v;
+  try {
+    v.config.emplace(load_config_from(opts));
+  } catch (const ExitError& e) {
+    v.why_not = e.what();
+    return v;
+  }
+  const Rig& rig = v.config->rig;
+  LegState home;
+  LegDynamics dyn;
+  if (inverse_kinematics(rig.model(), Placement{}, home) == Status::Ok &&
+      leg_dynamics(rig.model(), rig.load(), home, LengthKind::Motor, dyn) == Status::Ok)
+    v.holding = -rig.motor_gain().cwiseProduct(dyn.gravity);
+  return v;
 }
 
 int run_config(const ConfigOptions& o) {
@@ -57,7 +82,25 @@ int run_config(const ConfigOptions& o) {
       axes ? j.value(l.theta_home) : j.null();
       j.end_object();
     }
-    j.end_array().end_object();
+    j.end_array();
+    const ServoView sv = servo_view(o.model);
+    j.key("servo");
+    if (sv.config) {
+      const Rig& rig = sv.config->rig;
+      j.begin_object();
+      j.key("motor_gain").vector(rig.motor_gain());
+      j.field("drive_inertia", rig.drive_inertia());
+      j.key("nominal_inertia").vector(rig.nominal_inertia());
+      j.key("kp").vector(rig.kp());
+      j.key("ki").vector(rig.ki());
+      j.key("kd").vector(rig.kd());
+      j.key("holding_torque_home").vector(sv.holding);
+      j.field("torque_limit", rig.servo().torque_limit).field("control_period", rig.control_period());
+      j.field("plant_step", rig.plant_step()).end_object();
+    } else {
+      j.null();
+    }
+    j.end_object();
     std::fputs(j.str().c_str(), stdout);
     return kExitOk;
   }
@@ -79,6 +122,26 @@ int run_config(const ConfigOptions& o) {
     out += fmt::format("  home length {:.6f} m, direction {} [B]", l.length_home, v3(l.s_home_B));
     if (!std::isnan(l.theta_home)) out += fmt::format(", absolute twist at home {:.4f} deg", rad2deg(l.theta_home));
     out += "\n";
+  }
+  const ServoView sv = servo_view(o.model);
+  if (sv.config) {
+    const Rig& rig = sv.config->rig;
+    const ServoSpec& ss = rig.servo();
+    out += fmt::format(
+        "servo (study, simulate), leg 1: {:.5g} mm of leg per motor rad, {:.3g} nm per encoder count; inertia "
+        "{:.3g} kg m^2 (drive) + load = {:.3g} kg m^2\n",
+        1e3 * rig.motor_gain()[0], 1e9 * rig.motor_gain()[0] * rig.encoder_step(), rig.drive_inertia(),
+        rig.nominal_inertia()[0]);
+    out += fmt::format(
+        "  PID kp {:.4g} N m/rad, ki {:.4g} N m/(rad s), kd {:.4g} N m s/rad{}; torque limit {:g} N m, "
+        "holding the load at home {:.3g} N m\n",
+        rig.kp()[0], rig.ki()[0], rig.kd()[0],
+        ss.kp == 0.0 ? fmt::format(" (poles at {:g} Hz)", ss.pole_frequency) : std::string(), ss.torque_limit,
+        sv.holding[0]);
+    out += fmt::format("  load {:g} kg; control {:g} Hz, plant step {:g} ms\n", rig.load().mass,
+                       rig.simulation().control_rate, 1e3 * rig.plant_step());
+  } else {
+    out += fmt::format("servo (study, simulate): not usable: {}\n", sv.why_not);
   }
   std::fputs(out.c_str(), stdout);
   return kExitOk;
