@@ -25,6 +25,17 @@ Frame frame_for(const Model& model, const LoadSpec& load, const Vector6d& m, Len
   return {pivot + fk.placement.R_BP * (load.center_of_mass_P - model.spec().pivot_P), fk.placement.R_BP};
 }
 
+// The leg lengths of `kind` at the state `legs`: geometric, or motor-side (twist subtracted).
+Vector6d lengths_of(const Model& model, const LegState& legs, LengthKind kind) {
+  Vector6d m = legs.length;
+  if (kind == LengthKind::Motor) {
+    Vector6d dtheta;
+    EXPECT_EQ(twist(model, legs, dtheta), Status::Ok);
+    m -= model.geometry().twist_gain.cwiseProduct(dtheta);
+  }
+  return m;
+}
+
 class DynamicsTest : public ::testing::TestWithParam<LengthKind> {};
 
 // Gravity: the force along each leg is minus the derivative of the potential energy m g z_com
@@ -42,12 +53,7 @@ TEST_P(DynamicsTest, GravityIsMinusTheGradientOfThePotential) {
     ASSERT_EQ(inverse_kinematics(model, x, legs), Status::Ok);
     LegDynamics dyn;
     ASSERT_EQ(leg_dynamics(model, load, legs, kind, dyn), Status::Ok);
-    Vector6d m = legs.length;
-    if (kind == LengthKind::Motor) {
-      Vector6d dtheta;
-      ASSERT_EQ(twist(model, legs, dtheta), Status::Ok);
-      m -= model.geometry().twist_gain.cwiseProduct(dtheta);
-    }
+    const Vector6d m = lengths_of(model, legs, kind);
     const double h = 1e-6;
     for (int i = 0; i < kLegs; ++i) {
       Vector6d mp = m, mm = m;
@@ -80,12 +86,7 @@ TEST_P(DynamicsTest, MassMatrixGivesTheKineticEnergy) {
     ASSERT_EQ(inverse_kinematics(model, x, legs), Status::Ok);
     LegDynamics dyn;
     ASSERT_EQ(leg_dynamics(model, load, legs, kind, dyn), Status::Ok);
-    Vector6d m = legs.length;
-    if (kind == LengthKind::Motor) {
-      Vector6d dtheta;
-      ASSERT_EQ(twist(model, legs, dtheta), Status::Ok);
-      m -= model.geometry().twist_gain.cwiseProduct(dtheta);
-    }
+    const Vector6d m = lengths_of(model, legs, kind);
     Vector6d mdot;
     for (int i = 0; i < kLegs; ++i) mdot[i] = uniform(rng, -0.2, 0.2);
     const double h = 1e-6;

@@ -150,6 +150,24 @@ std::string summary_json(const Rig& rig, const ReportOptions& o, const std::vect
   return j.str();
 }
 
+// The rows of the error tables: strategy and which of the three errors.
+struct ErrorRow {
+  bool compensated;
+  const char* name;
+  ErrorStats StrategyRun::*member;
+  const ErrorStats& stats(const ReportedTest& t) const {
+    return (compensated ? t.run.compensated : t.run.conventional).*member;
+  }
+};
+constexpr ErrorRow kErrorRows[] = {
+    {false, "total", &StrategyRun::total},
+    {false, "twist only", &StrategyRun::twist_only},
+    {false, "tracking only", &StrategyRun::tracking_only},
+    {true, "total", &StrategyRun::total},
+    {true, "twist only", &StrategyRun::twist_only},
+    {true, "tracking only", &StrategyRun::tracking_only},
+};
+
 // Millimetres with four decimals; values too small for that (the exact compensation) keep two
 // significant digits, so that 1e-9 mm does not read as 0.
 std::string mm(double m) {
@@ -172,19 +190,14 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
   s += "\n|---|---|";
   for (std::size_t i = 0; i < tests.size(); ++i) s += "---:|---:|";
   s += "\n";
-  for (const bool comp : {false, true})
-    for (int e = 0; e < 3; ++e) {
-      s += fmt::format("| {} | {} |", comp ? "compensated" : "conventional",
-                       e == 0   ? "total"
-                       : e == 1 ? "twist only"
-                                : "tracking only");
-      for (const ReportedTest& t : tests) {
-        const StrategyRun& r = comp ? t.run.compensated : t.run.conventional;
-        const ErrorStats& st = e == 0 ? r.total : e == 1 ? r.twist_only : r.tracking_only;
-        s += fmt::format(" {} | {} |", mm(st.max), mm(st.rms));
-      }
-      s += "\n";
+  for (const ErrorRow& row : kErrorRows) {
+    s += fmt::format("| {} | {} |", row.compensated ? "compensated" : "conventional", row.name);
+    for (const ReportedTest& t : tests) {
+      const ErrorStats& st = row.stats(t);
+      s += fmt::format(" {} | {} |", mm(st.max), mm(st.rms));
     }
+    s += "\n";
+  }
   if (const std::string notes = report_notes(rig, tests); !notes.empty()) s += "\n" + notes;
   s += "\nTests:\n\n";
   for (const ReportedTest& t : tests)
@@ -288,19 +301,12 @@ std::string summary_table(const std::vector<ReportedTest>& tests) {
   std::string s = fmt::format("{:<28}", "max. error of point A [mm]");
   for (const ReportedTest& t : tests) s += fmt::format(" {:>10}", t.name.substr(0, 10));
   s += "\n";
-  for (const bool comp : {false, true})
-    for (int e = 0; e < 3; ++e) {
-      s += fmt::format("{:<13} {:<14}", e == 0 ? (comp ? "compensated" : "conventional") : "",
-                       e == 0   ? "total"
-                       : e == 1 ? "twist only"
-                                : "tracking only");
-      for (const ReportedTest& t : tests) {
-        const StrategyRun& r = comp ? t.run.compensated : t.run.conventional;
-        const ErrorStats& st = e == 0 ? r.total : e == 1 ? r.twist_only : r.tracking_only;
-        s += fmt::format(" {:>10}", mm(st.max));
-      }
-      s += "\n";
-    }
+  for (const ErrorRow& row : kErrorRows) {
+    const bool first = row.member == &StrategyRun::total;
+    s += fmt::format("{:<13} {:<14}", first ? (row.compensated ? "compensated" : "conventional") : "", row.name);
+    for (const ReportedTest& t : tests) s += fmt::format(" {:>10}", mm(row.stats(t).max));
+    s += "\n";
+  }
   return s;
 }
 
