@@ -124,7 +124,8 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
   if (n == 0) return Status::Ok;
   if (std::abs(trajectory.dt - rig.control_period()) > 1e-9 * rig.control_period() && n > 1)
     return fail(issue, Status::NonFiniteInput, 0, trajectory);
-  if (const Status s = check_trajectory(rig, trajectory, issue); s != Status::Ok) return s;
+  // make_plan checks every sample of the commands this run sends (limits, stroke, motor speed,
+  // holding torque) before the loop starts; check_trajectory adds the other strategy's commands.
   Plan plan;
   if (const Status s = make_plan(rig, trajectory, options.strategy, options.twist_in_plant, &plan, issue);
       s != Status::Ok)

@@ -53,9 +53,10 @@ struct SimulationIssue {
 [[nodiscard]] Status check_trajectory(const Rig& rig, const Trajectory& trajectory, SimulationIssue& issue);
 
 /// Simulates the trajectory at the rig's control rate (one sample per trajectory sample; the
-/// trajectory's period must equal the control period). Starts settled at the first pose. The
-/// trajectory is checked first (check_trajectory); on any failure `issue` says where, `samples`
-/// holds the ticks done so far, and the status is returned.
+/// trajectory's period must equal the control period). Starts settled at the first pose. Before
+/// the first tick, the commands this run will send are checked at every sample as check_trajectory
+/// does (pose limits, stroke, motor speed, holding torque), so nothing runs past a limit; on any
+/// failure `issue` says where, `samples` holds the ticks done so far, and the status is returned.
 [[nodiscard]] Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOptions& options,
                               std::vector<SimulationSample>& samples, SimulationIssue& issue);
 
