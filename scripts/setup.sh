@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libcli11-dev libfmt-dev   # library and CLI
   libgtest-dev libgmock-dev libbenchmark-dev        # tests and benchmarks
   gnuplot-nox                                       # figures
+  clang libclang-rt-dev                             # fuzzing and sanitizer builds (libFuzzer, ASan, UBSan)
 )
 
 missing=()

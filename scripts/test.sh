@@ -1,7 +1,34 @@
 #!/usr/bin/env bash
-# Set up, build, and run every test through ctest (unit, property, CLI, install, examples,
-# benchmark smoke run).
+# Set up, build, and run every test: the Release suite through ctest (unit, property, CLI, install,
+# examples, fuzz-input replays, stream stress test, benchmark smoke run); the same suite built with
+# AddressSanitizer + UndefinedBehaviorSanitizer in build-asan/; a bounded run of each libFuzzer
+# target (scripts/fuzz.sh, HEXATWIST_FUZZ_SECONDS per target, default 60).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+start=$SECONDS
+stage_start=$SECONDS
+stage_done() {
+  echo "hexatwist test: $1 passed in $((SECONDS - stage_start)) s" >&2
+  stage_start=$SECONDS
+}
+
 bash scripts/build.sh
 ctest --test-dir build --output-on-failure -j2
+stage_done "Release build and tests"
+
+# Any finding stops the program (-fno-sanitize-recover=all; ASan halts by itself) with an abort,
+# so that no test can take it for an ordinary exit code.
+sanitizer_env=(ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:check_initialization_order=1:detect_stack_use_after_return=1
+               UBSAN_OPTIONS=print_stacktrace=1:abort_on_error=1)
+if [ ! -f build-asan/build.ninja ]; then
+  echo "hexatwist: building with the sanitizers in build-asan/ (the first build takes several minutes)" >&2
+fi
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang++ -DHEXATWIST_SANITIZE=ON \
+  -DHEXATWIST_BUILD_BENCHMARKS=OFF >/dev/null
+env "${sanitizer_env[@]}" cmake --build build-asan -- -j2
+env "${sanitizer_env[@]}" ctest --test-dir build-asan --output-on-failure -j2
+stage_done "ASan + UBSan build and tests"
+
+bash scripts/fuzz.sh "${HEXATWIST_FUZZ_SECONDS:-60}"
+stage_done "fuzzing"
+echo "hexatwist test: all passed in $((SECONDS - start)) s" >&2
