@@ -16,6 +16,7 @@ std::string_view to_string(Status s) noexcept {
     case Status::SingularJacobian: return "singular_jacobian";
     case Status::MotorSpeedAboveMax: return "motor_speed_above_max";
     case Status::TorqueAboveMax: return "torque_above_max";
+    case Status::MalformedInput: return "malformed_input";
   }
   return "unknown";
 }
@@ -34,6 +35,7 @@ std::string_view describe(Status s) noexcept {
     case Status::SingularJacobian: return "forward kinematics met a singular platform Jacobian";
     case Status::MotorSpeedAboveMax: return "a motor would have to turn faster than its speed limit";
     case Status::TorqueAboveMax: return "holding the load would take more torque than a motor's limit";
+    case Status::MalformedInput: return "the input is not six comma-separated numbers";
   }
   return "unknown status";
 }

@@ -14,6 +14,7 @@
 #include "hexatwist/servo.hpp"
 #include "hexatwist/simulation.hpp"
 #include "hexatwist/status.hpp"
+#include "hexatwist/stream.hpp"
 #include "hexatwist/study.hpp"
 #include "hexatwist/trajectory.hpp"
 #include "hexatwist/twist.hpp"
