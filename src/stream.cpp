@@ -272,7 +272,7 @@ std::string_view line_error_words(LineError e) noexcept {
     case LineError::None: return "";
     case LineError::Empty: return "empty line";
     case LineError::TooLong: return "line longer than 1024 characters";
-    case LineError::MissingFields: return "missing (fewer than six fields x,y,z,roll,pitch,yaw)";
+    case LineError::MissingFields: return "missing (a pose has six fields: x y z roll pitch yaw)";
     case LineError::ExtraFields: return "extra field (more than six)";
     case LineError::EmptyField: return "empty field";
     case LineError::NotANumber: return "not a number";

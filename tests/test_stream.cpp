@@ -348,6 +348,26 @@ TEST(StreamOutputLine, JsonIsOneValidObjectWithTheSameFields) {
   }
 }
 
+TEST(StreamOutputLine, EveryDetailIsFreeOfCommasAndQuotes) {
+  std::array<char, kMaxOutputLength> buf{};
+  const std::size_t columns = std::count(kStreamCsvHeader.begin(), kStreamCsvHeader.end(), ',');
+  for (int st = 0; st <= static_cast<int>(Status::MalformedInput); ++st) {
+    for (int e = 0; e <= static_cast<int>(LineError::OutOfRange); ++e) {
+      for (const bool limited : {false, true}) {
+        StreamOutput out;
+        out.status = static_cast<Status>(st);
+        out.parse = {static_cast<LineError>(e), e - 2, e};
+        out.rate_limited = limited;
+        const std::string line(buf.data(), format_stream_output(out, StreamFormat::Csv, buf));
+        SCOPED_TRACE(line);
+        EXPECT_EQ(static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')), columns);
+        EXPECT_EQ(line.find('"'), std::string::npos);
+        EXPECT_EQ(line.find("unknown"), std::string::npos);
+      }
+    }
+  }
+}
+
 TEST(StreamOutputLine, LongestAnswerFitsAndShortBuffersAreRefused) {
   StreamOutput out;
   out.input = std::numeric_limits<std::uint64_t>::max();
