@@ -219,7 +219,8 @@ int run_stream(const StreamOptions& o) {
   std::array<std::uint64_t, 3> by_action{};
   StreamOutput out;
   LineReader reader(STDIN_FILENO);
-  const int timeout_ms = o.idle_timeout > 0 ? static_cast<int>(o.idle_timeout * 1000.0) : -1;
+  if (in_udp && o.idle_timeout > 0)  // at most about 23 days, the range of the timeout in ms
+    in_udp->set_receive_timeout(std::max(1, static_cast<int>(std::min(o.idle_timeout, 2e6) * 1000.0)));
   std::string stop_reason = "end of input";
 
   while (!g_stop && (o.count == 0 || state->inputs < o.count)) {
@@ -227,7 +228,7 @@ int run_stream(const StreamOptions& o) {
     if (in_udp) {
       std::size_t size = 0;
       bool truncated = false;
-      const auto r = in_udp->receive(datagram, timeout_ms, size, truncated);
+      const auto r = in_udp->receive(datagram, size, truncated);
       if (r == UdpSocket::Received::Timeout) {
         stop_reason = fmt::format("no datagram for {} s (--idle-timeout)", o.idle_timeout);
         break;

@@ -3,7 +3,7 @@
 #include <fmt/format.h>
 #include <netdb.h>
 #include <netinet/in.h>
-#include <poll.h>
+#include <sys/time.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -104,18 +104,20 @@ UdpSocket::~UdpSocket() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-UdpSocket::Received UdpSocket::receive(std::span<char> buffer, int timeout_ms, std::size_t& size, bool& truncated) {
-  pollfd p{fd_, POLLIN, 0};
-  const int ready = ::poll(&p, 1, timeout_ms);
-  if (ready < 0) {
-    if (errno == EINTR) return Received::Interrupted;
-    throw ExitError(kExitOutputFailed, fmt::format("receiving a pose: {}", std::strerror(errno)));
-  }
-  if (ready == 0) return Received::Timeout;
+void UdpSocket::set_receive_timeout(int timeout_ms) {
+  timeval tv{};
+  tv.tv_sec = timeout_ms / 1000;
+  tv.tv_usec = (timeout_ms % 1000) * 1000;
+  if (::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv) != 0)
+    throw ExitError(kExitBadInput, fmt::format("--idle-timeout: {}", std::strerror(errno)));
+}
+
+UdpSocket::Received UdpSocket::receive(std::span<char> buffer, std::size_t& size, bool& truncated) {
   // MSG_TRUNC: the return value is the datagram's real length, also when it did not fit.
   const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_TRUNC);
   if (n < 0) {
     if (errno == EINTR) return Received::Interrupted;
+    if (errno == EAGAIN || errno == EWOULDBLOCK) return Received::Timeout;
     throw ExitError(kExitOutputFailed, fmt::format("receiving a pose: {}", std::strerror(errno)));
   }
   truncated = static_cast<std::size_t>(n) > buffer.size();

@@ -43,12 +43,15 @@ class UdpSocket {
   UdpSocket& operator=(const UdpSocket&) = delete;
   ~UdpSocket();
 
+  /// How long `receive` waits for a datagram [ms]; 0 (the default) waits forever.
+  void set_receive_timeout(int timeout_ms);
+
   /// Result of a receive.
   enum class Received { Datagram, Timeout, Interrupted };
-  /// Waits up to `timeout_ms` (negative: forever) for one datagram into `buffer`; `size` is its
-  /// length and `truncated` says it was longer than the buffer. A signal ends the wait
+  /// Waits (up to the receive timeout) for one datagram into `buffer`, in one system call; `size`
+  /// is its length and `truncated` says it was longer than the buffer. A signal ends the wait
   /// (Interrupted). Other failures throw ExitError.
-  Received receive(std::span<char> buffer, int timeout_ms, std::size_t& size, bool& truncated);
+  Received receive(std::span<char> buffer, std::size_t& size, bool& truncated);
 
   /// Sends one datagram. Returns false if the peer refused it (nobody listening on loopback);
   /// other failures throw ExitError.
