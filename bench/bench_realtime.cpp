@@ -6,6 +6,8 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <pthread.h>
+#include <sched.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/prctl.h>
@@ -145,7 +147,7 @@ struct StreamProcess {
   int port = -1;
   std::string error;
 
-  explicit StreamProcess(int answer_port) {
+  StreamProcess(int answer_port, bool realtime) {
     int err[2];
     if (::pipe(err) != 0) {
       error = "pipe";
@@ -156,7 +158,8 @@ struct StreamProcess {
     posix_spawn_file_actions_adddup2(&fa, err[1], 2);
     posix_spawn_file_actions_addclose(&fa, err[0]);
     const std::string out = "--output=udp://127.0.0.1:" + std::to_string(answer_port);
-    const char* argv[] = {HEXATWIST_CLI, "stream", "--input=udp://127.0.0.1:0", out.c_str(), nullptr};
+    const char* argv[] = {HEXATWIST_CLI, "stream", "--input=udp://127.0.0.1:0", out.c_str(),
+                          realtime ? "--rt-priority=50" : nullptr, nullptr};
     if (posix_spawn(&pid, HEXATWIST_CLI, &fa, nullptr, const_cast<char**>(argv), environ) != 0) pid = -1;
     posix_spawn_file_actions_destroy(&fa);
     ::close(err[1]);
@@ -185,17 +188,30 @@ struct StreamProcess {
   }
 };
 
+// SCHED_FIFO for the calling thread (root or CAP_SYS_NICE); false if refused.
+bool fifo(int priority) {
+  sched_param p{};
+  p.sched_priority = priority;
+  return pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
+}
+
 // Sends `count` poses at `rate` per second (paced by absolute sleeps) and receives the answers on
 // another thread; latency = receive time - send time of the same input number. Bounded: at most
-// 30 s of waiting for answers.
+// 30 s of waiting for answers. Third argument 1: the stream runs with --rt-priority and the
+// sender and receiver under SCHED_FIFO too, as a deployment would (skipped without root).
 void BM_StreamUdpRoundTrip(benchmark::State& state) {
   const double rate = static_cast<double>(state.range(0));
   const std::size_t count = static_cast<std::size_t>(state.range(1));
+  const bool realtime = state.range(2) == 1;
   ::prctl(PR_SET_TIMERSLACK, 1UL);  // wake on time, not up to 50 us late
   const auto& lines = motion_lines();
+  if (realtime && !fifo(40)) {
+    state.SkipWithError("SCHED_FIFO refused (needs root or CAP_SYS_NICE)");
+    return;
+  }
   for (auto _ : state) {
     const int rx = udp_socket(0), tx = udp_socket(0);
-    StreamProcess proc(local_port(rx));
+    StreamProcess proc(local_port(rx), realtime);
     if (!proc.error.empty() || rx < 0 || tx < 0) {
       state.SkipWithError(proc.error.empty() ? "socket" : proc.error.c_str());
       return;
@@ -209,6 +225,7 @@ void BM_StreamUdpRoundTrip(benchmark::State& state) {
     std::atomic<bool> done{false};
     std::size_t got = 0, bad = 0;
     std::thread receiver([&] {
+      if (realtime) fifo(40);
       std::array<char, 2048> buf{};
       pollfd p{rx, POLLIN, 0};
       const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
@@ -260,10 +277,17 @@ void BM_StreamUdpRoundTrip(benchmark::State& state) {
     state.counters["bad_answers"] = static_cast<double>(bad);
     if (got < count) state.SkipWithError("some poses were not answered");
   }
+  if (realtime) {
+    sched_param p{};
+    pthread_setschedparam(pthread_self(), SCHED_OTHER, &p);
+  }
+  state.SetLabel(realtime ? "SCHED_FIFO" : "normal scheduling");
 }
 BENCHMARK(BM_StreamUdpRoundTrip)
-    ->Args({10000, 30000})
-    ->Args({20000, 40000})
+    ->Args({10000, 30000, 0})
+    ->Args({20000, 40000, 0})
+    ->Args({10000, 30000, 1})
+    ->Args({20000, 40000, 1})
     ->Iterations(1)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
