@@ -172,7 +172,13 @@ void enter_realtime(int priority) {
     throw ExitError(kExitBadInput, fmt::format("--rt-priority {}: cannot lock memory: {}", priority, std::strerror(errno)));
 }
 
-int run_stream(const StreamOptions& o) {
+// Default UDP endpoints: loopback, poses to port 9000, answers to port 9001.
+constexpr const char* kDefaultUdpInput = "udp://127.0.0.1:9000";
+constexpr const char* kDefaultUdpOutput = "udp://127.0.0.1:9001";
+
+int run_stream(StreamOptions o) {
+  if (o.input == "udp") o.input = kDefaultUdpInput;
+  if (o.output == "udp") o.output = kDefaultUdpOutput;
   const Model model = load_model_from(o.model);
   const StreamSettings settings = settings_from(o);
   const StreamFormat format =
@@ -283,9 +289,9 @@ Command make_stream_command(CLI::App& root) {
       "input, --count, --idle-timeout or SIGINT/SIGTERM, with a summary on stderr; exit 0 if every input was "
       "accepted, 3 if any was rejected.");
   add_model_options(*app, o->model);
-  app->add_option("--input", o->input, "stdin, or udp://HOST:PORT to listen on (HOST defaults to 127.0.0.1; port 0 picks one)")
+  app->add_option("--input", o->input, "stdin, or udp://HOST:PORT to listen on (HOST defaults to 127.0.0.1; port 0 picks one; udp alone: udp://127.0.0.1:9000)")
       ->capture_default_str();
-  app->add_option("--output", o->output, "stdout, or udp://HOST:PORT to send each answer to (HOST defaults to 127.0.0.1)")
+  app->add_option("--output", o->output, "stdout, or udp://HOST:PORT to send each answer to (HOST defaults to 127.0.0.1; udp alone: udp://127.0.0.1:9001)")
       ->capture_default_str();
   app->add_option("--strategy", o->strategy, "compensated (Eq. 12, twist included) or conventional (twist ignored)")
       ->capture_default_str();
