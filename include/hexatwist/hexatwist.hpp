@@ -10,6 +10,7 @@
 #include "hexatwist/limits.hpp"
 #include "hexatwist/model.hpp"
 #include "hexatwist/pose.hpp"
+#include "hexatwist/registration.hpp"
 #include "hexatwist/rig.hpp"
 #include "hexatwist/servo.hpp"
 #include "hexatwist/simulation.hpp"
