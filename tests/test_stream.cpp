@@ -351,7 +351,7 @@ TEST(StreamOutputLine, JsonIsOneValidObjectWithTheSameFields) {
 TEST(StreamOutputLine, EveryDetailIsFreeOfCommasAndQuotes) {
   std::array<char, kMaxOutputLength> buf{};
   const std::size_t columns = std::count(kStreamCsvHeader.begin(), kStreamCsvHeader.end(), ',');
-  for (int st = 0; st <= static_cast<int>(Status::MalformedInput); ++st) {
+  for (int st = 0; to_string(static_cast<Status>(st)) != "unknown"; ++st) {  // every status
     for (int e = 0; e <= static_cast<int>(LineError::OutOfRange); ++e) {
       for (const bool limited : {false, true}) {
         StreamOutput out;
