@@ -16,6 +16,9 @@ std::string_view to_string(Status s) noexcept {
     case Status::SingularJacobian: return "singular_jacobian";
     case Status::MotorSpeedAboveMax: return "motor_speed_above_max";
     case Status::TorqueAboveMax: return "torque_above_max";
+    case Status::MalformedInput: return "malformed_input";
+    case Status::TooFewPoints: return "too_few_points";
+    case Status::DegenerateRegistration: return "degenerate_registration";
   }
   return "unknown";
 }
@@ -34,6 +37,10 @@ std::string_view describe(Status s) noexcept {
     case Status::SingularJacobian: return "forward kinematics met a singular platform Jacobian";
     case Status::MotorSpeedAboveMax: return "a motor would have to turn faster than its speed limit";
     case Status::TorqueAboveMax: return "holding the load would take more torque than a motor's limit";
+    case Status::MalformedInput: return "the input is not six comma-separated numbers";
+    case Status::TooFewPoints: return "a registration needs at least three point pairs";
+    case Status::DegenerateRegistration:
+      return "the registration points are coincident or (nearly) collinear and do not fix the rotation";
   }
   return "unknown status";
 }

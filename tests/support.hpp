@@ -1,10 +1,14 @@
-// Test support: seeded random platforms and poses, an independent joint-chain twist, pose errors.
+// Test support: seeded random platforms and poses, an independent joint-chain twist, pose errors,
+// stress counts and measured-residual reports.
 #pragma once
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <random>
 
@@ -14,6 +18,17 @@ namespace hexatwist::test {
 
 /// Seed of every random generator in the suite (printed by failing tests through SCOPED_TRACE).
 inline constexpr std::uint32_t kSeed = 20211124u;
+
+/// `count` times the environment variable HEXATWIST_STRESS (an integer, default 1), for the
+/// seeded random stress tests: `HEXATWIST_STRESS=1000 ctest -R Trajectory` for a long run.
+inline int stress(int count) {
+  const char* s = std::getenv("HEXATWIST_STRESS");
+  const int factor = s != nullptr ? std::atoi(s) : 1;
+  return count * std::max(factor, 1);
+}
+
+/// Prints a measured residual (the tolerances are set about 10x these).
+inline void report(const char* what, double value) { std::printf("  measured %s: %.3g\n", what, value); }
 
 /// The embedded seed platform (configs/seed.yaml).
 inline const Model& seed_model() {

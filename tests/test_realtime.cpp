@@ -31,6 +31,10 @@ static_assert(noexcept(forward_kinematics(std::declval<const Model&>(), std::dec
                                           std::declval<const Placement&>(), std::declval<FkResult&>())));
 static_assert(noexcept(check_limits(std::declval<const Model&>(), std::declval<const LegState&>(), std::declval<LimitReport&>())));
 
+static_assert(noexcept(stream_line(std::declval<const Model&>(), std::declval<const StreamSettings&>(), std::string_view(),
+                                   AngleUnit::Degrees, std::declval<StreamState&>(), std::declval<StreamOutput&>())));
+static_assert(noexcept(format_stream_output(std::declval<const StreamOutput&>(), StreamFormat::Json, std::span<char>())));
+
 TEST(RealTime, CountingAllocatorSeesAllocations) {
   // The probe works: a heap allocation is counted (so the zero counts below mean something).
   const long before = g_allocations.load();
@@ -74,6 +78,48 @@ TEST(RealTime, CommandsTwistLimitsAndWarmFkDoNotAllocate) {
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_GE(ok, 100);  // the loop exercised the success path too
+}
+
+}  // namespace
+}  // namespace hexatwist::test
+
+namespace hexatwist::test {
+namespace {
+
+// The whole per-line path of `hexatwist stream`: parse, check, rate-limit (with its forward
+// kinematics), hold or skip, format.
+TEST(RealTime, StreamLinesDoNotAllocate) {
+  const Model& model = seed_model();
+  std::mt19937_64 rng(kSeed + 61);
+  std::vector<std::string> lines = {"garbage", "", "1,2,3", "nan,0,0,0,0,0", "0,0,0,0,0,0,0"};
+  for (int n = 0; n < 200; ++n) {
+    const Pose p = random_pose(rng, n % 2 ? 0.3 : 0.8, deg2rad(n % 2 ? 20 : 40));
+    lines.push_back(std::to_string(p.position.x()) + "," + std::to_string(p.position.y()) + "," +
+                    std::to_string(p.position.z()) + "," + std::to_string(rad2deg(p.rpy.x())) + "," +
+                    std::to_string(rad2deg(p.rpy.y())) + "," + std::to_string(rad2deg(p.rpy.z())));
+  }
+  StreamSettings hold_limited;
+  hold_limited.max_velocity = 0.2;
+  hold_limited.max_acceleration = 2.0;
+  StreamSettings skip;
+  skip.on_reject = RejectPolicy::Skip;
+  skip.strategy = Strategy::Conventional;
+  StreamState a, b;
+  StreamOutput out;
+  std::array<char, kMaxOutputLength> buf{};
+  std::size_t written = 0;
+  int limited = 0;
+  const long before = g_allocations.load();
+  for (const std::string& line : lines) {
+    (void)stream_line(model, hold_limited, line, AngleUnit::Degrees, a, out);
+    limited += out.rate_limited;
+    written += format_stream_output(out, StreamFormat::Json, buf);
+    (void)stream_line(model, skip, line, AngleUnit::Degrees, b, out);
+    written += format_stream_output(out, StreamFormat::Csv, buf);
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_GT(written, lines.size() * 2 * 40);
+  EXPECT_GT(limited, 50);  // the rate-limited steps (with forward kinematics) were exercised
 }
 
 }  // namespace

@@ -15,17 +15,6 @@ namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
-// Default case counts are multiplied by the environment variable HEXATWIST_STRESS (an integer,
-// default 1): `HEXATWIST_STRESS=1000 ctest -R Trajectory` for a long run.
-int stress(int count) {
-  const char* s = std::getenv("HEXATWIST_STRESS");
-  const int factor = s != nullptr ? std::atoi(s) : 1;
-  return count * std::max(factor, 1);
-}
-
-// Prints a measured residual (the tolerances below are about 10x these).
-void report(const char* what, double value) { std::printf("  measured %s: %.3g\n", what, value); }
-
 double log_uniform(std::mt19937_64& rng, double lo, double hi) {
   return std::exp(uniform(rng, std::log(lo), std::log(hi)));
 }

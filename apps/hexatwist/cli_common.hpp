@@ -83,5 +83,6 @@ Command make_fk_command(CLI::App& root);
 Command make_config_command(CLI::App& root);
 Command make_study_command(CLI::App& root);
 Command make_simulate_command(CLI::App& root);
+Command make_stream_command(CLI::App& root);
 
 }  // namespace hexatwist::cli

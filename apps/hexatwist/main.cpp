@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
       "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit or numerical failure, 4 output not written."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
-  const std::vector<Command> commands{make_study_command(app), make_simulate_command(app), make_ik_command(app),
+  const std::vector<Command> commands{make_study_command(app), make_simulate_command(app), make_stream_command(app), make_ik_command(app),
                                       make_fk_command(app), make_config_command(app)};
   try {
     app.parse(argc, argv);
@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
       if (chosen) break;
       print_error(
           "hexatwist: error: ",
-          fmt::format("unknown subcommand '{}'; expected study, simulate, ik, fk or config (see --help)", word));
+          fmt::format("unknown subcommand '{}'; expected study, simulate, stream, ik, fk or config (see --help)", word));
       return kExitBadInput;
     }
     print_error("hexatwist: error: ", fmt::format("{} (see --help)", e.what()));

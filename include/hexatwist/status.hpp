@@ -19,6 +19,9 @@ enum class Status : int {
   SingularJacobian,  ///< forward kinematics met a singular platform Jacobian
   MotorSpeedAboveMax,  ///< a trajectory needs a motor faster than its speed limit
   TorqueAboveMax,      ///< holding the load at a pose needs more torque than a motor's limit
+  MalformedInput,      ///< an input line is not six numbers (see LineParse)
+  TooFewPoints,        ///< a point registration got fewer than three point pairs
+  DegenerateRegistration,  ///< registration points are coincident or (nearly) collinear: the rotation is not determined
 };
 
 /// True for the statuses that mean "this pose is outside a limit".

@@ -1,0 +1,326 @@
+// hexatwist stream: one pose per line (stdin) or datagram (UDP) in, one answer per input out,
+// in order: six checked motor commands and a status (include/hexatwist/stream.hpp does the work;
+// this file only moves bytes).
+#include <fmt/format.h>
+#include <sched.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <optional>
+
+#include "cli_common.hpp"
+#include "udp.hpp"
+
+namespace hexatwist::cli {
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_stop_signal(int) { g_stop = 1; }
+
+// SIGINT and SIGTERM end the stream cleanly (the summary is printed); a blocking read returns.
+void install_stop_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;  // no SA_RESTART: read() and poll() return EINTR
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+struct StreamOptions {
+  ModelOptions model;
+  std::string input = "stdin";
+  std::string output = "stdout";
+  std::string strategy = "compensated";
+  std::string format = "csv";
+  std::string on_reject = "hold";
+  bool header = false;
+  bool si = false;
+  double max_velocity = 0;      // 0 = no limit
+  double max_acceleration = 0;  // 0 = no limit
+  double rate = 1000;
+  std::string start;
+  std::uint64_t count = 0;
+  double idle_timeout = 0;
+  int rt_priority = 0;
+  bool quiet = false;
+};
+
+// Lines of a file descriptor, without allocation: a line longer than the parser accepts is
+// passed on as its first kMaxLineLength + 1 characters, which the parser rejects as too long.
+class LineReader {
+ public:
+  enum class Result { Line, End, Interrupted };
+
+  explicit LineReader(int fd) : fd_(fd) {}
+
+  bool has_complete_line() const { return std::memchr(buf_.data() + begin_, '\n', end_ - begin_) != nullptr; }
+
+  Result next(std::string_view& line) {
+    for (;;) {
+      if (const void* nl = std::memchr(buf_.data() + begin_, '\n', end_ - begin_)) {
+        const std::size_t stop = static_cast<std::size_t>(static_cast<const char*>(nl) - buf_.data());
+        line = overlong_ ? std::string_view(prefix_.data(), prefix_.size())
+                         : std::string_view(buf_.data() + begin_, stop - begin_);
+        overlong_ = false;
+        begin_ = stop + 1;
+        return Result::Line;
+      }
+      if (end_ - begin_ > kMaxLineLength && !overlong_) {  // keep the start, drop the rest of the line
+        std::memcpy(prefix_.data(), buf_.data() + begin_, prefix_.size());
+        overlong_ = true;
+      }
+      if (overlong_) begin_ = end_;
+      if (eof_) {
+        if (begin_ == end_ && !overlong_) return Result::End;
+        line = overlong_ ? std::string_view(prefix_.data(), prefix_.size())
+                         : std::string_view(buf_.data() + begin_, end_ - begin_);
+        overlong_ = false;
+        begin_ = end_;
+        return Result::Line;  // the last line, without its newline
+      }
+      if (begin_ > 0) {
+        std::memmove(buf_.data(), buf_.data() + begin_, end_ - begin_);
+        end_ -= begin_;
+        begin_ = 0;
+      }
+      const ssize_t n = ::read(fd_, buf_.data() + end_, buf_.size() - end_);
+      if (n < 0) {
+        if (errno == EINTR) {
+          if (g_stop) return Result::Interrupted;
+          continue;
+        }
+        throw ExitError(kExitBadInput, fmt::format("--input: reading stdin: {}", std::strerror(errno)));
+      }
+      if (n == 0) eof_ = true;
+      end_ += static_cast<std::size_t>(n);
+    }
+  }
+
+ private:
+  int fd_;
+  std::array<char, 1 << 16> buf_{};
+  std::array<char, kMaxLineLength + 1> prefix_{};
+  std::size_t begin_ = 0, end_ = 0;
+  bool eof_ = false, overlong_ = false;
+};
+
+template <class E>
+E parse_choice(const std::string& text, const std::string& option, std::initializer_list<std::pair<const char*, E>> choices) {
+  std::string names;
+  for (const auto& [name, value] : choices) {
+    if (text == name) return value;
+    names += names.empty() ? name : std::string(", ") + name;
+  }
+  throw ExitError(kExitBadInput, fmt::format("{}: '{}' is not one of {}", option, printable(text), names));
+}
+
+StreamSettings settings_from(const StreamOptions& o) {
+  StreamSettings s;
+  s.strategy = parse_choice<Strategy>(o.strategy, "--strategy",
+                                      {{"compensated", Strategy::Compensated}, {"conventional", Strategy::Conventional}});
+  s.on_reject = parse_choice<RejectPolicy>(o.on_reject, "--on-reject",
+                                           {{"hold", RejectPolicy::Hold}, {"skip", RejectPolicy::Skip}});
+  s.period = 1.0 / o.rate;
+  if (o.max_velocity > 0) s.max_velocity = o.max_velocity;
+  if (o.max_acceleration > 0) s.max_acceleration = o.max_acceleration;
+  if (const std::string_view why = check_stream_settings(s); !why.empty())
+    throw ExitError(kExitBadInput, fmt::format("stream settings: {}", why));
+  return s;
+}
+
+// Where answers go: stdout (flushed whenever no further input is waiting) or one datagram each.
+class AnswerSink {
+ public:
+  explicit AnswerSink(std::optional<UdpSocket> udp) : udp_(std::move(udp)) {}
+
+  void write(std::string_view line) {
+    if (!udp_) {
+      if (std::fwrite(line.data(), 1, line.size(), stdout) != line.size())
+        throw ExitError(kExitOutputFailed, fmt::format("--output: writing stdout: {}", std::strerror(errno)));
+      return;
+    }
+    if (!line.empty() && line.back() == '\n') line.remove_suffix(1);  // a datagram is one answer
+    if (!udp_->send(line)) ++refused_;
+  }
+  void flush() {
+    if (!udp_ && std::fflush(stdout) != 0)
+      throw ExitError(kExitOutputFailed, fmt::format("--output: writing stdout: {}", std::strerror(errno)));
+  }
+  std::uint64_t refused() const { return refused_; }
+
+ private:
+  std::optional<UdpSocket> udp_;
+  std::uint64_t refused_ = 0;
+};
+
+void enter_realtime(int priority) {
+  if (priority <= 0) return;
+  sched_param p{};
+  p.sched_priority = priority;
+  if (sched_setscheduler(0, SCHED_FIFO, &p) != 0)
+    throw ExitError(kExitBadInput, fmt::format("--rt-priority {}: cannot use SCHED_FIFO: {} (needs root or CAP_SYS_NICE)",
+                                               priority, std::strerror(errno)));
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+    throw ExitError(kExitBadInput, fmt::format("--rt-priority {}: cannot lock memory: {}", priority, std::strerror(errno)));
+}
+
+// Default UDP endpoints: loopback, poses to port 9000, answers to port 9001.
+constexpr const char* kDefaultUdpInput = "udp://127.0.0.1:9000";
+constexpr const char* kDefaultUdpOutput = "udp://127.0.0.1:9001";
+
+int run_stream(StreamOptions o) {
+  if (o.input == "udp") o.input = kDefaultUdpInput;
+  if (o.output == "udp") o.output = kDefaultUdpOutput;
+  const Model model = load_model_from(o.model);
+  const StreamSettings settings = settings_from(o);
+  const StreamFormat format =
+      parse_choice<StreamFormat>(o.format, "--format", {{"csv", StreamFormat::Csv}, {"json", StreamFormat::Json}});
+  const AngleUnit unit = o.si ? AngleUnit::Radians : AngleUnit::Degrees;
+
+  auto state = std::make_unique<StreamState>();
+  // Rate limits need a place to start from: home, unless --start says otherwise.
+  const std::string start = o.start.empty() ? (settings.rate_limited() ? "home" : "none") : o.start;
+  if (start != "none") {
+    const Pose pose = start == "home" ? Pose{} : parse_pose_m_deg(start, "--start");
+    if (const Status s = start_stream(model, settings, pose, *state); s != Status::Ok)
+      throw ExitError(kExitOutOfLimit, fmt::format("--start: {} ({})", to_string(s), describe(s)));
+  }
+
+  std::optional<UdpSocket> in_udp, out_udp;
+  std::string in_text = "stdin", out_text = "stdout";
+  if (is_udp(o.input)) {
+    const UdpAddress local = parse_udp_address(o.input, "--input");
+    in_udp = UdpSocket::bound(local, "--input");
+    in_text = udp_text(local.host, in_udp->local_port());  // the port it got, also for port 0
+  } else if (o.input != "stdin" && o.input != "-") {
+    throw ExitError(kExitBadInput, fmt::format("--input: '{}' is neither stdin nor udp://HOST:PORT", printable(o.input)));
+  }
+  if (is_udp(o.output)) {
+    const UdpAddress peer = parse_udp_address(o.output, "--output");
+    out_udp = UdpSocket::connected(peer, "--output");
+    out_text = peer.text;
+  } else if (o.output != "stdout" && o.output != "-") {
+    throw ExitError(kExitBadInput, fmt::format("--output: '{}' is neither stdout nor udp://HOST:PORT", printable(o.output)));
+  }
+  if (in_udp && !o.quiet) {
+    std::fprintf(stderr, "hexatwist stream: listening on %s, answering to %s\n", in_text.c_str(), out_text.c_str());
+    std::fflush(stderr);
+  }
+  AnswerSink sink(std::move(out_udp));
+  install_stop_handlers();
+  enter_realtime(o.rt_priority);
+
+  if (o.header && format == StreamFormat::Csv) sink.write(kStreamCsvHeader);
+  std::array<char, kMaxOutputLength> answer{};
+  std::array<char, 2048> datagram{};
+  std::array<std::uint64_t, 64> by_status{};
+  std::array<std::uint64_t, 3> by_action{};
+  StreamOutput out;
+  LineReader reader(STDIN_FILENO);
+  if (in_udp && o.idle_timeout > 0)  // at most about 23 days, the range of the timeout in ms
+    in_udp->set_receive_timeout(std::max(1, static_cast<int>(std::min(o.idle_timeout, 2e6) * 1000.0)));
+  std::string stop_reason = "end of input";
+
+  while (!g_stop && (o.count == 0 || state->inputs < o.count)) {
+    std::string_view line;
+    if (in_udp) {
+      std::size_t size = 0;
+      bool truncated = false;
+      const auto r = in_udp->receive(datagram, size, truncated);
+      if (r == UdpSocket::Received::Timeout) {
+        stop_reason = fmt::format("no datagram for {} s (--idle-timeout)", o.idle_timeout);
+        break;
+      }
+      if (r == UdpSocket::Received::Interrupted) break;
+      // A datagram longer than the buffer cannot be a pose; the parser says so (too long).
+      line = std::string_view(datagram.data(), truncated ? datagram.size() : size);
+    } else {
+      if (!reader.has_complete_line()) sink.flush();  // about to wait: what was answered goes out now
+      const auto r = reader.next(line);
+      if (r != LineReader::Result::Line) break;
+    }
+    (void)stream_line(model, settings, line, unit, *state, out);
+    const std::size_t n = format_stream_output(out, format, answer);
+    sink.write(std::string_view(answer.data(), n));
+    ++by_status[static_cast<std::size_t>(out.status)];
+    ++by_action[static_cast<std::size_t>(out.action)];
+  }
+  sink.flush();
+  if (g_stop) stop_reason = "signal";
+  if (o.count != 0 && state->inputs >= o.count) stop_reason = fmt::format("--count {}", o.count);
+
+  const std::uint64_t rejected = state->inputs - by_status[0];
+  if (!o.quiet) {
+    std::string reasons;
+    for (std::size_t k = 1; k < by_status.size(); ++k)
+      if (by_status[k] > 0)
+        reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", by_status[k], to_string(static_cast<Status>(k)));
+    std::fprintf(stderr, "hexatwist stream: %s; %llu inputs; commands: %llu new, %llu held, %llu none; %llu rejected%s%s%s\n",
+                 stop_reason.c_str(), static_cast<unsigned long long>(state->inputs),
+                 static_cast<unsigned long long>(by_action[0]), static_cast<unsigned long long>(by_action[1]),
+                 static_cast<unsigned long long>(by_action[2]), static_cast<unsigned long long>(rejected),
+                 reasons.empty() ? "" : " (", reasons.c_str(), reasons.empty() ? "" : ")");
+    if (sink.refused() > 0)
+      std::fprintf(stderr, "hexatwist stream: %llu answers were refused by %s (nobody listening)\n",
+                   static_cast<unsigned long long>(sink.refused()), out_text.c_str());
+  }
+  return rejected == 0 ? kExitOk : kExitOutOfLimit;
+}
+
+}  // namespace
+
+Command make_stream_command(CLI::App& root) {
+  auto o = std::make_shared<StreamOptions>();
+  CLI::App* app = root.add_subcommand(
+      "stream",
+      "Motor commands for a stream of poses: one pose per line (stdin) or datagram (UDP) in, one answer per input "
+      "out, in order. A pose is x,y,z [m], roll,pitch,yaw [deg] (--si: rad). An answer is "
+      "input,status,command,m1..m6,leg,value,bound,detail (CSV) or the same as a JSON object: command is new, held "
+      "or none, m1..m6 are the motor-side commands [m]. A command outside a limit is never sent; a rejected pose "
+      "(outside a limit, non-finite, malformed) is answered with its status and the input's number. Ends at end of "
+      "input, --count, --idle-timeout or SIGINT/SIGTERM, with a summary on stderr; exit 0 if every input was "
+      "accepted, 3 if any was rejected.");
+  add_model_options(*app, o->model);
+  app->add_option("--input", o->input, "stdin, or udp://HOST:PORT to listen on (HOST defaults to 127.0.0.1; port 0 picks one; udp alone: udp://127.0.0.1:9000)")
+      ->capture_default_str();
+  app->add_option("--output", o->output, "stdout, or udp://HOST:PORT to send each answer to (HOST defaults to 127.0.0.1; udp alone: udp://127.0.0.1:9001)")
+      ->capture_default_str();
+  app->add_option("--strategy", o->strategy, "compensated (Eq. 12, twist included) or conventional (twist ignored)")
+      ->capture_default_str();
+  app->add_option("--format", o->format, "csv or json (one object per line)")->capture_default_str();
+  app->add_flag("--header", o->header, "write the CSV header line first");
+  app->add_flag("--si", o->si, "angles of the input poses in rad instead of degrees");
+  app->add_option("--on-reject", o->on_reject,
+                  "hold: answer a rejected pose with the last valid command; skip: with no command")
+      ->capture_default_str();
+  app->add_option("--max-velocity", o->max_velocity, "rate limit of each leg's command [m/s] (0: none)");
+  app->add_option("--max-acceleration", o->max_acceleration, "acceleration limit of each leg's command [m/s^2] (0: none)");
+  app->add_option("--rate", o->rate, "input rate the limits assume [Hz]: one input every 1/rate s")->capture_default_str();
+  app->add_option("--start", o->start,
+                  "pose the platform stands at when the stream starts (x,y,z [m],roll,pitch,yaw [deg]), home or none; "
+                  "default: home with rate limits, none without");
+  app->add_option("--count", o->count, "stop after this many inputs (0: no limit)");
+  app->add_option("--idle-timeout", o->idle_timeout, "UDP: stop after this many seconds without a datagram (0: wait)");
+  app->add_option("--rt-priority", o->rt_priority, "run under SCHED_FIFO at this priority with memory locked (needs root)");
+  app->add_flag("--quiet", o->quiet, "no summary on stderr");
+  return {app, [o] {
+            if (!(o->rate > 0) || !std::isfinite(o->rate))
+              throw ExitError(kExitBadInput, "--rate: expected a positive rate [Hz]");
+            if (o->max_velocity < 0 || o->max_acceleration < 0 || !std::isfinite(o->max_velocity) ||
+                !std::isfinite(o->max_acceleration))
+              throw ExitError(kExitBadInput, "--max-velocity, --max-acceleration: expected a positive limit, or 0 for none");
+            if (o->idle_timeout < 0 || !std::isfinite(o->idle_timeout))
+              throw ExitError(kExitBadInput, "--idle-timeout: expected seconds >= 0");
+            return run_stream(*o);
+          }};
+}
+
+}  // namespace hexatwist::cli

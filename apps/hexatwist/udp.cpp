@@ -1,0 +1,146 @@
+#include "udp.hpp"
+
+#include <fmt/format.h>
+#include <netdb.h>
+#include <netinet/in.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cstring>
+
+#include "cli_common.hpp"
+
+namespace hexatwist::cli {
+
+bool is_udp(std::string_view spec) { return spec.starts_with("udp://"); }
+
+UdpAddress parse_udp_address(std::string_view spec, std::string_view option) {
+  const auto bad = [&](std::string_view why) {
+    return ExitError(kExitBadInput, fmt::format("{}: '{}' {}; expected udp://HOST:PORT, e.g. udp://127.0.0.1:9000",
+                                                option, printable(spec), why));
+  };
+  if (!is_udp(spec)) throw bad("is not a UDP address");
+  std::string_view rest = spec.substr(6);
+  std::string host;
+  std::string_view port_text;
+  if (rest.starts_with("[")) {  // [IPv6]:PORT
+    const auto close = rest.find(']');
+    if (close == std::string_view::npos || close + 1 >= rest.size() || rest[close + 1] != ':')
+      throw bad("has an unclosed [IPv6] address or no :PORT");
+    host = std::string(rest.substr(1, close - 1));
+    port_text = rest.substr(close + 2);
+  } else {
+    const auto colon = rest.rfind(':');
+    if (colon == std::string_view::npos) throw bad("has no :PORT");
+    host = std::string(rest.substr(0, colon));
+    port_text = rest.substr(colon + 1);
+  }
+  if (host.empty()) host = "127.0.0.1";  // loopback unless asked otherwise
+  int port = -1;
+  const auto [ptr, ec] = std::from_chars(port_text.data(), port_text.data() + port_text.size(), port);
+  if (ec != std::errc() || ptr != port_text.data() + port_text.size() || port < 0 || port > 65535)
+    throw bad("has no port number in 0..65535");
+
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_DGRAM;
+  hints.ai_flags = AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  const std::string service = std::to_string(port);
+  if (const int rc = getaddrinfo(host.c_str(), service.c_str(), &hints, &found); rc != 0)
+    throw bad(fmt::format("names no host this machine can resolve ({})", gai_strerror(rc)));
+  UdpAddress a;
+  std::memcpy(&a.addr, found->ai_addr, found->ai_addrlen);
+  a.length = found->ai_addrlen;
+  freeaddrinfo(found);
+  a.host = host;
+  a.text = udp_text(host, port);
+  return a;
+}
+
+std::string udp_text(const std::string& host, int port) {
+  return host.find(':') != std::string::npos ? fmt::format("udp://[{}]:{}", host, port)
+                                             : fmt::format("udp://{}:{}", host, port);
+}
+
+namespace {
+
+int open_socket(const UdpAddress& a, std::string_view option) {
+  const int fd = ::socket(a.addr.ss_family, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) throw ExitError(kExitBadInput, fmt::format("{}: cannot open a UDP socket: {}", option, std::strerror(errno)));
+  return fd;
+}
+
+}  // namespace
+
+UdpSocket UdpSocket::bound(const UdpAddress& local, std::string_view option) {
+  UdpSocket s(open_socket(local, option));
+  if (::bind(s.fd_, reinterpret_cast<const sockaddr*>(&local.addr), local.length) != 0)
+    throw ExitError(kExitBadInput, fmt::format("{}: cannot listen on {}: {}", option, local.text, std::strerror(errno)));
+  return s;
+}
+
+UdpSocket UdpSocket::connected(const UdpAddress& peer, std::string_view option) {
+  UdpSocket s(open_socket(peer, option));
+  if (::connect(s.fd_, reinterpret_cast<const sockaddr*>(&peer.addr), peer.length) != 0)
+    throw ExitError(kExitBadInput, fmt::format("{}: cannot send to {}: {}", option, peer.text, std::strerror(errno)));
+  return s;
+}
+
+UdpSocket::UdpSocket(UdpSocket&& other) noexcept : fd_(other.fd_) { other.fd_ = -1; }
+
+UdpSocket& UdpSocket::operator=(UdpSocket&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = other.fd_;
+    other.fd_ = -1;
+  }
+  return *this;
+}
+
+UdpSocket::~UdpSocket() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void UdpSocket::set_receive_timeout(int timeout_ms) {
+  timeval tv{};
+  tv.tv_sec = timeout_ms / 1000;
+  tv.tv_usec = (timeout_ms % 1000) * 1000;
+  if (::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv) != 0)
+    throw ExitError(kExitBadInput, fmt::format("--idle-timeout: {}", std::strerror(errno)));
+}
+
+UdpSocket::Received UdpSocket::receive(std::span<char> buffer, std::size_t& size, bool& truncated) {
+  // MSG_TRUNC: the return value is the datagram's real length, also when it did not fit.
+  const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_TRUNC);
+  if (n < 0) {
+    if (errno == EINTR) return Received::Interrupted;
+    if (errno == EAGAIN || errno == EWOULDBLOCK) return Received::Timeout;
+    throw ExitError(kExitOutputFailed, fmt::format("receiving a pose: {}", std::strerror(errno)));
+  }
+  truncated = static_cast<std::size_t>(n) > buffer.size();
+  size = truncated ? buffer.size() : static_cast<std::size_t>(n);
+  return Received::Datagram;
+}
+
+bool UdpSocket::send(std::string_view data) {
+  for (;;) {
+    if (::send(fd_, data.data(), data.size(), 0) >= 0) return true;
+    if (errno == EINTR) continue;
+    if (errno == ECONNREFUSED) return false;  // an earlier datagram met a closed port
+    throw ExitError(kExitOutputFailed, fmt::format("sending an answer: {}", std::strerror(errno)));
+  }
+}
+
+int UdpSocket::local_port() const {
+  sockaddr_storage a{};
+  socklen_t len = sizeof a;
+  if (::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len) != 0) return -1;
+  if (a.ss_family == AF_INET) return ntohs(reinterpret_cast<const sockaddr_in*>(&a)->sin_port);
+  if (a.ss_family == AF_INET6) return ntohs(reinterpret_cast<const sockaddr_in6*>(&a)->sin6_port);
+  return -1;
+}
+
+}  // namespace hexatwist::cli

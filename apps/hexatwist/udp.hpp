@@ -1,0 +1,68 @@
+// UDP endpoints of `hexatwist stream` (POSIX sockets): addresses written udp://HOST:PORT, a
+// socket that receives one datagram per pose, and one that sends one datagram per answer.
+#pragma once
+
+#include <sys/socket.h>
+
+#include <cstddef>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace hexatwist::cli {
+
+/// A resolved UDP address.
+struct UdpAddress {
+  sockaddr_storage addr{};
+  socklen_t length = 0;
+  std::string host;  ///< as written (or 127.0.0.1), without brackets
+  std::string text;  ///< as shown to people: udp://127.0.0.1:9000
+};
+
+/// "udp://HOST:PORT" for people (IPv6 hosts in brackets).
+std::string udp_text(const std::string& host, int port);
+
+/// True if `spec` starts with "udp://".
+bool is_udp(std::string_view spec);
+
+/// Parses "udp://HOST:PORT", "udp://:PORT" (loopback) or "udp://[IPv6]:PORT"; HOST is a numeric
+/// address or a name (resolved once). Errors are ExitError(2) naming `option`.
+UdpAddress parse_udp_address(std::string_view spec, std::string_view option);
+
+/// An open UDP socket, closed on destruction.
+class UdpSocket {
+ public:
+  /// Bound to `local` (to receive poses). Errors are ExitError(2) naming `option`.
+  static UdpSocket bound(const UdpAddress& local, std::string_view option);
+  /// Connected to `peer` (to send answers). Errors are ExitError(2) naming `option`.
+  static UdpSocket connected(const UdpAddress& peer, std::string_view option);
+
+  UdpSocket(UdpSocket&& other) noexcept;
+  UdpSocket& operator=(UdpSocket&& other) noexcept;
+  UdpSocket(const UdpSocket&) = delete;
+  UdpSocket& operator=(const UdpSocket&) = delete;
+  ~UdpSocket();
+
+  /// How long `receive` waits for a datagram [ms]; 0 (the default) waits forever.
+  void set_receive_timeout(int timeout_ms);
+
+  /// Result of a receive.
+  enum class Received { Datagram, Timeout, Interrupted };
+  /// Waits (up to the receive timeout) for one datagram into `buffer`, in one system call; `size`
+  /// is its length and `truncated` says it was longer than the buffer. A signal ends the wait
+  /// (Interrupted). Other failures throw ExitError.
+  Received receive(std::span<char> buffer, std::size_t& size, bool& truncated);
+
+  /// Sends one datagram. Returns false if the peer refused it (nobody listening on loopback);
+  /// other failures throw ExitError.
+  bool send(std::string_view data);
+
+  /// The port the socket is bound to (useful after binding port 0).
+  int local_port() const;
+
+ private:
+  explicit UdpSocket(int fd) : fd_(fd) {}
+  int fd_ = -1;
+};
+
+}  // namespace hexatwist::cli
