@@ -29,14 +29,18 @@ export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
 for target in "${targets[@]}"; do
   [ -x "build-fuzz/fuzz_$target" ] || { echo "hexatwist fuzz: no target '$target'" >&2; exit 2; }
   corpus=build-fuzz/corpus/$target artifacts=build-fuzz/artifacts/$target log=build-fuzz/fuzz_$target.log
+  rm -rf "$artifacts"
   mkdir -p "$corpus" "$artifacts"
   inputs=("$corpus" "fuzz/corpus/$target")
   [ -d "fuzz/regressions/$target" ] && inputs+=("fuzz/regressions/$target")
-  options=(-max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -print_final_stats=1
+  # A single allocation above 256 MB is a bug here (the inputs are a few kB) and is reported at
+  # once; memory that grows by small steps is caught at 2 GB, but libFuzzer's report of it can hang
+  # (seen with ASan): the outer timeout ends such a run.
+  options=(-max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=256 -print_final_stats=1
            -artifact_prefix="$artifacts/")
   [ -f "fuzz/dict/$target.dict" ] && options+=(-dict="fuzz/dict/$target.dict")
   echo "hexatwist fuzz: $target for ${seconds} s (log: $log)" >&2
-  if ! "build-fuzz/fuzz_$target" "${options[@]}" "${inputs[@]}" >"$log" 2>&1; then
+  if ! timeout -k 10 $((seconds + 120)) "build-fuzz/fuzz_$target" "${options[@]}" "${inputs[@]}" >"$log" 2>&1; then
     tail -n 60 "$log" >&2
     echo "hexatwist fuzz: $target FAILED; the input is in $artifacts/. Fix the bug, then keep the input as a" \
          "regression test: cp $artifacts/<file> fuzz/regressions/$target/" >&2

@@ -1,13 +1,16 @@
 #include "hexatwist/config.hpp"
 
 #include <fmt/format.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <initializer_list>
 #include <map>
+#include <sstream>
 #include <vector>
 
 #include "hexatwist/error.hpp"
@@ -224,10 +227,43 @@ Screw read_screw(const Reader& r, const Field& n, Screw s, bool top) {
 
 void read_extras(const Reader& r, const Field& top, Locations& locs, ConfigSpec& out);
 
+// Where each document of a YAML text starts, from the parser's events (no nodes are built).
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  std::vector<YAML::Mark> marks;
+  void OnDocumentStart(const YAML::Mark& mark) override { marks.push_back(mark); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
+// yaml-cpp 0.7 reads some malformed text (a ',' where a document starts, as in ",a: 1") as an
+// endless series of empty documents, so that LoadAll never returns and fills the memory. A
+// document that starts where the one before it started has read nothing: the text is stuck there.
+void check_documents_advance(const Reader& r, std::string_view yaml_text) {
+  std::istringstream in{std::string(yaml_text)};
+  YAML::Parser parser(in);
+  DocumentStarts starts;
+  while (parser.HandleNextDocument(starts)) {
+    const std::vector<YAML::Mark>& m = starts.marks;
+    if (m.size() >= 2 && m[m.size() - 1].pos == m[m.size() - 2].pos) {
+      const auto pos = static_cast<std::size_t>(std::max(0, m.back().pos));
+      throw Error(fmt::format("{}: YAML syntax error: unexpected '{}'", r.where(m.back()),
+                              one_line(yaml_text.substr(std::min(pos, yaml_text.size()), 1))));
+    }
+  }
+}
+
 ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& locs, ConfigSpec& extras) {
   const Reader r(source);
   std::vector<YAML::Node> docs;
   try {
+    check_documents_advance(r, yaml_text);
     docs = YAML::LoadAll(std::string(yaml_text));
   } catch (const YAML::Exception& e) {
     throw Error(fmt::format("{}: YAML syntax error: {}", r.where(e.mark), one_line(e.msg)));

@@ -490,7 +490,13 @@ Trajectory resample(const TimedPoses& samples, double dt) {
       const double s2 = s * s, s3 = s2 * s;
       const double h00 = 2.0 * s3 - 3.0 * s2 + 1.0, h10 = s3 - 2.0 * s2 + s;
       const double h01 = -2.0 * s3 + 3.0 * s2, h11 = s3 - s2;
-      traj.poses[k] = Pose::from_vector(h00 * q[i] + h10 * h * slope[i] + h01 * q[i + 1] + h11 * h * slope[i + 1]);
+      const Vector6d qk = h00 * q[i] + h10 * h * slope[i] + h01 * q[i + 1] + h11 * h * slope[i + 1];
+      // Finite samples whose differences or rates overflow a double (1e308 m next to 0 m) give
+      // an infinite slope: no pose can be interpolated there.
+      if (!qk.allFinite())
+        throw Error(fmt::format("resample: between {} and {}: the interpolation overflows a double (a value or "
+                                "its rate of change beyond 1e308)", at(i), at(i + 1)));
+      traj.poses[k] = Pose::from_vector(qk);
     }
   }
   return traj;

@@ -272,6 +272,13 @@ TEST(Config, SyntaxErrorNamesItsLine) {
   expect_error(replace_line(kSymmetric, 5, "\tda: 0.2"), 5, {"YAML syntax error"});
 }
 
+TEST(Config, TextThatYamlCppReadsAsEndlessDocumentsIsASyntaxError) {
+  // yaml-cpp 0.7 alone never ends on these (found by fuzz/fuzz_config.cpp).
+  expect_error(",name: {a!b}\n", 1, {"YAML syntax error", "unexpected ','"});
+  expect_error("!tag ,\n", 1, {"YAML syntax error", "unexpected ','"});
+  expect_error(kSymmetric + "---\n,\n", 18, {"YAML syntax error", "unexpected ','"});
+}
+
 TEST(Config, MissingKeyPointsAtTheBlockThatLacksIt) {
   expect_error(erase_lines(kSymmetric, 7, 7), 2, {"field 'symmetric.H'", "missing"});
   expect_error(erase_lines(kSymmetric, 13, 13), 12, {"field 'limits.length_min'", "missing"});

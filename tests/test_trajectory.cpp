@@ -730,6 +730,11 @@ TEST(Trajectory, BadResampleInputsAreErrors) {
   bad_pose.poses[1].rpy.x() = std::numeric_limits<double>::infinity();
   expect(error_of([&] { (void)resample(bad_pose, 0.1); }), "sample 1: pose is not finite");
   expect(error_of([&] { (void)resample(polynomial_samples({0.0, 1e3}, 1), 1e-6); }), "samples");
+  // Finite samples whose rate of change overflows a double (found by fuzz/fuzz_trajectory_csv.cpp).
+  TimedPoses huge = polynomial_samples({0.0, 0.25, 0.6}, 1);
+  huge.lines = {3, 5, 7};
+  huge.poses[1].position.y() = 1e308;
+  expect(error_of([&] { (void)resample(huge, 0.01); }), "between sample 0 (line 3) and sample 1 (line 5): the interpolation overflows");
 }
 
 }  // namespace

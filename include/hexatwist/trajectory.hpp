@@ -125,7 +125,9 @@ TimedPoses parse_trajectory_csv(std::string_view text, std::string_view source);
 /// time within 1e-9 dt of an input time gives that input pose exactly. Angles are interpolated as
 /// given (no wrapping at ±pi). Throws hexatwist::Error if dt <= 0 or non-finite, fewer than 2
 /// samples, t and poses differ in size, times are not finite and strictly increasing, a pose is
-/// not finite, or more than 1e8 samples would result.
+/// not finite, more than 1e8 samples would result, or the interpolation overflows a double
+/// (finite samples whose difference or rate of change is beyond 1e308): it never returns a
+/// non-finite pose.
 Trajectory resample(const TimedPoses& samples, double dt);
 
 }  // namespace hexatwist
