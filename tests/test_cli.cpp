@@ -734,3 +734,165 @@ TEST(CliStream, UdpAnswersOneDatagramPerDatagramInOrder) {
 }
 
 }  // namespace
+
+// ----- hexatwist synth / measure -----
+namespace {
+
+// A measured run as a trajectory file: calibration stations 0.1 m from home along x, y and z
+// (or, `z_only`, twice along z), held 0.5 s each and home again by t = 7.5 s; then a 5 deg yaw
+// and back. Register on t <= 8.
+std::string calibrated_csv(bool z_only = false) {
+  const std::vector<std::array<double, 4>> rows = {
+      {0, 0, 0, 0},   {0.5, 0, 0, 0}, {1.5, 0.1, 0, 0}, {2.5, 0.1, 0, 0}, {3.5, 0, 0.1, 0}, {4.5, 0, 0.1, 0},
+      {5.5, 0, 0, 0.1}, {6.5, 0, 0, 0.1}, {7.5, 0, 0, 0}, {8.0, 0, 0, 0},  {9.5, 0, 0, 0},   {10.0, 0, 0, 0},
+      {11.5, 0, 0, 0},  {12.0, 0, 0, 0}};
+  std::ostringstream os;
+  os << "t,x,y,z,roll,pitch,yaw\n";
+  for (const auto& r : rows) {
+    const double yaw = (r[0] == 9.5 || r[0] == 10.0) ? 5.0 : 0.0;
+    const double x = z_only ? 0.0 : r[1], y = z_only ? 0.0 : r[2], z = z_only ? r[1] + r[2] + r[3] : r[3];
+    os << r[0] << "," << x << "," << y << "," << z << ",0,0," << yaw << "\n";
+  }
+  return os.str();
+}
+
+// Runs synth on a trajectory file; returns the log's path (its truth is beside it).
+std::string synth_log(const std::string& trajectory, const std::string& name,
+                      std::initializer_list<std::string> extra = {}) {
+  const std::string out = (temp_dir() / (name + ".csv")).string();
+  std::vector<std::string> args{"synth", "--trajectory", trajectory, "--out", out};
+  args.insert(args.end(), extra.begin(), extra.end());
+  const Outcome r = run(args);
+  EXPECT_EQ(r.code, 0) << r.err;
+  return out;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream is(text);
+  for (std::string line; std::getline(is, line);) lines.push_back(line);
+  return lines;
+}
+
+std::string joined(const std::vector<std::string>& lines) {
+  std::string s;
+  for (const std::string& l : lines) s += l + "\n";
+  return s;
+}
+
+}  // namespace
+
+TEST(CliMeasure, SynthThenMeasureGivesTheSideBySideReport) {
+  const std::string traj = write_file("calibrated.csv", calibrated_csv());
+  const std::string log = synth_log(traj, "log", {"--seed", "4"});
+  const YAML::Node truth = YAML::LoadFile((temp_dir() / "log.truth.json").string());
+  EXPECT_EQ(truth["noise"].as<double>(), 1e-5);
+  EXPECT_EQ(truth["points"].as<int>(), 1201);  // 12 s at 100 Hz
+  EXPECT_EQ(lines_of(read_file(log))[0], "t_s,x_mm,y_mm,z_mm");
+  const std::filesystem::path out = temp_dir() / "measure-out";
+  const Outcome r = run({"measure", "--points", log, "--trajectory", traj, "--register-until", "8", "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("registration: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("experiment    compensated"), std::string::npos) << r.out;
+  const YAML::Node s = YAML::LoadFile((out / "summary.json").string());
+  const YAML::Node m = s["tests"][0]["measured"];
+  ASSERT_TRUE(m.IsMap()) << r.out;
+  EXPECT_EQ(m["points"].as<int>(), 1201);
+  EXPECT_EQ(m["evaluated"].as<int>(), 400);  // t > 8 s
+  // The frame the synth drew, to about the noise over the stations' spread (10 um over 0.1 m).
+  double worst = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      worst = std::max(worst, std::abs(m["registration"]["R_BT"][i][j].as<double>() - truth["X_BT"]["R"][i][j].as<double>()));
+  EXPECT_LT(worst, 2e-4);
+  const double sigma = m["registration"]["sigma"].as<double>();
+  EXPECT_GT(sigma, 0.8e-5);
+  EXPECT_LT(sigma, 1.2e-5);
+  // The measured error: the noise (rms sqrt(3) 10 um) over the servo's own few micrometres.
+  EXPECT_GT(m["rms_error"].as<double>(), 1.2e-5);
+  EXPECT_LT(m["rms_error"].as<double>(), 2.5e-5);
+  EXPECT_LT(m["simulated_max_error"].as<double>(), 2e-5);
+  // Named after the run (the trajectory file), as simulate names its files.
+  for (const char* f : {"calibrated_measured.csv", "calibrated_measured.svg", "calibrated_compensated.csv", "summary.md"})
+    EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
+  EXPECT_TRUE(is_png(out / "calibrated_measured.png"));
+  const std::string md = read_file(out / "summary.md");
+  EXPECT_NE(md.find("| experiment | measured |"), std::string::npos);
+  EXPECT_NE(md.find("| experiment | simulated at the measured times |"), std::string::npos);
+  // One row per point; the evaluated ones carry the simulated error.
+  const std::vector<std::string> rows = lines_of(read_file(out / "calibrated_measured.csv"));
+  ASSERT_EQ(rows.size(), 1202u);
+  EXPECT_EQ(rows[0].rfind("t_s,line,registration_window,registration_point,x_T_m,", 0), 0u);
+  EXPECT_NE(rows.back().back(), ',');
+}
+
+TEST(CliMeasure, AnIndexedLogGivesTheSameErrors) {
+  const std::string traj = write_file("calibrated.csv", calibrated_csv());
+  const std::string log = synth_log(traj, "timed", {"--seed", "5", "--lead-error-pct", "0.2"});
+  // The same points with a sample index from 1000 and unsuffixed names, as another export might give.
+  std::vector<std::string> lines = lines_of(read_file(log));
+  lines[0] = "Index,X,Y,Z";
+  for (std::size_t k = 1; k < lines.size(); ++k) lines[k] = std::to_string(999 + k) + lines[k].substr(lines[k].find(','));
+  const std::string indexed = write_file("indexed.csv", joined(lines));
+  const auto measured = [&](const std::vector<std::string>& extra, const std::string& name) {
+    std::vector<std::string> args{"measure", "--trajectory", traj, "--register-until", "8", "--no-figures", "--no-csv",
+                                  "--out", (temp_dir() / name).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const Outcome r = run(args);
+    EXPECT_EQ(r.code, 0) << r.err;
+    return YAML::LoadFile((temp_dir() / name / "summary.json").string())["tests"][0]["measured"];
+  };
+  const YAML::Node a = measured({"--points", log}, "by-time");
+  const YAML::Node b = measured({"--points", indexed, "--index", "--rate", "100", "--time-offset", "10", "--columns",
+                                 "index,x,y,z", "--units", "mm"},
+                                "by-index");
+  EXPECT_NEAR(a["max_error"].as<double>(), b["max_error"].as<double>(), 1e-12);
+  EXPECT_NEAR(a["rms_error"].as<double>(), b["rms_error"].as<double>(), 1e-12);
+  // A 0.2 % lead error: far above the noise.
+  EXPECT_GT(a["max_error"].as<double>(), 1e-4);
+}
+
+TEST(CliMeasure, BadPointLogsAreOneLineErrorsWithExitTwo) {
+  const std::string traj = write_file("calibrated.csv", calibrated_csv());
+  const std::string good = synth_log(traj, "good");
+  const std::vector<std::string> lines = lines_of(read_file(good));
+  const auto measure = [&](const std::string& points, std::initializer_list<std::string> extra = {}) {
+    std::vector<std::string> args{"measure", "--points", points, "--trajectory", traj, "--register-until", "8",
+                                  "--no-figures", "--out", (temp_dir() / "bad-out").string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run(args);
+  };
+  // Wrong column count.
+  std::vector<std::string> v = lines;
+  v[4] = "0.03,1,2";
+  const std::string short_row = write_file("short.csv", joined(v));
+  expect_error(measure(short_row), 2, {short_row + ":5:9:", "column 'z'", "3 cells"});
+  // Units missing.
+  v = lines;
+  v[0] = "t,x,y,z";
+  const std::string no_units = write_file("nounits.csv", joined(v));
+  expect_error(measure(no_units), 2, {no_units + ":1:3:", "units missing"});
+  // Fewer points than a registration needs.
+  const std::string two = write_file("two.csv", joined({lines[0], lines[1], lines[2]}));
+  expect_error(measure(two), 2, {two + ":3:1:", "2 points", "at least 3"});
+  // Time stamps out of order.
+  v = lines;
+  std::swap(v[10], v[11]);
+  const std::string swapped = write_file("swapped.csv", joined(v));
+  expect_error(measure(swapped), 2, {swapped + ":12:1:", "column 't'", "not after"});
+  // A point outside the trajectory's time span (the tracker clock 1 s late).
+  expect_error(measure(good, {"--time-offset", "-1"}), 2, {good + ":1103:1:", "outside", "time span"});
+  // Degenerate registration points: the stations all on a line.
+  const std::string line_traj = write_file("zline.csv", calibrated_csv(true));
+  const std::string on_line = synth_log(line_traj, "online");
+  expect_error(run({"measure", "--points", on_line, "--trajectory", line_traj, "--register-until", "8", "--out",
+                    (temp_dir() / "bad-out").string()}),
+               2, {on_line + ": lines 2-802:", "on a line", "condition"});
+  // Options.
+  expect_error(run({"measure", "--points", good, "--trajectory", traj}), 2, {"--register-until", "--register-first"});
+  expect_error(measure(good, {"--index"}), 2, {"--index", "--rate"});
+  expect_error(run({"measure", "--points", good, "--test", "Lq"}), 2, {"--test", "'Lq'"});
+  expect_error(run({"synth", "--trajectory", traj, "--rate", "300", "--out", (temp_dir() / "x.csv").string()}), 2,
+               {"300 Hz does not divide the control rate 1000 Hz"});
+  EXPECT_FALSE(std::filesystem::exists(temp_dir() / "bad-out"));
+}

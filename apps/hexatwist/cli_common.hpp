@@ -52,6 +52,10 @@ Config load_config_from(const ModelOptions& opts);
 /// Reads a whole file; a missing, unreadable or directory path becomes ExitError(2) naming `option`.
 std::string read_text_file(const std::string& path, const std::string& option, const std::string& what);
 
+/// Writes `content` to the file whole: to a temporary name first, then renamed; ExitError(4)
+/// naming the file if it cannot be written.
+void write_output_file(const std::string& path, std::string_view content);
+
 /// Name of the platform source for messages.
 std::string model_source(const ModelOptions& opts);
 
@@ -84,5 +88,7 @@ Command make_config_command(CLI::App& root);
 Command make_study_command(CLI::App& root);
 Command make_simulate_command(CLI::App& root);
 Command make_stream_command(CLI::App& root);
+Command make_synth_command(CLI::App& root);
+Command make_measure_command(CLI::App& root);
 
 }  // namespace hexatwist::cli

@@ -32,8 +32,9 @@ int main(int argc, char** argv) {
       "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit or numerical failure, 4 output not written."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
-  const std::vector<Command> commands{make_study_command(app), make_simulate_command(app), make_stream_command(app), make_ik_command(app),
-                                      make_fk_command(app), make_config_command(app)};
+  const std::vector<Command> commands{make_study_command(app),   make_simulate_command(app), make_synth_command(app),
+                                      make_measure_command(app), make_stream_command(app),   make_ik_command(app),
+                                      make_fk_command(app),      make_config_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
       if (chosen) break;
       print_error(
           "hexatwist: error: ",
-          fmt::format("unknown subcommand '{}'; expected study, simulate, stream, ik, fk or config (see --help)", word));
+          fmt::format("unknown subcommand '{}'; expected study, simulate, synth, measure, stream, ik, fk or config (see --help)", word));
       return kExitBadInput;
     }
     print_error("hexatwist: error: ", fmt::format("{} (see --help)", e.what()));
