@@ -279,8 +279,8 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
     throw Error(fmt::format("{}: expected a mapping with 'symmetric' or 'legs', 'screw' and 'limits' at top level, got {}",
                             r.where(root.Mark()), kind(root)));
   const Field top{root, "", root.Mark()};
-  r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "limits", "observation_point", "pivot",
-                   "servo", "load", "simulation", "study"});
+  r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "length_offsets", "limits",
+                   "observation_point", "pivot", "servo", "load", "simulation", "study"});
 
   ModelSpec spec;
   const Field name = Reader::child(top, "name");
@@ -388,6 +388,21 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
         farthest = rho;
         spec.observation_P = leg.platform_P;
       }
+    }
+  }
+
+  // The legs' zero errors (identification's estimate), one list for either layout.
+  if (const Field offsets = Reader::child(top, "length_offsets"); offsets.present()) {
+    constexpr const char* kWhat = "real minus motor-side length at zero twist of legs 1..6 [m]";
+    if (!offsets.node.IsSequence() || offsets.node.size() != kLegs)
+      r.fail(offsets.at(), offsets.path,
+             fmt::format("expected a list of 6 numbers ({}), got {}", kWhat,
+                         offsets.node.IsSequence() ? fmt::format("{} numbers", offsets.node.size())
+                                                   : std::string(kind(offsets.node))));
+    for (int i = 0; i < kLegs; ++i) {
+      const Field f = Reader::item(offsets, static_cast<std::size_t>(i), fmt::format("{}[{}]", offsets.path, i));
+      spec.legs[static_cast<std::size_t>(i)].length_offset = r.number(f, kWhat);
+      locs[fmt::format("leg {}: length_offset", i + 1)] = loc(f);
     }
   }
 
@@ -512,7 +527,7 @@ std::string locate(const Reader& r, const Locations& locs, std::string_view sour
   std::string sub;
   const bool leg_field = field.starts_with("leg ");
   if (leg_field)
-    for (const char* s : {"base_axis", "platform_axis", "base", "platform", "lead"}) {
+    for (const char* s : {"base_axis", "platform_axis", "base", "platform", "lead", "length_offset"}) {
       const std::size_t n = std::strlen(s);
       if (what.starts_with(s) && what.substr(n).starts_with(": ")) {
         sub = s;

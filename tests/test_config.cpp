@@ -221,6 +221,29 @@ TEST(Config, PerLegScrewSettingsOverrideTheScrewBlock) {
   EXPECT_EQ(m.leg(4).driven, DrivenSide::Platform);
 }
 
+TEST(Config, LengthOffsetsGiveEveryLegItsZeroErrorInEitherForm) {
+  const std::string offsets = "length_offsets: [0.001, -0.0005, 0, 2.5e-4, -1e-3, 3e-6]\n";
+  const std::array<double, kLegs> expected{0.001, -0.0005, 0.0, 2.5e-4, -1e-3, 3e-6};
+  for (const std::string& form : {kSymmetric, seed_legs_yaml()}) {
+    const Model m = load_model(form + offsets, "offsets.yaml");
+    for (int i = 0; i < kLegs; ++i) EXPECT_EQ(m.leg(i).length_offset, expected[static_cast<std::size_t>(i)]) << i;
+    // Nothing else changes.
+    const Model plain = load_model(form, "plain.yaml");
+    expect_same_model(m, plain);
+    EXPECT_EQ(plain.geometry().length_offset, Vector6d::Zero());
+  }
+}
+
+TEST(Config, BadLengthOffsetsAreLocated) {
+  const int line = 17;  // appended after kSymmetric's 16 lines
+  expect_error(kSymmetric + "length_offsets: [0, 0, 0]\n", line, {"field 'length_offsets'", "6 numbers", "got 3"});
+  expect_error(kSymmetric + "length_offsets: 0.001\n", line, {"field 'length_offsets'", "6 numbers", "scalar"});
+  expect_error(kSymmetric + "length_offsets: [0, 0, x, 0, 0, 0]\n", line, {"field 'length_offsets[2]'", "number"});
+  // The model's own check (shorter than the stroke), at the entry it came from.
+  expect_error(kSymmetric + "length_offsets: [0, 0, 0, 1.5, 0, 0]\n", line,
+               {"field 'length_offsets[3]'", "stroke"});
+}
+
 TEST(Config, ZeroLeadLegsFormNeedsNoAxesAndNoThread) {
   // A plain Stewart platform: joints only.
   std::string yaml =

@@ -6,6 +6,7 @@
 #include "hexatwist/dynamics.hpp"
 #include "hexatwist/error.hpp"
 #include "hexatwist/forward.hpp"
+#include "hexatwist/identification.hpp"
 #include "hexatwist/kinematics.hpp"
 #include "hexatwist/limits.hpp"
 #include "hexatwist/measurement.hpp"
