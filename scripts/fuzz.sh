@@ -5,6 +5,9 @@
 # (the repository stays clean) and stops at the first crash, leaving the input in
 # build-fuzz/artifacts/<target>/.
 #   bash scripts/fuzz.sh [SECONDS] [TARGET...]      TARGET: config, trajectory_csv, pose_line
+# HEXATWIST_FUZZ_SEED=N fixes libFuzzer's random seed, so a run explores the same sequence of inputs
+# every time (scripts/test.sh uses seed 1: a test must not pass or fail by chance). Unset, each
+# run draws a new seed and explores new ground: that is how to hunt for bugs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
@@ -30,6 +33,7 @@ for target in "${targets[@]}"; do
   [ -x "build-fuzz/fuzz_$target" ] || { echo "hexatwist fuzz: no target '$target'" >&2; exit 2; }
   corpus=build-fuzz/corpus/$target artifacts=build-fuzz/artifacts/$target log=build-fuzz/fuzz_$target.log
   rm -rf "$artifacts"
+  [ -n "${HEXATWIST_FUZZ_SEED:-}" ] && rm -rf "$corpus"  # a seeded run starts from the same inputs
   mkdir -p "$corpus" "$artifacts"
   inputs=("$corpus" "fuzz/corpus/$target")
   [ -d "fuzz/regressions/$target" ] && inputs+=("fuzz/regressions/$target")
@@ -39,7 +43,8 @@ for target in "${targets[@]}"; do
   options=(-max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=256 -print_final_stats=1
            -artifact_prefix="$artifacts/")
   [ -f "fuzz/dict/$target.dict" ] && options+=(-dict="fuzz/dict/$target.dict")
-  echo "hexatwist fuzz: $target for ${seconds} s (log: $log)" >&2
+  [ -n "${HEXATWIST_FUZZ_SEED:-}" ] && options+=(-seed="$HEXATWIST_FUZZ_SEED")
+  echo "hexatwist fuzz: $target for ${seconds} s, seed ${HEXATWIST_FUZZ_SEED:-random} (log: $log)" >&2
   if ! timeout -k 10 $((seconds + 120)) "build-fuzz/fuzz_$target" "${options[@]}" "${inputs[@]}" >"$log" 2>&1; then
     tail -n 60 "$log" >&2
     echo "hexatwist fuzz: $target FAILED; the input is in $artifacts/. Fix the bug, then keep the input as a" \
