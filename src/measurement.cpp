@@ -38,10 +38,10 @@ std::string unit_name(double to_si) { return to_si == 1.0 ? "m" : to_si == 1e-3 
 
 // One wanted column: where it is in the header and the factor of its values to SI.
 struct Column {
-  std::string name;             // as the format names it
-  std::size_t index = 0;        // cell index in the row
-  double to_si = 1.0;           // factor to SI (0 while unknown)
-  std::string_view header;      // the header cell
+  std::string name;         // as the format names it
+  std::size_t index = 0;    // cell index in the row
+  double to_si = 1.0;       // factor to SI (0 while unknown)
+  std::string_view header;  // the header cell
 };
 
 // Finds `name` in the header cells; the suffix found (or none) in `suffix`.
@@ -70,7 +70,8 @@ Column find_column(const detail::CsvReader& r, const detail::CsvLine& line, cons
   }
   if (!found) {
     std::string names;
-    for (const detail::CsvCell& c : cells) names += fmt::format("{}'{}'", names.empty() ? "" : ", ", detail::printable(c.text, 40));
+    for (const detail::CsvCell& c : cells)
+      names += fmt::format("{}'{}'", names.empty() ? "" : ", ", detail::printable(c.text, 40));
     std::string accepted = fmt::format("'{}'", name);
     for (const Suffix& s : suffixes) accepted += fmt::format(" or '{}{}'", name, s.text);
     r.fail(line.number, line.text, 0, name,
@@ -148,9 +149,10 @@ PointLog parse_point_log(std::string_view text, std::string_view source, const P
       p[static_cast<int>(a)] = r.number(line, cells[xyz[a].index], xyz[a].name, xyz[a].to_si);
     if (!log.stamps.empty() && !(stamp > log.stamps.back()))
       r.fail(line.number, line.text, tc.offset, time.name,
-             fmt::format("{} {} is not after {} on line {}; {} must be strictly increasing",
-                         format.indexed ? "index" : "time", stamp, log.stamps.back(), log.lines.back(),
-                         format.indexed ? "indices" : "times"));
+             format.indexed ? fmt::format("index {} is not after {} on line {}; indices must be strictly increasing",
+                                          stamp, log.stamps.back(), log.lines.back())
+                            : fmt::format("time {} s is not after {} s on line {}; times must be strictly increasing",
+                                          stamp, log.stamps.back(), log.lines.back()));
     log.stamps.push_back(stamp);
     log.points_T.push_back(p);
     log.lines.push_back(line.number);
@@ -168,7 +170,8 @@ PointLog parse_point_log(std::string_view text, std::string_view source, const P
 
 std::vector<double> trajectory_times(const PointLog& log, const TimeAlignment& alignment) {
   if (!std::isfinite(alignment.offset))
-    throw Error(fmt::format("{}: time offset: expected a finite number of seconds, got {}", log.source, alignment.offset));
+    throw Error(
+        fmt::format("{}: time offset: expected a finite number of seconds, got {}", log.source, alignment.offset));
   if (log.indexed && !(std::isfinite(alignment.rate) && alignment.rate > 0.0))
     throw Error(fmt::format("{}: sample rate: expected > 0 Hz for a log of sample indices, got {}", log.source,
                             alignment.rate));
@@ -236,10 +239,11 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
   };
   for (std::size_t k = 0; k < n; ++k) {
     if (!(times[k] >= front - kTimeTolerance && times[k] <= back + kTimeTolerance))
-      throw Error(fmt::format(
-          "{}: point at t = {} s{} is outside the commanded trajectory's time span [{}, {}] s (check the time offset{})",
-          where(k), times[k], log.indexed ? fmt::format(" (index {})", log.stamps[k]) : std::string(), front, back,
-          log.indexed ? " and the sample rate" : ""));
+      throw Error(
+          fmt::format("{}: point at t = {} s{} is outside the commanded trajectory's time span [{}, {}] s (check the "
+                      "time offset{})",
+                      where(k), times[k], log.indexed ? fmt::format(" (index {})", log.stamps[k]) : std::string(),
+                      front, back, log.indexed ? " and the sample rate" : ""));
     times[k] = std::clamp(times[k], front, back);
   }
   const std::vector<Pose> desired = interpolate(commanded, times);
@@ -275,8 +279,10 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
     throw Error(fmt::format("{}: {} ({}) hold every point: no point is left after the registration to evaluate", src,
                             lines_text, window_text));
   m.window_end = times[m.window - 1];
+  if (!(std::isfinite(w.settle) && w.settle >= 0.0))
+    throw Error(fmt::format("{}: settle time: expected a finite number >= 0 s, got {}", src, w.settle));
   std::vector<PointPair> pairs;
-  std::vector<std::size_t> used;
+  std::vector<std::size_t>& used = m.registered;
   for (std::size_t k = 0; k < m.window; ++k) {
     MeasuredPoint& p = m.points[k];
     p.in_window = true;
@@ -287,10 +293,11 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
   const std::string rest_text =
       w.settle > 0.0 ? fmt::format(" at rest (commanded pose unchanged for {} s)", w.settle) : std::string();
   if (used.size() < 3)
-    throw Error(fmt::format("{}: {}: only {} of the {} points in {} {}{}; registering the tracker frame needs at least "
-                            "3 (widen the window, or lower the settle time)",
-                            src, lines_text, used.size(), m.window, window_text, used.size() == 1 ? "is" : "are",
-                            rest_text.empty() ? std::string(" usable") : rest_text));
+    throw Error(
+        fmt::format("{}: {}: only {} of the {} points in {} {}{}; registering the tracker frame needs at least "
+                    "3 (widen the window, or lower the settle time)",
+                    src, lines_text, used.size(), m.window, window_text, used.size() == 1 ? "is" : "are",
+                    rest_text.empty() ? std::string(" usable") : rest_text));
 
   // Each registration point's model position: where the nominal model puts the observation point
   // for the commands the platform ran (exactly the commanded position with compensation).
@@ -305,8 +312,8 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
                               where(k), p.time, describe(s)));
     if (const Status s = forward_kinematics(model, command, LengthKind::Motor, placement_from_pose(pose), fk);
         s != Status::Ok)
-      throw Error(fmt::format("{}: forward kinematics of the command at t = {} s failed ({})", where(k), p.time,
-                              describe(s)));
+      throw Error(
+          fmt::format("{}: forward kinematics of the command at t = {} s failed ({})", where(k), p.time, describe(s)));
     p.model_B = platform_point_B(model, fk.placement, obs);
     pairs.push_back({p.p_T, p.model_B});
   }
@@ -318,8 +325,11 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
     mean /= static_cast<double>(pairs.size());
     Matrix3d cov = Matrix3d::Zero();
     for (const PointPair& pair : pairs) cov += (pair.p_B - mean) * (pair.p_B - mean).transpose();
-    const Vector3d spread =
-        (cov / static_cast<double>(pairs.size())).selfadjointView<Eigen::Lower>().eigenvalues().cwiseMax(0.0).cwiseSqrt();
+    const Vector3d spread = (cov / static_cast<double>(pairs.size()))
+                                .selfadjointView<Eigen::Lower>()
+                                .eigenvalues()
+                                .cwiseMax(0.0)
+                                .cwiseSqrt();
     throw Error(fmt::format(
         "{}: {}: the {} registration points{} in {} are {} (rms spread {:.3g} m, {:.3g} m and {:.3g} m along their "
         "principal axes; condition {:.3g}, at most {:.3g}); they cannot fix the tracker frame (register on stations "
@@ -328,8 +338,7 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
         spread[2] < kCoincident ? "all at one place" : "on a line or nearly", spread[2], spread[1], spread[0],
         m.registration.condition, options.registration.max_condition));
   }
-  if (s != Status::Ok)
-    throw Error(fmt::format("{}: {}: registration failed: {}", src, lines_text, describe(s)));
+  if (s != Status::Ok) throw Error(fmt::format("{}: {}: registration failed: {}", src, lines_text, describe(s)));
 
   // Errors: every point registered; the statistics over the points after the window.
   std::vector<double> norm, axis[3];
@@ -349,10 +358,10 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
 std::vector<double> simulated_errors(const std::vector<SimulationSample>& samples, const Measurement& measurement) {
   std::vector<double> out;
   out.reserve(measurement.points.size() - std::min(measurement.window, measurement.points.size()));
-  const auto later = [](const SimulationSample& s, double t) { return s.time < t; };
+  const auto before = [](const SimulationSample& s, double t) { return s.time < t; };
   for (std::size_t k = measurement.window; k < measurement.points.size(); ++k) {
     const double t = measurement.points[k].time;
-    const auto it = std::lower_bound(samples.begin(), samples.end(), t - kTimeTolerance, later);
+    const auto it = std::lower_bound(samples.begin(), samples.end(), t - kTimeTolerance, before);
     if (it != samples.end() && std::abs(it->time - t) <= kTimeTolerance) {
       out.push_back(it->error);
     } else if (it == samples.end() || it == samples.begin()) {

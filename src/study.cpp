@@ -78,7 +78,9 @@ void keep_after(TestRun& run, double t) {
   const auto& ticks = run.conventional.samples;
   std::size_t drop = 0;
   while (drop < ticks.size() && ticks[drop].time <= t) ++drop;
-  const auto cut = [drop](auto& v) { v.erase(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(std::min(drop, v.size()))); };
+  const auto cut = [drop](auto& v) {
+    v.erase(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(std::min(drop, v.size())));
+  };
   cut(run.conventional.samples);
   cut(run.compensated.samples);
   cut(run.tracking_only);

@@ -8,8 +8,8 @@
 #include <span>
 #include <string>
 
-#include "hexatwist/error.hpp"
 #include "csv.hpp"
+#include "hexatwist/error.hpp"
 
 namespace hexatwist {
 namespace {
@@ -212,8 +212,7 @@ Trajectory sweep_trajectory(int coordinate, double amplitude, const MotionLimits
 
 Trajectory waypoint_trajectory(std::span<const Vector6d> waypoints, const MotionLimits& limits, double dwell,
                                double dt) {
-  if (waypoints.size() < 2)
-    throw Error(fmt::format("waypoints: expected at least 2 poses, got {}", waypoints.size()));
+  if (waypoints.size() < 2) throw Error(fmt::format("waypoints: expected at least 2 poses, got {}", waypoints.size()));
   for (std::size_t k = 0; k < waypoints.size(); ++k)
     if (!waypoints[k].allFinite()) throw Error(fmt::format("waypoints: pose {} is not finite", k + 1));
   check_dwell_and_period(dwell, dt, "waypoints");
@@ -295,7 +294,8 @@ Vector6d read_row(const detail::CsvReader& r, const detail::CsvLine& line, const
                        detail::printable(cells[7].text, 40), cells.size()));
   t = r.number(line, cells[0], kColumns[0].name, factor[0]);
   Vector6d q;
-  for (std::size_t c = 1; c < 7; ++c) q[static_cast<int>(c) - 1] = r.number(line, cells[c], kColumns[c].name, factor[c]);
+  for (std::size_t c = 1; c < 7; ++c)
+    q[static_cast<int>(c) - 1] = r.number(line, cells[c], kColumns[c].name, factor[c]);
   return q;
 }
 
@@ -341,8 +341,7 @@ class Pchip {
  public:
   Pchip(const TimedPoses& samples, const char* what) : samples_(samples), t_(samples.t), what_(what) {
     const std::size_t m = t_.size();
-    if (m != samples.poses.size())
-      throw Error(fmt::format("{}: {} times but {} poses", what, m, samples.poses.size()));
+    if (m != samples.poses.size()) throw Error(fmt::format("{}: {} times but {} poses", what, m, samples.poses.size()));
     if (m < 2) throw Error(fmt::format("{}: need at least 2 samples, got {}", what, m));
     const auto at = [&](std::size_t i) { return where(i); };
     q_.resize(m);

@@ -70,20 +70,11 @@ TEST(Measurement, IndexedLogWithSuffixesAndOtherColumns) {
 // containing every one of `parts`.
 void expect_log_error(const std::string& text, const PointLogFormat& format, int line, int column,
                       std::string_view name, std::initializer_list<std::string_view> parts = {}) {
-  std::string msg;
-  try {
-    (void)parse_point_log(text, "bad.csv", format);
-    ADD_FAILURE() << "parsed without error:\n" << text;
-    return;
-  } catch (const Error& e) {
-    msg = e.what();
-  }
-  SCOPED_TRACE("message: " + msg);
-  EXPECT_EQ(msg.find('\n'), std::string::npos) << "not a single line";
-  const std::string where =
-      "bad.csv:" + std::to_string(line) + ":" + std::to_string(column) + ": column '" + std::string(name) + "':";
-  EXPECT_EQ(msg.rfind(where, 0), 0u) << "does not start with " << where;
-  for (const std::string_view p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "does not name '" << p << "'";
+  SCOPED_TRACE(text);
+  test::expect_error_line(
+      [&] { (void)parse_point_log(text, "bad.csv", format); },
+      "bad.csv:" + std::to_string(line) + ":" + std::to_string(column) + ": column '" + std::string(name) + "':",
+      parts);
 }
 
 TEST(Measurement, BadLogsNameLineColumnAndColumn) {
@@ -100,11 +91,12 @@ TEST(Measurement, BadLogsNameLineColumnAndColumn) {
   expect_log_error(head + "0.02,1,2,inf\n", mm, 4, 10, "z", {"finite", "'inf'"});
   expect_log_error(head + "0.02, ,2,3\n", mm, 4, 6, "x", {"empty cell"});
   // Time stamps out of order (and an index that is not whole).
-  expect_log_error(head + "0.005,1,2,3\n", mm, 4, 1, "t", {"time 0.005 is not after 0.01 on line 3", "increasing"});
-  expect_log_error(head + "0.01,1,2,3\n", mm, 4, 1, "t", {"not after 0.01"});
+  expect_log_error(head + "0.005,1,2,3\n", mm, 4, 1, "t", {"time 0.005 s is not after 0.01 s on line 3", "increasing"});
+  expect_log_error(head + "0.01,1,2,3\n", mm, 4, 1, "t", {"not after 0.01 s"});
   PointLogFormat ix = mm;
   ix.indexed = true;
   expect_log_error("t,x,y,z\n1,0,0,0\n2.5,0,0,0\n", ix, 3, 1, "t", {"whole sample index", "'2.5'"});
+  expect_log_error("t,x,y,z\n1,0,0,0\n1,0,0,0\n", ix, 3, 1, "t", {"index 1 is not after 1 on line 2"});
   // Header.
   expect_log_error("time,x,y,z\n0,0,0,0\n", mm, 1, 1, "t", {"not in the header", "'time', 'x'", "'t' or 't_s'"});
   expect_log_error("t,x,y,x_mm,z\n", mm, 1, 7, "x", {"named twice", "'x' and 'x_mm'"});
@@ -254,6 +246,11 @@ TEST(Measurement, WithTrackerNoiseTheResidualMatchesIt) {
   report("registered home point error [m]", pos);
   EXPECT_LT(rot, 2e-5);
   EXPECT_LT(pos, 5e-6);
+  // The registration's pairs map back to their points: the worst residual is that point's.
+  ASSERT_EQ(m.registered.size(), static_cast<std::size_t>(r.count));
+  const MeasuredPoint& worst = m.points[m.registered[static_cast<std::size_t>(r.max_residual_index)]];
+  EXPECT_TRUE(worst.registered);
+  EXPECT_NEAR((apply(r.X_BT, worst.p_T) - worst.model_B).norm(), r.max_residual, 1e-15);
   // The measured error is the noise on top of the servo's own: |noise| has rms sigma sqrt(3).
   EXPECT_NEAR(m.error.rms, std::sqrt(3.0) * o.noise, 0.2 * o.noise);
 }
@@ -292,21 +289,11 @@ TEST(Measurement, LeadErrorRaisesTheErrorWithItsSignAndSize) {
   EXPECT_NEAR(top[1] / top[0], 2.0, 0.1);
 }
 
-// measure_points must throw one line starting with `start` and containing every one of `parts`.
+// measure_points must throw one line naming the log and containing every one of `parts`.
 void expect_measure_error(const ShortRun& run, const PointLog& log, const MeasurementOptions& mo,
                           std::initializer_list<std::string_view> parts) {
-  std::string msg;
-  try {
-    (void)measure_points(run.rig().model(), timed_poses(run.trajectory), log, mo);
-    ADD_FAILURE() << "measured without error";
-    return;
-  } catch (const Error& e) {
-    msg = e.what();
-  }
-  SCOPED_TRACE("message: " + msg);
-  EXPECT_EQ(msg.find('\n'), std::string::npos) << "not a single line";
-  EXPECT_EQ(msg.rfind("synthetic log:", 0), 0u);
-  for (const std::string_view p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "does not name '" << p << "'";
+  test::expect_error_line([&] { (void)measure_points(run.rig().model(), timed_poses(run.trajectory), log, mo); },
+                          "synthetic log:", parts);
 }
 
 TEST(Measurement, BadLogsForTheRunAreOneLineErrors) {
@@ -319,8 +306,9 @@ TEST(Measurement, BadLogsForTheRunAreOneLineErrors) {
   // A point outside the trajectory's time span: a clock offset the wrong way.
   mo.time.offset = -0.5;
   const std::size_t last = log.log.points_T.size() - 1;
-  expect_measure_error(run, log.log, mo,
-                       {":" + std::to_string(log.log.lines[last - 49]) + ":1: point at t = ", "outside", "time offset"});
+  expect_measure_error(
+      run, log.log, mo,
+      {":" + std::to_string(log.log.lines[last - 49]) + ":1: point at t = ", "outside", "time offset"});
   mo.time.offset = 0.0;
   // A window without three points at rest: the first two points only.
   mo.window.first = 2;

@@ -40,8 +40,8 @@ TEST(Synthesis, NoiseFreePointsAreTheSimulatedPointInTheTrackerFrame) {
     EXPECT_EQ(log.log.stamps[k], s.time);
     EXPECT_EQ(log.log.lines[k], static_cast<int>(k) + 2);
     // Without parameter errors the real platform is the simulated one.
-    const Vector3d p_B = platform_point_B(model, placement_from_pose(Pose::from_vector(s.actual)),
-                                          model.spec().observation_P);
+    const Vector3d p_B =
+        platform_point_B(model, placement_from_pose(Pose::from_vector(s.actual)), model.spec().observation_P);
     worst = std::max(worst, (apply(log.X_BT, log.log.points_T[k]) - p_B).norm());
     worst = std::max(worst, (log.true_B[k] - p_B).norm());
   }
@@ -72,10 +72,10 @@ TEST(Synthesis, ParameterErrorsMoveThePointsAsTheRealPlatformDoes) {
     ASSERT_EQ(forward_kinematics(real, motor, LengthKind::Motor, Placement{}, fk), Status::Ok);
     worst = std::max(worst, (platform_point_B(real, fk.placement, real.spec().observation_P) - log.true_B[k]).norm());
     const Model& model = config.rig.model();
-    moved = std::max(moved, (platform_point_B(model, placement_from_pose(Pose::from_vector(s.actual)),
-                                              model.spec().observation_P) -
-                             log.true_B[k])
-                                .norm());
+    moved = std::max(
+        moved, (platform_point_B(model, placement_from_pose(Pose::from_vector(s.actual)), model.spec().observation_P) -
+                log.true_B[k])
+                   .norm());
   }
   report("synthetic real point minus FK from home [m]", worst);
   EXPECT_LT(worst, 1e-10);

@@ -51,7 +51,8 @@ Run build_run(const Config& config, const RunOptions& o) {
     run.commanded = timed_poses(run.test.trajectory);
     return run;
   }
-  throw ExitError(kExitBadInput, fmt::format("--test: unknown test '{}'; expected Lz, Lx, Rz or Ry", printable(o.test)));
+  throw ExitError(kExitBadInput,
+                  fmt::format("--test: unknown test '{}'; expected Lz, Lx, Rz or Ry", printable(o.test)));
 }
 
 Strategy strategy_of(const RunOptions& o) {
@@ -97,7 +98,7 @@ std::string truth_json(const Config& config, const SynthOptions& o, const Run& r
       .field("strategy", o.run.strategy)
       .field("points", static_cast<int>(log.log.points_T.size()))
       .field("rate", so.rate)
-      .field("seed", static_cast<double>(so.seed));
+      .field("seed", so.seed);
   j.key("calibration_end");
   std::isfinite(run.calibration_end) ? j.value(run.calibration_end) : j.null();
   j.key("X_BT").begin_object();
@@ -143,15 +144,17 @@ int run_synth(const SynthOptions& o) {
     so.errors.zero_offset = random_zero_offsets(
         parse_numbers(o.offsets_mm, 1, "--offsets-mm", "a bound [mm], or six offsets [mm]")[0] / 1e3, o.seed);
   else
-    for (int i = 0; const double v : parse_numbers(o.offsets_mm, 6, "--offsets-mm", "a bound [mm], or six offsets [mm]"))
+    for (int i = 0;
+         const double v : parse_numbers(o.offsets_mm, 6, "--offsets-mm", "a bound [mm], or six offsets [mm]"))
       so.errors.zero_offset[i++] = v / 1e3;
   const std::vector<double> point = parse_numbers(o.point_offset_mm, 3, "--point-offset-mm", "x,y,z [mm]");
   so.errors.observation_offset_P = Vector3d(point[0], point[1], point[2]) / 1e3;
 
   SimulationIssue issue;
   if (const Status s = check_trajectory(rig, run.test.trajectory, issue); s != Status::Ok)
-    throw ExitError(kExitOutOfLimit, fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
-                                                 is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+    throw ExitError(kExitOutOfLimit,
+                    fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
+                                is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
   SyntheticLog log;
   if (const Status s = synthesize(rig, run.test.trajectory, so, log, issue); s != Status::Ok)
     throw ExitError(kExitOutOfLimit,
@@ -175,11 +178,11 @@ int run_synth(const SynthOptions& o) {
   std::string text = fmt::format("hexatwist synth on {}: {}\n", model_source(o.run.model), rig.model().spec().name);
   text += fmt::format("run: {}, {} commands, {:.2f} s: {} points at {:g} Hz\n", run.test.description, o.run.strategy,
                       run.test.trajectory.duration(), log.log.points_T.size(), so.rate);
-  text += fmt::format(
-      "real platform: lead {:+g}% ({:g} mm), twist sign {}, zero offsets [{}] mm, point offset [{}] mm\n",
-      o.lead_error_pct, 1e3 * rig.model().leg(0).lead * (1.0 + so.errors.lead_error),
-      so.errors.flip_twist_sign ? "flipped" : "as modelled", mm_list(so.errors.zero_offset),
-      mm_list(so.errors.observation_offset_P));
+  text +=
+      fmt::format("real platform: lead {:+g}% ({:g} mm), twist sign {}, zero offsets [{}] mm, point offset [{}] mm\n",
+                  o.lead_error_pct, 1e3 * rig.model().leg(0).lead * (1.0 + so.errors.lead_error),
+                  so.errors.flip_twist_sign ? "flipped" : "as modelled", mm_list(so.errors.zero_offset),
+                  mm_list(so.errors.observation_offset_P));
   text += fmt::format("tracker: origin ({:.3f}, {:.3f}, {:.3f}) m in the base frame, noise {:g} um per axis, seed {}\n",
                       origin.x(), origin.y(), origin.z(), o.noise_um, o.seed);
   text += fmt::format("wrote {} and {}", out, truth);
@@ -218,8 +221,9 @@ PointLogFormat log_format(const MeasureOptions& o) {
     begin = comma + 1;
   }
   if (names.size() != 4 || std::find(names.begin(), names.end(), std::string()) != names.end())
-    throw ExitError(kExitBadInput, fmt::format("--columns: expected four column names (time or index, x, y, z), got '{}'",
-                                               printable(o.columns)));
+    throw ExitError(
+        kExitBadInput,
+        fmt::format("--columns: expected four column names (time or index, x, y, z), got '{}'", printable(o.columns)));
   f.time_column = names[0];
   f.x_column = names[1];
   f.y_column = names[2];
@@ -280,20 +284,21 @@ int run_measure(const MeasureOptions& o) {
     std::size_t drop = 0;
     while (drop < t.trajectory.poses.size() && t.trajectory.time(drop) <= m.window_end) ++drop;
     t.trajectory.t0 = t.trajectory.time(drop);
-    t.trajectory.poses.erase(t.trajectory.poses.begin(), t.trajectory.poses.begin() + static_cast<std::ptrdiff_t>(drop));
+    t.trajectory.poses.erase(t.trajectory.poses.begin(),
+                             t.trajectory.poses.begin() + static_cast<std::ptrdiff_t>(drop));
     const StrategyRun& sim = mo.strategy == Strategy::Compensated ? t.run.compensated : t.run.conventional;
     measured.simulated = simulated_errors(sim.samples, m);
     measured.simulated_stats = error_stats(measured.simulated);
     const Registration& reg = m.registration;
-    const MeasuredPoint& worst = m.points[static_cast<std::size_t>(reg.max_residual_index)];
+    const MeasuredPoint& worst = m.points[m.registered[static_cast<std::size_t>(reg.max_residual_index)]];
     std::string s = fmt::format("points: {}: {} points, t = {:.3f} to {:.3f} s; {} commands\n", printable(o.points),
                                 m.points.size(), m.points.front().time, m.points.back().time, o.run.strategy);
     s += fmt::format(
-        "registration: {} points at rest of the {} in {} (t <= {:.3f} s): rms residual {:.4f} mm, largest {:.4f} mm "
-        "(line {}), noise {:.4f} mm per axis, condition {:.3g}\n",
+        "registration: on the {} points at rest among the {} of {} (t <= {:.3f} s): rms residual {:.4f} mm, largest "
+        "{:.4f} mm (line {}), noise {:.4f} mm per axis, condition {:.3g}\n",
         reg.count, m.window, window, m.window_end, 1e3 * reg.rms_residual, 1e3 * reg.max_residual, worst.line,
         1e3 * reg.sigma, reg.condition);
-    s += fmt::format("evaluated: the {} points after it, against the simulation of the same run\n",
+    s += fmt::format("evaluated: the {} points after the window, against the simulation of the same run\n",
                      m.points.size() - m.window);
     t.measured = std::move(measured);
     return s;
@@ -325,7 +330,8 @@ Command make_synth_command(CLI::App& root) {
                   "Zero-length offset of each leg's motor-side length [mm]: one number B draws each uniformly in "
                   "[-B, B] (seeded); six comma-separated numbers give them")
       ->capture_default_str();
-  app->add_option("--point-offset-mm", o->point_offset_mm, "Real minus modelled observation point, x,y,z [mm, platform]")
+  app->add_option("--point-offset-mm", o->point_offset_mm,
+                  "Real minus modelled observation point, x,y,z [mm, platform]")
       ->capture_default_str();
   app->add_option("--out", o->out, "The CSV to write (default tracker_<test>.csv); the truth goes beside it");
   return {app, [o] { return run_synth(*o); }};
@@ -350,11 +356,11 @@ Command make_measure_command(CLI::App& root) {
       ->check(CLI::IsMember({"mm", "m"}));
   app->add_flag("--index", o->index, "The time column is a sample index; give --rate");
   app->add_option("--rate", o->rate, "Samples per second of an indexed log [Hz]");
-  app->add_option("--time-offset", o->time_offset,
-                  "The log's time (or index/rate) when the trajectory's time is 0 [s]")
+  app->add_option("--time-offset", o->time_offset, "The log's time (or index/rate) when the trajectory's time is 0 [s]")
       ->capture_default_str();
-  auto* until = app->add_option("--register-until", o->register_until,
-                                "Register on the points with t <= SECONDS (default with --test: the calibration moves)");
+  auto* until =
+      app->add_option("--register-until", o->register_until,
+                      "Register on the points with t <= SECONDS (default with --test: the calibration moves)");
   auto* first = app->add_option("--register-first", o->register_first, "Or on the first N points of the log");
   until->excludes(first);
   app->add_option("--settle", o->settle,

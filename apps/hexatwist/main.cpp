@@ -53,9 +53,9 @@ int main(int argc, char** argv) {
       if (word.starts_with("-")) continue;
       for (const Command& c : commands) chosen = chosen || c.app->get_name() == word;
       if (chosen) break;
-      print_error(
-          "hexatwist: error: ",
-          fmt::format("unknown subcommand '{}'; expected study, simulate, synth, measure, stream, ik, fk or config (see --help)", word));
+      print_error("hexatwist: error: ", fmt::format("unknown subcommand '{}'; expected study, simulate, synth, "
+                                                    "measure, stream, ik, fk or config (see --help)",
+                                                    word));
       return kExitBadInput;
     }
     print_error("hexatwist: error: ", fmt::format("{} (see --help)", e.what()));

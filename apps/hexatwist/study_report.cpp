@@ -134,6 +134,11 @@ void stats_json(JsonWriter& j, const StrategyRun& r, const Rig& rig) {
       .end_object();
 }
 
+// The log line of the registration point with the largest residual.
+int worst_line(const Measurement& m) {
+  return m.points[m.registered[static_cast<std::size_t>(m.registration.max_residual_index)]].line;
+}
+
 void measured_json(JsonWriter& j, const ReportedMeasurement& r) {
   const Measurement& m = r.measurement;
   const Registration& reg = m.registration;
@@ -155,7 +160,7 @@ void measured_json(JsonWriter& j, const ReportedMeasurement& r) {
   j.key("t_BT").vector(reg.X_BT.t);
   j.field("rms_residual", reg.rms_residual)
       .field("max_residual", reg.max_residual)
-      .field("max_residual_line", m.points[static_cast<std::size_t>(std::max(reg.max_residual_index, 0))].line)
+      .field("max_residual_line", worst_line(m))
       .field("sigma", reg.sigma)
       .field("condition", reg.condition)
       .field("reflection", reg.reflection)
@@ -249,7 +254,9 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
     for (const bool simulated : {false, true}) {
       s += fmt::format("| experiment | {} |", simulated ? "simulated at the measured times" : "measured");
       for (const ReportedTest& t : tests) {
-        const ErrorStats* st = !t.measured ? nullptr : simulated ? &t.measured->simulated_stats : &t.measured->measurement.error;
+        const ErrorStats* st = !t.measured ? nullptr
+                               : simulated ? &t.measured->simulated_stats
+                                           : &t.measured->measurement.error;
         s += st != nullptr ? fmt::format(" {} | {} |", mm(st->max), mm(st->rms)) : std::string(" | |");
       }
       s += "\n";
@@ -260,12 +267,14 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
       const Measurement& m = r.measurement;
       const Registration& reg = m.registration;
       s += fmt::format(
-          "\n**{}**: measured points `{}`, {} commands. The tracker frame was registered on {} points at rest of {} "
-          "points in {} (t <= {:.3f} s): rms residual {} mm, largest {} mm (line {}), noise estimate {} mm per axis, "
-          "condition {:.3g}. The {} points after it are evaluated (`{}_measured.csv`, `{}_measured.png`).\n",
-          t.name, r.source, strategy_name(r.strategy), reg.count, m.window, r.window, m.window_end, mm(reg.rms_residual),
-          mm(reg.max_residual), m.points[static_cast<std::size_t>(std::max(reg.max_residual_index, 0))].line,
-          mm(reg.sigma), reg.condition, m.points.size() - m.window, t.name, t.name);
+          "\n**{}**: measured points `{}`, {} commands. The tracker frame was registered on the {} points at rest "
+          "among "
+          "the {} of {} (t <= {:.3f} s): rms residual {} mm, largest {} mm (line {}), noise estimate {} mm per axis, "
+          "condition {:.3g}. The {} points after them are evaluated (`{}_measured.csv`, `{}_measured.png`).\n",
+          t.name, r.source, strategy_name(r.strategy), reg.count, m.window, r.window, m.window_end,
+          mm(reg.rms_residual), mm(reg.max_residual),
+          worst_line(m), mm(reg.sigma), reg.condition,
+          m.points.size() - m.window, t.name, t.name);
     }
   }
   if (const std::string notes = report_notes(rig, tests); !notes.empty()) s += "\n" + notes;
@@ -295,7 +304,8 @@ Figure measured_figure(const fs::path& dir, const ReportedTest& t) {
   Series measured{fmt::format("measured ({})", strategy), {}, {}, Series::Style::Solid};
   Series simulated{fmt::format("simulated ({}, closed loop)", strategy), {}, {}, Series::Style::Dashed};
   std::array<Series, 3> axes;
-  for (int a = 0; a < 3; ++a) axes[static_cast<std::size_t>(a)].label = fmt::format("{} (base frame)", kCoordinateNames[a]);
+  for (int a = 0; a < 3; ++a)
+    axes[static_cast<std::size_t>(a)].label = fmt::format("{} (base frame)", kCoordinateNames[a]);
   for (std::size_t k = m.window; k < m.points.size(); ++k) {
     const MeasuredPoint& p = m.points[k];
     const double x = displacement(t, p.time, p.desired);
@@ -492,12 +502,14 @@ std::string summary_table(const std::vector<ReportedTest>& tests) {
     for (const ReportedTest& t : tests) s += fmt::format(" {:>10}", mm(row.stats(t).max));
     s += "\n";
   }
-  for (const ReportedTest& m : tests) {
-    if (!m.measured) continue;
-    s += fmt::format("{:<13} {:<14}", "experiment", strategy_name(m.measured->strategy));
-    for (const ReportedTest& t : tests) s += fmt::format(" {:>10}", t.measured ? mm(t.measured->measurement.error.max) : "");
+  // The experiment: one row per strategy measured.
+  for (const Strategy strategy : {Strategy::Conventional, Strategy::Compensated}) {
+    const auto measured = [strategy](const ReportedTest& t) { return t.measured && t.measured->strategy == strategy; };
+    if (std::none_of(tests.begin(), tests.end(), measured)) continue;
+    s += fmt::format("{:<13} {:<14}", "experiment", strategy_name(strategy));
+    for (const ReportedTest& t : tests)
+      s += fmt::format(" {:>10}", measured(t) ? mm(t.measured->measurement.error.max) : std::string());
     s += "\n";
-    break;
   }
   return s;
 }

@@ -14,9 +14,9 @@ namespace hexatwist::cli {
 
 /// A point log measured on the test (`hexatwist measure`), reported beside the simulation.
 struct ReportedMeasurement {
-  std::string source;             ///< the point log's file
+  std::string source;                         ///< the point log's file
   Strategy strategy = Strategy::Compensated;  ///< the commands the platform ran
-  std::string window;             ///< how the registration window was chosen, for the reader
+  std::string window;                         ///< how the registration window was chosen, for the reader
   Measurement measurement;
   std::vector<double> simulated;  ///< simulated error of the same strategy at each evaluated point [m]
   ErrorStats simulated_stats;     ///< statistics of `simulated` [m]

@@ -74,9 +74,9 @@ std::vector<double> trajectory_times(const PointLog& log, const TimeAlignment& a
 /// registered. The paper registers on "the home pose and the first calibration moves"; a sweep
 /// alone cannot do it (the points of Lz and Lx lie on a line).
 struct CalibrationSpec {
-  double step = 0.2;                      ///< each station's translation from home along x, y and z [m]
-  MotionLimits limits{0.2, 0.5, 2.5};     ///< the moves between stations [m/s, m/s^2, m/s^3] (the study's)
-  double dwell = 1.0;                     ///< rest at each station [s]
+  double step = 0.2;                   ///< each station's translation from home along x, y and z [m]
+  MotionLimits limits{0.2, 0.5, 2.5};  ///< the moves between stations [m/s, m/s^2, m/s^3] (the study's)
+  double dwell = 1.0;                  ///< rest at each station [s]
 };
 
 /// A measured test: at rest at home, then translations to +step along x, y and z in turn and back
@@ -115,22 +115,25 @@ struct MeasurementOptions {
 
 /// One measured point.
 struct MeasuredPoint {
-  double time = 0.0;                       ///< trajectory time [s]
-  int line = 0;                            ///< source line
-  Vector3d p_T = Vector3d::Zero();         ///< as measured [m, T]
-  Vector3d p_B = Vector3d::Zero();         ///< registered: X_BT p_T [m, B]
-  Vector6d desired = Vector6d::Zero();     ///< commanded pose [m, rad]
-  Vector3d desired_B = Vector3d::Zero();   ///< the observation point at the commanded pose [m, B]
-  Vector3d error_B = Vector3d::Zero();     ///< p_B - desired_B [m, B]
-  bool in_window = false;                  ///< in the registration window
-  bool registered = false;                 ///< one of the registration's points (in the window, at rest)
-  Vector3d model_B = Vector3d::Zero();     ///< for a registration point: its model position [m, B]
+  double time = 0.0;                      ///< trajectory time [s]
+  int line = 0;                           ///< source line
+  Vector3d p_T = Vector3d::Zero();        ///< as measured [m, T]
+  Vector3d p_B = Vector3d::Zero();        ///< registered: X_BT p_T [m, B]
+  Vector6d desired = Vector6d::Zero();    ///< commanded pose [m, rad]
+  Vector3d desired_B = Vector3d::Zero();  ///< the observation point at the commanded pose [m, B]
+  Vector3d error_B = Vector3d::Zero();    ///< p_B - desired_B [m, B]
+  bool in_window = false;                 ///< in the registration window
+  bool registered = false;                ///< one of the registration's points (in the window, at rest)
+  Vector3d model_B = Vector3d::Zero();    ///< for a registration point: its model position [m, B]
 };
 
 /// A processed point log.
 struct Measurement {
   std::vector<MeasuredPoint> points;
   Registration registration;  ///< X_BT and its fit: residuals, noise estimate, condition
+  /// The points that registered, in the order of the registration's pairs: points[registered[i]]
+  /// is pair i (so the worst is points[registered[registration.max_residual_index]]).
+  std::vector<std::size_t> registered;
   std::size_t window = 0;     ///< points in the registration window (points[0 .. window-1])
   double window_end = 0.0;    ///< trajectory time of the window's last point [s]
   /// The evaluated points are those after the window (the registration fits the window's

@@ -29,9 +29,9 @@ struct SyntheticLog {
   /// The log as a tracker would give it: stamps are the trajectory's time [s]; points [m, T];
   /// lines as in a CSV with one header line (point k on line k + 2).
   PointLog log;
-  RigidTransform X_BT;                 ///< the tracker frame in the base frame (what registration finds)
-  std::vector<Vector3d> true_B;        ///< the real observation point at each point, before transform and noise [m, B]
-  std::vector<std::size_t> ticks;      ///< the simulation tick of each point
+  RigidTransform X_BT;             ///< the tracker frame in the base frame (what registration finds)
+  std::vector<Vector3d> true_B;    ///< the real observation point at each point, before transform and noise [m, B]
+  std::vector<std::size_t> ticks;  ///< the simulation tick of each point
   std::vector<SimulationSample> simulation;  ///< the closed loop on the nominal model, every tick
 };
 
