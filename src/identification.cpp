@@ -79,7 +79,7 @@ class Evaluator {
       Vector6d r = o.motor + p.length_offset;
       Vector6d r_lead = Vector6d::Zero();
       if (travel) {
-        const Vector6d turned = (o.motor - home_command_).cwiseProduct(inverse_lead_);  // screw turns x 2 pi
+        const Vector6d turned = (o.motor - home_command_).cwiseProduct(inverse_lead_);  // screw revolutions
         r += turned * p.lead - (o.motor - home_command_);
         r_lead = turned;
       }
@@ -123,7 +123,7 @@ class Evaluator {
   const IdentificationOptions& options_;
   std::vector<Placement> guess_;
   Vector6d home_command_;  // motor-side length at which the encoders read zero (home) [m]
-  Vector6d inverse_lead_;  // 1 / nominal lead: the drives' screw turns per metre commanded, x 2 pi
+  Vector6d inverse_lead_;  // 1 / nominal lead: the drives' screw revolutions per metre commanded
   int failed_index_ = -1;
 };
 
