@@ -27,7 +27,7 @@ Matrix3d skew(const Vector3d& v) {
 }
 
 // The platform's residuals e_k = X_BT p_T,k - A_B,k and their Jacobian with respect to lead,
-// offsets and A, through twist-aware forward kinematics of every observation (theory §12). Each
+// offsets and A, through twist-aware forward kinematics of every observation (theory §13). Each
 // observation's last solution is the next start, so a solver's small steps cost one or two Newton
 // iterations each.
 class Evaluator {
@@ -75,11 +75,11 @@ class Evaluator {
     Vector6d dtheta;
     for (std::size_t k = 0; k < observations_.size(); ++k) {
       const Observation& o = observations_[k];
-      // Real motor-side lengths r = m + delta (+ the travel at the real lead, theory §12).
+      // Real motor-side lengths r = m + delta (+ the travel at the real lead, theory §13).
       Vector6d r = o.motor + p.length_offset;
       Vector6d r_lead = Vector6d::Zero();
       if (travel) {
-        const Vector6d turned = (o.motor - home_command_).cwiseProduct(inverse_lead_);  // screw turns x 2 pi
+        const Vector6d turned = (o.motor - home_command_).cwiseProduct(inverse_lead_);  // screw revolutions
         r += turned * p.lead - (o.motor - home_command_);
         r_lead = turned;
       }
@@ -95,7 +95,7 @@ class Evaluator {
       if (J == nullptr) continue;
 
       // Implicit function theorem on f(x, theta) = g(x; lead) - r(theta) = 0 at the solution:
-      // dx/dtheta = -J_f_x^-1 df/dtheta, with g = |L| - sign lead / 2pi dtheta (theory §5, §12).
+      // dx/dtheta = -J_f_x^-1 df/dtheta, with g = |L| - sign lead / 2pi dtheta (theory §5, §13).
       Status s = length_jacobian(*model, fk.legs, LengthKind::Motor, J_f_x);
       if (s == Status::Ok) s = twist(*model, fk.legs, dtheta);
       if (s != Status::Ok) {
@@ -123,7 +123,7 @@ class Evaluator {
   const IdentificationOptions& options_;
   std::vector<Placement> guess_;
   Vector6d home_command_;  // motor-side length at which the encoders read zero (home) [m]
-  Vector6d inverse_lead_;  // 1 / nominal lead: the drives' screw turns per metre commanded, x 2 pi
+  Vector6d inverse_lead_;  // 1 / nominal lead: the drives' screw revolutions per metre commanded
   int failed_index_ = -1;
 };
 

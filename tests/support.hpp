@@ -80,6 +80,13 @@ inline Pose random_valid_pose(const Model& model, std::mt19937_64& rng, double d
   }
 }
 
+/// The seed platform with zero errors (length offsets) drawn uniformly in [-max_offset, max_offset] [m].
+inline Model seed_with_offsets(std::mt19937_64& rng, double max_offset) {
+  ModelSpec spec = seed_model().spec();
+  for (LegSpec& leg : spec.legs) leg.length_offset = uniform(rng, -max_offset, max_offset);
+  return Model(spec);
+}
+
 /// A random, asymmetric but well-conditioned platform: joints scattered around two circles,
 /// fixed axes tilted at random, a random lead and sign of the twist term.
 inline Model random_platform(std::mt19937_64& rng) {

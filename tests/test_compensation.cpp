@@ -112,9 +112,7 @@ TEST(Compensation, BothCommandsTakeTheLengthOffsetsOut) {
   // A leg whose real length is its motor-side length + delta is commanded delta shorter, with
   // the twist compensated or not; the compensated command still lands exactly on the pose.
   std::mt19937_64 rng(kSeed + 21);
-  ModelSpec spec = seed_model().spec();
-  for (LegSpec& leg : spec.legs) leg.length_offset = uniform(rng, -1e-3, 1e-3);
-  const Model offset(spec);
+  const Model offset = seed_with_offsets(rng, 1e-3);
   const Vector6d& delta = offset.geometry().length_offset;
   for (int n = 0; n < 200; ++n) {
     const Pose p = random_valid_pose(seed_model(), rng, 0.4, deg2rad(25));

@@ -132,9 +132,7 @@ TEST(Forward, MotorModeTakesTheLengthOffsetsOutAndGeometricModeIgnoresThem) {
   // Motor-side lengths m of a platform with offsets delta are m0 - delta, m0 those without: both
   // models must give the same pose for their own lengths. Geometric lengths have no offset.
   std::mt19937_64 rng(kSeed + 40);
-  ModelSpec spec = seed_model().spec();
-  for (LegSpec& leg : spec.legs) leg.length_offset = uniform(rng, -2e-3, 2e-3);
-  const Model offset(spec);
+  const Model offset = seed_with_offsets(rng, 2e-3);
   const Vector6d& delta = offset.geometry().length_offset;
   double worst = 0.0;
   for (int n = 0; n < 200; ++n) {

@@ -1,7 +1,7 @@
 // Identification of what the model needs from tracker measurements (issue 5): the screw lead, the
 // sign of the twist term, the legs' zero-length offsets, the observation point and the tracker
 // frame, by nonlinear least squares on the observation point's positions at commanded motor-side
-// lengths, with standard deviations and an identifiability check. Theory: docs/theory.md §12.
+// lengths, with standard deviations and an identifiability check. Theory: docs/theory.md §13.
 #pragma once
 
 #include <array>
@@ -25,7 +25,7 @@ struct Observation {
   Vector3d p_T = Vector3d::Zero();    ///< measured observation point [m, T]
 };
 
-/// How a lead that differs from the nominal one shows in the measurements (theory §12).
+/// How a lead that differs from the nominal one shows in the measurements (theory §13).
 enum class LeadEffect {
   TwistOnly,       ///< through the twist term only: the commanded lengths are the real motor-side lengths
   TwistAndTravel,  ///< also through the travel: the drives turned the screws by the nominal lead's angles
@@ -61,15 +61,15 @@ struct IdentificationOptions {
   LeadEffect lead_effect = LeadEffect::TwistOnly;  ///< measurement model of the lead
   int max_iterations = 100;                        ///< solver iterations per sign
   /// Largest accepted condition number of the column-scaled Jacobian; above it some parameter
-  /// combination is undetermined (exact confounding gives about 1e16).
+  /// combination is undetermined (exact confounding gives about 1e15).
   double max_condition = 1e8;
   FkOptions fk;  ///< forward kinematics of every observation
 };
 
 /// The solve with the twist sign held at one value.
 struct SignFit {
-  double twist_sign = 0.0;                ///< the sign held
-  Status status = Status::NoConvergence;  ///< Ok, SolverNoConvergence or what forward kinematics returned
+  double twist_sign = 0.0;                      ///< the sign held
+  Status status = Status::SolverNoConvergence;  ///< Ok, SolverNoConvergence or what forward kinematics returned
   double cost = std::numeric_limits<double>::infinity();  ///< half the sum of squared residuals at the end [m^2]
   int iterations = 0;                                     ///< solver iterations
   bool lead_at_bound = false;                             ///< the lead ended at 0: this sign cannot explain the data
@@ -115,7 +115,8 @@ struct Identification {
 /// Residuals e_k = X_BT p_T,k - A_B,k of the candidate `p` (3K, observation k at rows 3k..3k+2)
 /// [m, B], and optionally their Jacobian (3K x 16) with respect to the parameters in the order
 /// of ParameterVector (rotation as the left perturbation dw). Forward kinematics starts from home
-/// for every observation. Returns Ok or the first failing forward kinematics status.
+/// for every observation. TwistAndTravel needs nominal leads > 0 (identify checks it). Returns Ok
+/// or the first failing forward kinematics status.
 [[nodiscard]] Status identification_residuals(const Model& nominal, std::span<const Observation> observations,
                                               const PlatformParameters& p, const IdentificationOptions& options,
                                               Eigen::VectorXd& residuals, Eigen::MatrixXd* J);

@@ -1,7 +1,7 @@
 // What a real platform may have that its nominal model does not, in the parameters a laser tracker
 // can reveal: the screw lead, the sign of the twist term, each leg's zero-length offset and the
 // observation point. `hexatwist synth` builds a platform with known errors from these; an
-// identification estimates them (docs/theory.md §12).
+// identification estimates them (docs/theory.md §12, §13).
 #pragma once
 
 #include "hexatwist/model.hpp"
