@@ -408,10 +408,10 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
       return fail(Status::NotIdentifiable,
                   fmt::format("leg {} has lead 0 in the nominal model: the drives' travel is unknown", i + 1));
   }
-  if (3 * K <= kIdentifiedParameters)
+  if (K < kMinObservations)
     return fail(Status::NotIdentifiable,
-                fmt::format("{} observations give {} equations for {} parameters; at least 6 are needed", K, 3 * K,
-                            kIdentifiedParameters));
+                fmt::format("{} observations give {} equations for {} parameters; at least {} are needed", K, 3 * K,
+                            kIdentifiedParameters, kMinObservations));
 
   // Start: the nominal model, the tracker frame by Kabsch onto its predictions of A.
   PlatformParameters start;

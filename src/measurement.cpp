@@ -14,6 +14,7 @@
 #include "hexatwist/compensation.hpp"
 #include "hexatwist/error.hpp"
 #include "hexatwist/forward.hpp"
+#include "random.hpp"
 
 namespace hexatwist {
 namespace {
@@ -197,6 +198,54 @@ Trajectory measured_test_trajectory(const StudySpec& study, const StudyTest& tes
   return traj;
 }
 
+namespace {
+
+// True if `pose` and the poses every 5 mm (5 mrad) on the straight line from `from` to it are
+// inside every limit for the commands of `strategy`.
+bool reachable_from(const Model& model, Strategy strategy, const Vector6d& from, const Vector6d& pose) {
+  constexpr double kCheckStep = 5e-3;  // [m or rad]
+  const int steps = std::max(1, static_cast<int>(std::ceil((pose - from).norm() / kCheckStep)));
+  Vector6d command;
+  LimitReport limit;
+  for (int j = 1; j <= steps; ++j) {
+    const Vector6d q = from + (pose - from) * (static_cast<double>(j) / steps);
+    if (motor_commands(model, Pose::from_vector(q), strategy, command, limit) != Status::Ok) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+Trajectory stations_trajectory(const Model& model, Strategy strategy, const StationsSpec& spec, double dt) {
+  constexpr int kMaxStations = 10000, kMaxDraws = 1000;
+  if (spec.count < 1 || spec.count > kMaxStations)
+    throw Error(fmt::format("stations: expected 1 to {} stations, got {}", kMaxStations, spec.count));
+  if (!(std::isfinite(spec.translation) && spec.translation >= 0.0 && std::isfinite(spec.rotation) &&
+        spec.rotation >= 0.0))
+    throw Error(fmt::format("stations: expected finite ranges >= 0, got ±{} m and ±{} rad", spec.translation,
+                            spec.rotation));
+  detail::Random rng(spec.seed);
+  std::vector<Vector6d> waypoints{Vector6d::Zero()};
+  for (int i = 0; i < spec.count; ++i) {
+    for (int draw = 0;; ++draw) {
+      if (draw == kMaxDraws)
+        throw Error(fmt::format("stations: station {}: no pose within ±{} m and ±{} rad drawn in {} tries is "
+                                "reachable inside the limits; give smaller ranges",
+                                i + 1, spec.translation, spec.rotation, kMaxDraws));
+      Vector6d q;
+      for (int c = 0; c < 6; ++c) q[c] = (c < 3 ? spec.translation : spec.rotation) * rng.symmetric();
+      // The way home from the last station is checked with it.
+      if (reachable_from(model, strategy, waypoints.back(), q) &&
+          (i + 1 < spec.count || reachable_from(model, strategy, q, Vector6d::Zero()))) {
+        waypoints.push_back(q);
+        break;
+      }
+    }
+  }
+  waypoints.push_back(Vector6d::Zero());
+  return waypoint_trajectory(waypoints, spec.limits, spec.dwell, dt);
+}
+
 // ---- registration and errors ------------------------------------------------------------------
 
 namespace {
@@ -225,27 +274,43 @@ bool at_rest(const TimedPoses& commanded, double t, const Vector6d& pose, double
   return true;
 }
 
+// "log:line:column" of point k, for messages.
+std::string point_location(const PointLog& log, std::size_t k) {
+  return fmt::format("{}:{}:{}", log.source, log.lines[k], k < log.stamp_columns.size() ? log.stamp_columns[k] : 1);
+}
+
+// The trajectory time of every point, each checked to lie in the commanded trajectory's span.
+std::vector<double> aligned_times(const TimedPoses& commanded, const PointLog& log, const TimeAlignment& alignment) {
+  if (commanded.t.size() < 2)
+    throw Error(fmt::format("{}: the commanded trajectory has fewer than 2 poses", log.source));
+  std::vector<double> times = trajectory_times(log, alignment);
+  const double front = commanded.t.front(), back = commanded.t.back();
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    if (!(times[k] >= front - kTimeTolerance && times[k] <= back + kTimeTolerance))
+      throw Error(
+          fmt::format("{}: point at t = {} s{} is outside the commanded trajectory's time span [{}, {}] s (check the "
+                      "time offset{})",
+                      point_location(log, k), times[k],
+                      log.indexed ? fmt::format(" (index {})", log.stamps[k]) : std::string(), front, back,
+                      log.indexed ? " and the sample rate" : ""));
+    times[k] = std::clamp(times[k], front, back);
+  }
+  return times;
+}
+
+void check_settle(const std::string& source, double settle) {
+  if (!(std::isfinite(settle) && settle >= 0.0))
+    throw Error(fmt::format("{}: settle time: expected a finite number >= 0 s, got {}", source, settle));
+}
+
 }  // namespace
 
 Measurement measure_points(const Model& model, const TimedPoses& commanded, const PointLog& log,
                            const MeasurementOptions& options) {
   const std::string& src = log.source;
   const std::size_t n = log.points_T.size();
-  if (commanded.t.size() < 2) throw Error(fmt::format("{}: the commanded trajectory has fewer than 2 poses", src));
-  std::vector<double> times = trajectory_times(log, options.time);
-  const double front = commanded.t.front(), back = commanded.t.back();
-  const auto where = [&](std::size_t k) {
-    return fmt::format("{}:{}:{}", src, log.lines[k], k < log.stamp_columns.size() ? log.stamp_columns[k] : 1);
-  };
-  for (std::size_t k = 0; k < n; ++k) {
-    if (!(times[k] >= front - kTimeTolerance && times[k] <= back + kTimeTolerance))
-      throw Error(
-          fmt::format("{}: point at t = {} s{} is outside the commanded trajectory's time span [{}, {}] s (check the "
-                      "time offset{})",
-                      where(k), times[k], log.indexed ? fmt::format(" (index {})", log.stamps[k]) : std::string(),
-                      front, back, log.indexed ? " and the sample rate" : ""));
-    times[k] = std::clamp(times[k], front, back);
-  }
+  const std::vector<double> times = aligned_times(commanded, log, options.time);
+  const auto where = [&](std::size_t k) { return point_location(log, k); };
   const std::vector<Pose> desired = interpolate(commanded, times);
   const Vector3d& obs = model.spec().observation_P;
 
@@ -279,8 +344,7 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
     throw Error(fmt::format("{}: {} ({}) hold every point: no point is left after the registration to evaluate", src,
                             lines_text, window_text));
   m.window_end = times[m.window - 1];
-  if (!(std::isfinite(w.settle) && w.settle >= 0.0))
-    throw Error(fmt::format("{}: settle time: expected a finite number >= 0 s, got {}", src, w.settle));
+  check_settle(src, w.settle);
   std::vector<PointPair> pairs;
   std::vector<std::size_t>& used = m.registered;
   for (std::size_t k = 0; k < m.window; ++k) {
@@ -373,6 +437,39 @@ std::vector<double> simulated_errors(const std::vector<SimulationSample>& sample
     }
   }
   return out;
+}
+
+// ---- observations for identification ----------------------------------------------------------
+
+ObservationSet observations_at_rest(const Model& model, const TimedPoses& commanded, const PointLog& log,
+                                    const TimeAlignment& time, Strategy strategy, double settle) {
+  check_settle(log.source, settle);
+  const std::vector<double> times = aligned_times(commanded, log, time);
+  const std::vector<Pose> desired = interpolate(commanded, times);
+  ObservationSet set;
+  set.settle = settle;
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    if (!at_rest(commanded, times[k], desired[k].to_vector(), settle)) continue;
+    Observation o;
+    LimitReport limit;
+    if (const Status s = motor_commands(model, desired[k], strategy, o.motor, limit); s != Status::Ok)
+      throw Error(fmt::format("{}: the commanded pose at t = {} s is outside a limit ({}); no command reached it",
+                              point_location(log, k), times[k], describe(s)));
+    o.p_T = log.points_T[k];
+    if (set.points.empty() ||
+        (desired[k].to_vector() - desired[set.points.back()].to_vector()).cwiseAbs().maxCoeff() > kSamePose)
+      ++set.poses;
+    set.observations.push_back(o);
+    set.points.push_back(k);
+  }
+  if (set.observations.size() < static_cast<std::size_t>(kMinObservations))
+    throw Error(fmt::format(
+        "{}: only {} of the {} points {}; an identification needs at least {} (lower the settle time, or record "
+        "a run that stops at more poses: a stations run)",
+        log.source, set.observations.size(), times.size(),
+        settle > 0.0 ? fmt::format("are at rest (commanded pose unchanged for {} s)", settle) : std::string("are usable"),
+        kMinObservations));
+  return set;
 }
 
 }  // namespace hexatwist

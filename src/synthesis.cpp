@@ -3,31 +3,12 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <random>
 
 #include "hexatwist/error.hpp"
+#include "random.hpp"
 
 namespace hexatwist {
-namespace {
-
-// Random numbers from the raw output of mt19937_64, which the standard fixes bit for bit (its
-// distributions are left to each library): the same seed gives the same log everywhere.
-class Random {
- public:
-  explicit Random(std::uint64_t seed) : engine_(seed) {}
-  // Uniform in [0, 1), 53 bits.
-  double uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
-  // Standard normal (Box-Muller; 1 - u is in (0, 1], so the logarithm is finite).
-  double normal() {
-    const double r = std::sqrt(-2.0 * std::log(1.0 - uniform()));
-    return r * std::cos(2.0 * kPi * uniform());
-  }
-
- private:
-  std::mt19937_64 engine_;
-};
-
-}  // namespace
+using detail::Random;
 
 RigidTransform random_tracker_frame(std::uint64_t seed) {
   Random rng(seed);
@@ -46,7 +27,7 @@ Vector6d random_zero_offsets(double bound, std::uint64_t seed) {
   Vector6d offsets = Vector6d::Zero();
   if (bound == 0.0) return offsets;
   Random rng(seed ^ 0xD1B54A32D192ED03ull);
-  for (int i = 0; i < kLegs; ++i) offsets[i] = bound * (2.0 * rng.uniform() - 1.0);
+  for (int i = 0; i < kLegs; ++i) offsets[i] = bound * rng.symmetric();
   return offsets;
 }
 

@@ -345,5 +345,140 @@ TEST(Measurement, SimulatedErrorsAreInterpolatedBetweenTicks) {
   EXPECT_TRUE(std::isnan(e[3]));
 }
 
+// ---- stations and observations for identification ----------------------------------------------
+
+TEST(Measurement, StationsAreReachableHeldAndReproducible) {
+  const Config config = default_config();
+  const Model& model = config.rig.model();
+  const double dt = config.rig.control_period();
+  StationsSpec spec;
+  spec.count = 12;
+  spec.seed = 5;
+  const Trajectory traj = stations_trajectory(model, Strategy::Compensated, spec, dt);
+  EXPECT_EQ(traj.poses.front().to_vector(), Vector6d::Zero());
+  EXPECT_EQ(traj.poses.back().to_vector(), Vector6d::Zero());
+  // Every tick inside every limit, and the runs of ticks at one pose: home, the stations, home.
+  std::vector<Vector6d> held;
+  int run_length = 0;
+  Vector6d command;
+  LimitReport limit;
+  for (std::size_t k = 0; k < traj.poses.size(); ++k) {
+    const Vector6d q = traj.poses[k].to_vector();
+    ASSERT_EQ(motor_commands(model, traj.poses[k], Strategy::Compensated, command, limit), Status::Ok) << k;
+    run_length = (k > 0 && q == traj.poses[k - 1].to_vector()) ? run_length + 1 : 1;
+    if (run_length == static_cast<int>(std::floor(spec.dwell / dt))) held.push_back(q);
+  }
+  ASSERT_EQ(held.size(), static_cast<std::size_t>(spec.count + 2));
+  for (int i = 1; i <= spec.count; ++i) {
+    const Vector6d& q = held[static_cast<std::size_t>(i)];
+    EXPECT_LE(q.head<3>().cwiseAbs().maxCoeff(), spec.translation);
+    EXPECT_LE(q.tail<3>().cwiseAbs().maxCoeff(), spec.rotation);
+    EXPECT_GT(q.head<3>().norm(), 0.0);  // every coordinate at once
+  }
+  // The same seed gives the same run; another seed another one.
+  EXPECT_EQ(stations_trajectory(model, Strategy::Compensated, spec, dt).poses.back().to_vector(), Vector6d::Zero());
+  EXPECT_EQ(stations_trajectory(model, Strategy::Compensated, spec, dt).poses[traj.poses.size() / 2].to_vector(),
+            traj.poses[traj.poses.size() / 2].to_vector());
+  spec.seed = 6;
+  const Trajectory other = stations_trajectory(model, Strategy::Compensated, spec, dt);
+  EXPECT_NE(other.poses[other.poses.size() / 2].to_vector(), traj.poses[traj.poses.size() / 2].to_vector());
+}
+
+TEST(Measurement, StationsRefuseBadSpecsInOneLine) {
+  const Model model = test::seed_model();
+  StationsSpec spec;
+  spec.count = 0;
+  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); }, "stations:",
+                          {"1 to 10000", "got 0"});
+  spec.count = 3;
+  spec.translation = std::nan("");
+  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); }, "stations:",
+                          {"finite"});
+  // Far outside the workspace: within +-30 m, a draw inside the seed's +-0.5 m has odds of 1e-5.
+  spec.translation = 30.0;
+  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
+                          "stations: station 1:", {"1000 tries", "smaller ranges"});
+}
+
+// A stations run of the real platform (lead 5 % long, the other thread hand, offsets within
+// +-1 mm, the observation point 1-3 mm off) seen by a noisy tracker: its points at rest, with
+// the commands the drives got, identify every parameter within the issue's bounds.
+TEST(Measurement, PointsAtRestOfAStationsRunIdentifyTheRealPlatform) {
+  const Config config = default_config();
+  const Rig& rig = config.rig;
+  StationsSpec spec;
+  spec.count = 40;
+  const Trajectory traj = stations_trajectory(rig.model(), Strategy::Compensated, spec, rig.control_period());
+  SynthesisOptions o;
+  o.errors.lead_error = 0.05;
+  o.errors.flip_twist_sign = true;
+  o.errors.zero_offset = random_zero_offsets(1e-3, 11);
+  o.errors.observation_offset_P = Vector3d(2e-3, -1.5e-3, 3e-3);
+  o.seed = 11;
+  SyntheticLog log;
+  SimulationIssue issue;
+  ASSERT_EQ(synthesize(rig, traj, o, log, issue), Status::Ok) << describe(issue.status);
+
+  const ObservationSet set =
+      observations_at_rest(rig.model(), timed_poses(traj), log.log, {}, Strategy::Compensated, 0.25);
+  // At rest: 0.75 s of each 1 s rest at 100 Hz (76 points) at 42 poses, home twice.
+  EXPECT_GT(set.observations.size(), 40u * 70u);
+  EXPECT_LT(set.observations.size(), 42u * 80u);
+  for (std::size_t i = 0; i < set.points.size(); i += 97) {
+    // The command of the commanded pose, which at rest is the pose of the tick.
+    const std::size_t tick = log.ticks[set.points[i]];
+    Vector6d command;
+    LimitReport limit;
+    ASSERT_EQ(motor_commands(rig.model(), traj.poses[tick], Strategy::Compensated, command, limit), Status::Ok);
+    EXPECT_LT((set.observations[i].motor - command).cwiseAbs().maxCoeff(), 1e-12) << i;
+    EXPECT_EQ(set.observations[i].p_T, log.log.points_T[set.points[i]]);
+  }
+  IdentificationOptions io;
+  io.lead_effect = LeadEffect::TwistAndTravel;  // the synth's drives turn the screws by the nominal lead's angles
+  Identification id;
+  ASSERT_EQ(identify(rig.model(), set.observations, id, io), Status::Ok) << id.reason;
+  const PlatformParameters& e = id.estimate;
+  const double lead = rig.model().leg(0).lead * 1.05;
+  // Measured: lead 1.2e-6 relative (sd 0.9e-6), offsets within 4.3 um (sd 4.3-7.2 um), the point
+  // within 1.4 um (sd 1.4 um). The issue's bounds: 0.5 %, 20 um.
+  EXPECT_LT(std::abs(e.lead / lead - 1.0), 1e-5);
+  EXPECT_EQ(e.twist_sign, -rig.model().leg(0).twist_sign);
+  EXPECT_LT((e.length_offset - o.errors.zero_offset).cwiseAbs().maxCoeff(), 20e-6);
+  const Vector3d point = rig.model().spec().observation_P + o.errors.observation_offset_P;
+  EXPECT_LT((e.observation_P - point).cwiseAbs().maxCoeff(), 10e-6);
+  // Each error within 4 of its standard deviations, and the noise recovered.
+  const ParameterVector truth_error = (ParameterVector() << e.lead - lead, e.length_offset - o.errors.zero_offset,
+                                       e.observation_P - point, Vector6d::Zero())
+                                          .finished();
+  for (int p = 0; p < kRotationIndex; ++p) {
+    EXPECT_LT(std::abs(truth_error[p]), 4.0 * id.sd[p]) << parameter_name(p);
+    std::printf("  %-10s error %+.3g, sd %.3g\n", std::string(parameter_name(p)).c_str(), truth_error[p], id.sd[p]);
+  }
+  EXPECT_NEAR(id.sigma, o.noise, 0.05 * o.noise);
+}
+
+TEST(Measurement, TooFewPointsAtRestForAnIdentificationIsOneLine) {
+  const ShortRun run(2, deg2rad(5.0));
+  SynthesisOptions o;
+  o.seed = 3;
+  const SyntheticLog log = synth(run, o);
+  PointLog few = log.log;
+  few.stamps.resize(5);
+  few.points_T.resize(5);
+  few.lines.resize(5);
+  few.stamp_columns.resize(5);
+  test::expect_error_line(
+      [&] {
+        (void)observations_at_rest(run.rig().model(), timed_poses(run.trajectory), few, {}, Strategy::Compensated, 0.0);
+      },
+      "synthetic log: only 5 of the 5 points are usable", {"at least 6"});
+  test::expect_error_line(
+      [&] {
+        (void)observations_at_rest(run.rig().model(), timed_poses(run.trajectory), log.log, {}, Strategy::Compensated,
+                                   -1.0);
+      },
+      "synthetic log: settle time:");
+}
+
 }  // namespace
 }  // namespace hexatwist

@@ -20,6 +20,7 @@ enum ExitCode : int {
   kExitBadInput = 2,      ///< malformed input, bad configuration, unreadable file
   kExitOutOfLimit = 3,    ///< a pose outside a limit, or a forward-kinematics failure
   kExitOutputFailed = 4,  ///< an output file or figure could not be written
+  kExitNotIdentified = 5, ///< identify: the data do not determine the parameters, or the solver did not converge
 };
 
 /// A failure the tool reports as one line on stderr with its exit code.
@@ -90,5 +91,6 @@ Command make_simulate_command(CLI::App& root);
 Command make_stream_command(CLI::App& root);
 Command make_synth_command(CLI::App& root);
 Command make_measure_command(CLI::App& root);
+Command make_identify_command(CLI::App& root);
 
 }  // namespace hexatwist::cli

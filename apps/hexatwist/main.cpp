@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
   const std::vector<Command> commands{make_study_command(app),   make_simulate_command(app), make_synth_command(app),
-                                      make_measure_command(app), make_stream_command(app),   make_ik_command(app),
+                                      make_measure_command(app), make_identify_command(app), make_stream_command(app),   make_ik_command(app),
                                       make_fk_command(app),      make_config_command(app)};
   try {
     app.parse(argc, argv);

@@ -33,6 +33,8 @@ enum class LeadEffect {
 
 /// Number of continuous parameters identified: lead, six offsets, A, rotation and translation of X_BT.
 inline constexpr int kIdentifiedParameters = 16;
+/// Fewest observations an identification accepts: 3K equations must exceed the 16 parameters.
+inline constexpr int kMinObservations = kIdentifiedParameters / 3 + 1;
 /// Position of each group in ParameterVector, covariance and Jacobian columns.
 inline constexpr int kLeadIndex = 0;          ///< lead [m]
 inline constexpr int kOffsetIndex = 1;        ///< length offsets of legs 1..6 [m]

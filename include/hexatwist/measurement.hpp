@@ -6,11 +6,13 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "hexatwist/identification.hpp"
 #include "hexatwist/registration.hpp"
 #include "hexatwist/study.hpp"
 
@@ -86,6 +88,27 @@ struct CalibrationSpec {
 Trajectory measured_test_trajectory(const StudySpec& study, const StudyTest& test, const CalibrationSpec& calibration,
                                     double dt, double& calibration_end);
 
+/// A calibration run for identification (docs/theory.md §13): the platform stops at random poses
+/// spread over the workspace, every coordinate at once, so that the tracker sees the lead, the
+/// offsets and the observation point from many directions. The paper's tests alone leave some leg
+/// offsets undetermined to ±0.1 mm; 40 stations with a 1 s rest fix them to a few µm.
+struct StationsSpec {
+  int count = 40;                         ///< stations, not counting home at the start and the end
+  double translation = 0.25;              ///< each of x, y, z drawn uniformly in ±translation [m]
+  double rotation = deg2rad(15.0);        ///< each of roll, pitch, yaw drawn uniformly in ±rotation [rad]
+  MotionLimits limits{0.2, 0.5, 2.5};     ///< the moves, on the distance in pose coordinates [m or rad /s, /s^2, /s^3]
+  double dwell = 1.0;                     ///< rest at each station [s]
+  std::uint64_t seed = 1;                 ///< the same seed gives the same stations everywhere
+};
+
+/// Home, then `spec.count` stations, then home: straight moves in pose coordinates (jerk-limited,
+/// as waypoint_trajectory), `dwell` at each. A station is drawn again (up to 1000 times) while it,
+/// or a pose every 5 mm (or 5 mrad) along the move to it, is outside a limit of `model` for the
+/// commands of `strategy`. Sampled every `dt` [s] from t0 = 0. Throws hexatwist::Error for a count
+/// below 1 or above 10000, a range that is not finite and >= 0, no reachable station in 1000
+/// draws, and as waypoint_trajectory.
+Trajectory stations_trajectory(const Model& model, Strategy strategy, const StationsSpec& spec, double dt);
+
 // ---- registration and errors ------------------------------------------------------------------
 
 /// Which points register the tracker frame: a leading part of the log (the window), and of it
@@ -154,5 +177,25 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
 /// The simulated observation error (SimulationSample::error) at each evaluated point's time,
 /// linearly interpolated between the control ticks (exact on a tick) [m]; NaN outside the ticks.
 std::vector<double> simulated_errors(const std::vector<SimulationSample>& samples, const Measurement& measurement);
+
+// ---- observations for identification ----------------------------------------------------------
+
+/// The points of a log that an identification can use, as observations (identification.hpp).
+struct ObservationSet {
+  std::vector<Observation> observations;  ///< commanded motor-side lengths and the point as measured
+  std::vector<std::size_t> points;        ///< the log's index of each observation
+  std::size_t poses = 0;                  ///< distinct commanded poses among them (runs of one pose)
+  double settle = 0.0;                    ///< the settle time applied [s]
+};
+
+/// The points of `log` taken while the commanded pose had been still for `settle` seconds (as the
+/// registration's, RegistrationWindow::settle; 0 = every point), each with the motor-side lengths
+/// that the nominal `model` commands for the commanded pose under `strategy`: what the drives were
+/// told, which is where they stand once the servo has settled. Throws hexatwist::Error with one
+/// line naming the log, and the line of a point at fault, for: a point outside the trajectory's
+/// time span, a settle time that is not finite and >= 0, a commanded pose outside a limit, fewer
+/// than 6 points at rest (16 parameters need 3K > 16).
+ObservationSet observations_at_rest(const Model& model, const TimedPoses& commanded, const PointLog& log,
+                                    const TimeAlignment& time, Strategy strategy, double settle);
 
 }  // namespace hexatwist
