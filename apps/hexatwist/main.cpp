@@ -29,7 +29,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "hexatwist: twist-aware kinematics of lead-screw Stewart platforms.\n"
       "Poses are typed as x,y,z [m] and roll,pitch,yaw [deg] (R = Rz*Ry*Rx); all JSON output is SI (m, rad).\n"
-      "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit or numerical failure, 4 output not written."};
+      "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit or numerical failure, 4 output not written, 5 identify: "
+      "the data do not determine the parameters."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
   const std::vector<Command> commands{make_study_command(app),   make_simulate_command(app), make_synth_command(app),
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
       for (const Command& c : commands) chosen = chosen || c.app->get_name() == word;
       if (chosen) break;
       print_error("hexatwist: error: ", fmt::format("unknown subcommand '{}'; expected study, simulate, synth, "
-                                                    "measure, stream, ik, fk or config (see --help)",
+                                                    "measure, identify, stream, ik, fk or config (see --help)",
                                                     word));
       return kExitBadInput;
     }
