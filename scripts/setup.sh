@@ -7,6 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config     # toolchain
   libeigen3-dev libyaml-cpp-dev libcli11-dev libfmt-dev   # library and CLI
+  libceres-dev                                      # identification (nonlinear least squares)
   libgtest-dev libgmock-dev libbenchmark-dev        # tests and benchmarks
   gnuplot-nox                                       # figures
   clang libclang-rt-dev                             # fuzzing and sanitizer builds (libFuzzer, ASan, UBSan)

@@ -28,8 +28,9 @@ Status compute_commands(const Model& model, const Pose& pose, CommandReport& out
     return fail(out.limit, s);
   }
   length_error(model, out.twist, out.length_error);
-  out.conventional = out.legs.length;
-  out.compensated = out.legs.length - out.length_error;  // Eq. (11)-(12) as absolute motor-side lengths
+  // Eq. (11)-(12) as absolute motor-side lengths; both commands take the legs' zero errors out.
+  out.conventional = out.legs.length - model.geometry().length_offset;
+  out.compensated = out.conventional - out.length_error;
   if (pose_status != Status::Ok) return pose_status;
   return check_stroke(model, out.compensated, out.limit);
 }
@@ -42,13 +43,14 @@ Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, V
   if (const Status s = inverse_kinematics(model, placement_from_pose(pose), legs); s != Status::Ok)
     return fail(report, s);
   if (const Status s = check_limits(model, legs, report); s != Status::Ok) return s;
+  const Vector6d& offset = model.geometry().length_offset;
   if (strategy == Strategy::Conventional || !model.has_twist()) {
-    command = legs.length;
+    command = legs.length - offset;
     return Status::Ok;
   }
   Vector6d dtheta;
   if (const Status s = twist(model, legs, dtheta); s != Status::Ok) return fail(report, s);
-  Vector6d compensated = legs.length - model.geometry().twist_gain.cwiseProduct(dtheta);  // Eq. (12)
+  Vector6d compensated = legs.length - offset - model.geometry().twist_gain.cwiseProduct(dtheta);  // Eq. (12)
   if (const Status s = check_stroke(model, compensated, report); s != Status::Ok) return s;
   command = compensated;
   return Status::Ok;

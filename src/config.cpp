@@ -279,8 +279,8 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
     throw Error(fmt::format("{}: expected a mapping with 'symmetric' or 'legs', 'screw' and 'limits' at top level, got {}",
                             r.where(root.Mark()), kind(root)));
   const Field top{root, "", root.Mark()};
-  r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "limits", "observation_point", "pivot",
-                   "servo", "load", "simulation", "study"});
+  r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "length_offsets", "limits",
+                   "observation_point", "pivot", "servo", "load", "simulation", "study"});
 
   ModelSpec spec;
   const Field name = Reader::child(top, "name");
@@ -388,6 +388,21 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
         farthest = rho;
         spec.observation_P = leg.platform_P;
       }
+    }
+  }
+
+  // The legs' zero errors (identification's estimate), one list for either layout.
+  if (const Field offsets = Reader::child(top, "length_offsets"); offsets.present()) {
+    constexpr const char* kWhat = "real minus motor-side length at zero twist of legs 1..6 [m]";
+    if (!offsets.node.IsSequence() || offsets.node.size() != kLegs)
+      r.fail(offsets.at(), offsets.path,
+             fmt::format("expected a list of 6 numbers ({}), got {}", kWhat,
+                         offsets.node.IsSequence() ? fmt::format("{} numbers", offsets.node.size())
+                                                   : std::string(kind(offsets.node))));
+    for (int i = 0; i < kLegs; ++i) {
+      const Field f = Reader::item(offsets, static_cast<std::size_t>(i), fmt::format("{}[{}]", offsets.path, i));
+      spec.legs[static_cast<std::size_t>(i)].length_offset = r.number(f, kWhat);
+      locs[fmt::format("leg {}: length_offset", i + 1)] = loc(f);
     }
   }
 
@@ -512,7 +527,7 @@ std::string locate(const Reader& r, const Locations& locs, std::string_view sour
   std::string sub;
   const bool leg_field = field.starts_with("leg ");
   if (leg_field)
-    for (const char* s : {"base_axis", "platform_axis", "base", "platform", "lead"}) {
+    for (const char* s : {"base_axis", "platform_axis", "base", "platform", "lead", "length_offset"}) {
       const std::size_t n = std::strlen(s);
       if (what.starts_with(s) && what.substr(n).starts_with(": ")) {
         sub = s;
@@ -579,5 +594,52 @@ constexpr const char* kSeedSource = "seed platform (embedded configs/seed.yaml)"
 Model default_model() { return load_model(seed_config_yaml(), kSeedSource); }
 
 Config default_config() { return load_config(seed_config_yaml(), kSeedSource); }
+
+std::string corrected_config_yaml(std::string_view yaml_text, std::string_view source, const ModelSpec& corrected,
+                                  std::string_view header) {
+  (void)load_config(yaml_text, source);  // located errors for text that does not load
+  const LegSpec& first = corrected.legs[0];
+  for (int i = 1; i < kLegs; ++i) {
+    const LegSpec& leg = corrected.legs[static_cast<std::size_t>(i)];
+    if (leg.lead != first.lead || leg.thread != first.thread)
+      throw Error(fmt::format("{}: corrected model: leg {} has lead {} m ({}) but leg 1 has {} m ({}); one screw "
+                              "block cannot hold both",
+                              one_line(source), i + 1, leg.lead, leg.thread == ThreadSense::Right ? "right" : "left",
+                              first.lead, first.thread == ThreadSense::Right ? "right" : "left"));
+  }
+  // Shortest text that reads back to the same double.
+  const auto number = [](double v) { return YAML::Node(fmt::format("{}", v)); };
+  const auto flow_list = [&](std::initializer_list<double> values) {
+    YAML::Node list(YAML::NodeType::Sequence);
+    for (const double v : values) list.push_back(number(v));
+    list.SetStyle(YAML::EmitterStyle::Flow);
+    return list;
+  };
+  const char* thread = first.thread == ThreadSense::Right ? "right" : "left";
+  YAML::Node root = YAML::Load(std::string(yaml_text));
+  root["name"] = corrected.name;
+  root["screw"]["lead"] = number(first.lead);
+  root["screw"]["thread"] = thread;
+  if (YAML::Node legs = root["legs"]; legs.IsSequence())
+    for (std::size_t i = 0; i < legs.size(); ++i) {
+      if (legs[i]["lead"]) legs[i]["lead"] = number(first.lead);
+      if (legs[i]["thread"]) legs[i]["thread"] = thread;
+    }
+  const auto& o = corrected.legs;
+  root["length_offsets"] = flow_list({o[0].length_offset, o[1].length_offset, o[2].length_offset, o[3].length_offset,
+                                      o[4].length_offset, o[5].length_offset});
+  const Vector3d& a = corrected.observation_P;
+  root["observation_point"] = flow_list({a.x(), a.y(), a.z()});
+
+  std::string text;
+  for (std::size_t begin = 0; begin < header.size();) {
+    const std::size_t end = std::min(header.find('\n', begin), header.size());
+    text += "# " + std::string(header.substr(begin, end - begin)) + "\n";
+    begin = end + 1;
+  }
+  YAML::Emitter out;
+  out << root;
+  return text + out.c_str() + "\n";
+}
 
 }  // namespace hexatwist

@@ -18,8 +18,10 @@ Status residual(const Model& model, const Placement& x, const Vector6d& lengths,
                 Vector6d& f) noexcept {
   if (const Status s = inverse_kinematics(model, x, legs); s != Status::Ok) return s;
   f = legs.length - lengths;
-  if (kind == LengthKind::Geometric || !model.has_twist()) return Status::Ok;
-  // Motor-side length m = |L| - twist_gain * dtheta (docs/theory.md §5).
+  if (kind == LengthKind::Geometric) return Status::Ok;
+  // Motor-side length m = |L| - length_offset - twist_gain * dtheta (docs/theory.md §4-5).
+  f -= model.geometry().length_offset;
+  if (!model.has_twist()) return Status::Ok;
   Vector6d dtheta;
   if (const Status s = twist(model, legs, dtheta); s != Status::Ok) return s;
   f -= model.geometry().twist_gain.cwiseProduct(dtheta);

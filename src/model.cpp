@@ -18,7 +18,7 @@ constexpr double kMinAxisNorm = 1e-9;
 constexpr double kMaxHomeCondition = 1e8;
 
 // Every message is "field: what", field one of home_height, limits.<x>, observation_point, pivot,
-// legs, "leg N" or "leg N: <base|platform|lead|base_axis|platform_axis>": src/config.cpp maps the
+// legs, "leg N" or "leg N: <base|platform|lead|length_offset|base_axis|platform_axis>": src/config.cpp maps the
 // field back to the line of the YAML file it came from.
 [[noreturn]] void fail(const std::string& msg) { throw Error(msg); }
 
@@ -84,6 +84,13 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
       fail(fmt::format("{}: home length {:.6f} m is outside the stroke [{}, {}] m", who, leg.length_home,
                        lim.length_min, lim.length_max));
 
+    // An offset is a zero error of the motor-side length: one as long as the stroke is not.
+    require_finite(ls.length_offset, who + ": length_offset");
+    if (!(std::abs(ls.length_offset) < lim.length_max - lim.length_min))
+      fail(fmt::format("{}: length_offset: expected less than the stroke ({} m) in magnitude, got {} m", who,
+                       lim.length_max - lim.length_min, ls.length_offset));
+    leg.length_offset = ls.length_offset;
+
     leg.lead = ls.lead;
     leg.thread = ls.thread;
     leg.driven = ls.driven;
@@ -133,6 +140,7 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
     geometry_.cos_theta_home[i] = leg.cos_theta_home;
     geometry_.sin_theta_home[i] = leg.sin_theta_home;
     geometry_.twist_gain[i] = leg.twist_gain;
+    geometry_.length_offset[i] = leg.length_offset;
     geometry_.has_axes[i] = axes ? 1.0 : 0.0;
   }
 

@@ -22,6 +22,13 @@ Status fail(SimulationIssue& issue, Status status, std::size_t index, const Traj
   return status;
 }
 
+// The leg lengths forward kinematics of the plant takes for motor-side lengths `motor`: these
+// themselves when the plant twists (LengthKind::Motor), the real lengths (the legs' zero errors
+// added back) when it does not (LengthKind::Geometric).
+Vector6d plant_lengths(const Model& model, const Vector6d& motor, bool twist_in_plant) noexcept {
+  return twist_in_plant ? motor : Vector6d(motor + model.geometry().length_offset);
+}
+
 // The targets of a whole trajectory, computed (and checked) before the loop runs.
 struct Plan {
   std::vector<Vector6d> command;          // motor-side target [m]
@@ -92,7 +99,8 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   Placement guess = placement_from_pose(trajectory.poses[0]);
   const Vector3d& obs = model.spec().observation_P;
   for (std::size_t k = 0; k < n; ++k) {
-    if (const Status s = forward_kinematics(model, command[k], kind, guess, fk); s != Status::Ok)
+    if (const Status s = forward_kinematics(model, plant_lengths(model, command[k], twist_in_plant), kind, guess, fk);
+        s != Status::Ok)
       return fail(issue, s, k, trajectory);
     guess = fk.placement;
     const Placement desired = placement_from_pose(trajectory.poses[k]);
@@ -143,7 +151,8 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
   drives.speed = plan.reference[0].speed;
   Vector6d motor = model.length_home() + gain.cwiseProduct(drives.angle);
   FkResult fk;
-  if (const Status s = forward_kinematics(model, motor, kind, placement_from_pose(trajectory.poses[0]), fk);
+  if (const Status s = forward_kinematics(model, plant_lengths(model, motor, options.twist_in_plant), kind,
+                                          placement_from_pose(trajectory.poses[0]), fk);
       s != Status::Ok)
     return fail(issue, s, 0, trajectory);
   LegDynamics dyn;
@@ -192,7 +201,9 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
     integrate_drives(rig, A.inverse(), gain.cwiseProduct(dyn.gravity), torque, drives);
     motor = model.length_home() + gain.cwiseProduct(drives.angle);
     const Placement previous = fk.placement;  // warm start from the last tick
-    if (const Status s = forward_kinematics(model, motor, kind, previous, fk); s != Status::Ok)
+    if (const Status s =
+            forward_kinematics(model, plant_lengths(model, motor, options.twist_in_plant), kind, previous, fk);
+        s != Status::Ok)
       return fail(issue, s, k + 1, trajectory);
   }
   return Status::Ok;

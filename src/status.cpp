@@ -19,6 +19,8 @@ std::string_view to_string(Status s) noexcept {
     case Status::MalformedInput: return "malformed_input";
     case Status::TooFewPoints: return "too_few_points";
     case Status::DegenerateRegistration: return "degenerate_registration";
+    case Status::NotIdentifiable: return "not_identifiable";
+    case Status::SolverNoConvergence: return "solver_no_convergence";
   }
   return "unknown";
 }
@@ -41,6 +43,9 @@ std::string_view describe(Status s) noexcept {
     case Status::TooFewPoints: return "a registration needs at least three point pairs";
     case Status::DegenerateRegistration:
       return "the registration points are coincident or (nearly) collinear and do not fix the rotation";
+    case Status::NotIdentifiable:
+      return "the measurements do not determine every identified parameter (rank-deficient Jacobian or too few points)";
+    case Status::SolverNoConvergence: return "the least-squares solver stopped before it converged";
   }
   return "unknown status";
 }

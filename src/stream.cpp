@@ -102,8 +102,8 @@ std::string_view to_string(CommandAction a) noexcept {
 namespace {
 
 // The lengths a command of `strategy` means: motor-side lengths of the twist-aware model when
-// compensating, geometric leg lengths when the twist is ignored. A command is inside the limits
-// when the pose it means is.
+// compensating, geometric leg lengths (once the legs' zero errors are added back) when the twist
+// is ignored. A command is inside the limits when the pose it means is.
 LengthKind command_kind(const Model& model, Strategy strategy) noexcept {
   return strategy == Strategy::Compensated && model.has_twist() ? LengthKind::Motor : LengthKind::Geometric;
 }
@@ -163,7 +163,9 @@ Status advance(const Model& model, const StreamSettings& s, StreamState& state, 
   }
   out.rate_limited = true;
   LimitReport report;
-  Status st = forward_kinematics(model, next, command_kind(model, s.strategy), state.placement, state.fk, s.fk);
+  const LengthKind kind = command_kind(model, s.strategy);
+  const Vector6d lengths = kind == LengthKind::Geometric ? Vector6d(next + model.geometry().length_offset) : next;
+  Status st = forward_kinematics(model, lengths, kind, state.placement, state.fk, s.fk);
   if (st == Status::Ok) st = check_limits(model, state.fk.legs, report);
   if (st == Status::Ok) st = check_stroke(model, next, report);
   if (st != Status::Ok) {

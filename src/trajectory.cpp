@@ -3,12 +3,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <string>
-#include <system_error>
 
+#include "csv.hpp"
 #include "hexatwist/error.hpp"
 
 namespace hexatwist {
@@ -16,29 +16,6 @@ namespace {
 
 // Largest number of poses a sweep or a resampling may produce (48 bytes each).
 constexpr double kMaxSamples = 1e8;
-
-// Text from the input as it may appear inside a one-line message: control characters escaped,
-// and (if `max` is set) cut at a character boundary after `max` bytes.
-std::string printable(std::string_view s, std::size_t max = std::string_view::npos) {
-  std::size_t n = std::min(s.size(), max);
-  while (n < s.size() && n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;  // UTF-8 continuation
-  std::string out;
-  for (const char c : s.substr(0, n)) {
-    const auto u = static_cast<unsigned char>(c);
-    if (c == '\t')
-      out += "\\t";
-    else if (c == '\r')
-      out += "\\r";
-    else if (c == '\n')
-      out += "\\n";
-    else if (u < 0x20 || u == 0x7f)
-      out += fmt::format("\\x{:02x}", u);
-    else
-      out += c;
-  }
-  if (n < s.size()) out += "...";
-  return out;
-}
 
 void check_limit(double value, const char* name) {
   if (!std::isfinite(value)) throw Error(fmt::format("motion limits: {} must be finite, got {}", name, value));
@@ -167,50 +144,79 @@ double Trajectory::duration() const noexcept {
   return poses.size() < 2 ? 0.0 : dt * static_cast<double>(poses.size() - 1);
 }
 
-Trajectory sweep_trajectory(int coordinate, double amplitude, const MotionLimits& limits, double dwell, double dt) {
-  if (coordinate < 0 || coordinate > 5)
-    throw Error(fmt::format("sweep: coordinate must be 0..5 (x, y, z, roll, pitch, yaw), got {}", coordinate));
-  if (!std::isfinite(amplitude) || amplitude <= 0.0)
-    throw Error(fmt::format("sweep: amplitude must be finite and > 0, got {}", amplitude));
-  if (!std::isfinite(dwell) || dwell < 0.0)
-    throw Error(fmt::format("sweep: dwell must be finite and >= 0 s, got {}", dwell));
-  if (!std::isfinite(dt) || dt <= 0.0) throw Error(fmt::format("sweep: dt must be finite and > 0 s, got {}", dt));
+namespace {
 
-  // Four dwells around three moves: 0 -> +a, +a -> -a, -a -> 0.
-  const JerkLimitedMove out(amplitude, limits), across(-2.0 * amplitude, limits), back(amplitude, limits);
+// Straight-line jerk-limited moves through `waypoints` with `dwell` before, between and after
+// them (see waypoint_trajectory); `what` names the caller in messages.
+Trajectory through_waypoints(std::span<const Vector6d> waypoints, const MotionLimits& limits, double dwell, double dt,
+                             const char* what) {
   struct Stage {
-    const JerkLimitedMove* move;
+    JerkLimitedMove move;
     double start_time;  // [s]
-    double start;       // coordinate at the start of the move
+    Vector6d start;     // pose at the start of the move
+    Vector6d unit;      // direction of the move (zero for a move of zero length)
   };
-  const double t_out = dwell;
-  const double t_across = t_out + out.duration() + dwell;
-  const double t_back = t_across + across.duration() + dwell;
-  const double total = t_back + back.duration() + dwell;
-  const Stage stages[3] = {{&out, t_out, 0.0}, {&across, t_across, amplitude}, {&back, t_back, -amplitude}};
+  std::vector<Stage> stages;
+  double t = dwell;
+  for (std::size_t k = 0; k + 1 < waypoints.size(); ++k) {
+    const Vector6d delta = waypoints[k + 1] - waypoints[k];
+    const double distance = delta.norm();
+    Stage& s = stages.emplace_back(Stage{JerkLimitedMove(distance, limits), t, waypoints[k], Vector6d::Zero()});
+    if (distance > 0.0) s.unit = delta / distance;
+    t += s.move.duration() + dwell;
+  }
+  const double total = t;
 
   // Rounded up, but a total that is a whole number of dt up to rounding is not pushed one further.
   const double steps = std::ceil(total / dt - 1e-9);
   if (!(steps + 1.0 <= kMaxSamples))
-    throw Error(fmt::format("sweep: {} s at dt = {} s is more than {:.0f} samples", total, dt, kMaxSamples));
+    throw Error(fmt::format("{}: {} s at dt = {} s is more than {:.0f} samples", what, total, dt, kMaxSamples));
   const auto n = static_cast<std::size_t>(std::max(steps, 1.0));
 
   Trajectory traj;
   traj.dt = dt;
   traj.poses.resize(n + 1);
   for (std::size_t k = 0; k < n; ++k) {
-    const double t = traj.time(k);
+    const double tk = traj.time(k);
     // The move under way (or the last one begun): before it starts and after it ends the
     // clamped sample holds its start or end.
     const Stage* stage = &stages[0];
     for (const Stage& s : stages)
-      if (t >= s.start_time) stage = &s;
-    Vector6d q = Vector6d::Zero();
-    q[coordinate] = stage->start + stage->move->sample(t - stage->start_time).position;
-    traj.poses[k] = Pose::from_vector(q);
+      if (tk >= s.start_time) stage = &s;
+    traj.poses[k] = Pose::from_vector(stage->start + stage->unit * stage->move.sample(tk - stage->start_time).position);
   }
-  // poses[n] stays home: the end, exactly.
+  traj.poses[n] = Pose::from_vector(waypoints.back());  // the end, exactly
   return traj;
+}
+
+void check_dwell_and_period(double dwell, double dt, const char* what) {
+  if (!std::isfinite(dwell) || dwell < 0.0)
+    throw Error(fmt::format("{}: dwell must be finite and >= 0 s, got {}", what, dwell));
+  if (!std::isfinite(dt) || dt <= 0.0) throw Error(fmt::format("{}: dt must be finite and > 0 s, got {}", what, dt));
+}
+
+}  // namespace
+
+Trajectory sweep_trajectory(int coordinate, double amplitude, const MotionLimits& limits, double dwell, double dt) {
+  if (coordinate < 0 || coordinate > 5)
+    throw Error(fmt::format("sweep: coordinate must be 0..5 (x, y, z, roll, pitch, yaw), got {}", coordinate));
+  if (!std::isfinite(amplitude) || amplitude <= 0.0)
+    throw Error(fmt::format("sweep: amplitude must be finite and > 0, got {}", amplitude));
+  check_dwell_and_period(dwell, dt, "sweep");
+  // Three moves: 0 -> +a, +a -> -a, -a -> 0.
+  std::array<Vector6d, 4> waypoints{Vector6d::Zero(), Vector6d::Zero(), Vector6d::Zero(), Vector6d::Zero()};
+  waypoints[1][coordinate] = amplitude;
+  waypoints[2][coordinate] = -amplitude;
+  return through_waypoints(waypoints, limits, dwell, dt, "sweep");
+}
+
+Trajectory waypoint_trajectory(std::span<const Vector6d> waypoints, const MotionLimits& limits, double dwell,
+                               double dt) {
+  if (waypoints.size() < 2) throw Error(fmt::format("waypoints: expected at least 2 poses, got {}", waypoints.size()));
+  for (std::size_t k = 0; k < waypoints.size(); ++k)
+    if (!waypoints[k].allFinite()) throw Error(fmt::format("waypoints: pose {} is not finite", k + 1));
+  check_dwell_and_period(dwell, dt, "waypoints");
+  return through_waypoints(waypoints, limits, dwell, dt, "waypoints");
 }
 
 // ---- CSV ------------------------------------------------------------------------------------
@@ -242,171 +248,84 @@ constexpr ColumnSpec kColumns[7] = {
 constexpr const char* kHeaderWhat =
     "the header row t, x, y, z, roll, pitch, yaw (unit suffixes: t_s; _m or _mm; _deg or _rad)";
 
-bool blank(char c) { return c == ' ' || c == '\t'; }
-
-// One cell of a line: its text without the surrounding whitespace, and where that text starts.
-struct Cell {
-  std::string_view text;
-  std::size_t offset;  // byte offset in the line of `text` (of the cell's start if `text` is empty)
-};
-
-// Splits a line at commas and trims each cell.
-std::vector<Cell> split(std::string_view line) {
-  std::vector<Cell> cells;
-  std::size_t begin = 0;
-  for (;;) {
-    const std::size_t comma = line.find(',', begin);
-    const std::size_t end = comma == std::string_view::npos ? line.size() : comma;
-    std::size_t b = begin, e = end;
-    while (b < e && blank(line[b])) ++b;
-    while (e > b && blank(line[e - 1])) --e;
-    cells.push_back({line.substr(b, e - b), b < e ? b : begin});
-    if (comma == std::string_view::npos) return cells;
-    begin = comma + 1;
+// The factor to SI of each column, from the header row.
+std::array<double, 7> read_header(const detail::CsvReader& r, const detail::CsvLine& line) {
+  const std::vector<detail::CsvCell> cells = detail::split_csv(line.text);
+  std::array<double, 7> factor{};
+  for (std::size_t c = 0; c < 7; ++c) {
+    const ColumnSpec& spec = kColumns[c];
+    // "'x', 'x_m' or 'x_mm'"
+    std::string names;
+    for (std::size_t k = 0; k < spec.units.size() && spec.units[k].header != nullptr; ++k) {
+      const bool last = k + 1 == spec.units.size() || spec.units[k + 1].header == nullptr;
+      names += fmt::format("{}'{}'", k == 0 ? "" : last ? " or " : ", ", spec.units[k].header);
+    }
+    if (c >= cells.size())
+      r.fail(line.number, line.text, line.text.size(), spec.name,
+             fmt::format("missing from the header; expected {} as column {} of {}", names, c + 1, kHeaderWhat));
+    const detail::CsvCell& cell = cells[c];
+    bool found = false;
+    for (const Unit& u : spec.units)
+      if (u.header != nullptr && cell.text == u.header) factor[c] = u.to_si, found = true;
+    if (!found) {
+      const char* hint = cell.text.find(';') != std::string_view::npos ? " (cells are separated by commas)" : "";
+      r.fail(line.number, line.text, cell.offset, spec.name,
+             fmt::format("expected {} as column {} of {}, got '{}'{}", names, c + 1, kHeaderWhat,
+                         detail::printable(cell.text, 40), hint));
+    }
   }
+  if (cells.size() > 7)
+    r.fail(line.number, line.text, cells[7].offset, "yaw",
+           fmt::format("extra column '{}' after 'yaw'; expected exactly 7 columns t, x, y, z, roll, pitch, yaw",
+                       detail::printable(cells[7].text, 40)));
+  return factor;
 }
 
-class CsvReader {
- public:
-  explicit CsvReader(std::string_view source) : source_(printable(source)) {}
-
-  // "source:line:column: column 'name': message"; `offset` is a byte offset into `line`, shown
-  // as a 1-based character column (UTF-8 continuation bytes do not count).
-  [[noreturn]] void fail(int line_no, std::string_view line, std::size_t offset, std::string_view column,
-                         const std::string& message) const {
-    int col = 1;
-    for (std::size_t i = 0; i < offset && i < line.size(); ++i)
-      if ((static_cast<unsigned char>(line[i]) & 0xC0) != 0x80) ++col;
-    throw Error(fmt::format("{}:{}:{}: column '{}': {}", source_, line_no, col, column, message));
-  }
-
-  // The factor to SI of each column, from the header row.
-  std::array<double, 7> header(int line_no, std::string_view line) const {
-    const std::vector<Cell> cells = split(line);
-    std::array<double, 7> factor{};
-    for (std::size_t c = 0; c < 7; ++c) {
-      const ColumnSpec& spec = kColumns[c];
-      // "'x', 'x_m' or 'x_mm'"
-      std::string names;
-      for (std::size_t k = 0; k < spec.units.size() && spec.units[k].header != nullptr; ++k) {
-        const bool last = k + 1 == spec.units.size() || spec.units[k + 1].header == nullptr;
-        names += fmt::format("{}'{}'", k == 0 ? "" : last ? " or " : ", ", spec.units[k].header);
-      }
-      if (c >= cells.size())
-        fail(line_no, line, line.size(), spec.name,
-             fmt::format("missing from the header; expected {} as column {} of {}", names, c + 1, kHeaderWhat));
-      const Cell& cell = cells[c];
-      bool found = false;
-      for (const Unit& u : spec.units)
-        if (u.header != nullptr && cell.text == u.header) factor[c] = u.to_si, found = true;
-      if (!found) {
-        const char* hint = cell.text.find(';') != std::string_view::npos ? " (cells are separated by commas)" : "";
-        fail(line_no, line, cell.offset, spec.name,
-             fmt::format("expected {} as column {} of {}, got '{}'{}", names, c + 1, kHeaderWhat,
-                         printable(cell.text, 40), hint));
-      }
-    }
-    if (cells.size() > 7)
-      fail(line_no, line, cells[7].offset, "yaw",
-           fmt::format("extra column '{}' after 'yaw'; expected exactly 7 columns t, x, y, z, roll, pitch, yaw",
-                       printable(cells[7].text, 40)));
-    return factor;
-  }
-
-  // The seven values of a data row, in SI units.
-  Vector6d row(int line_no, std::string_view line, const std::array<double, 7>& factor, double& t) const {
-    const std::vector<Cell> cells = split(line);
-    if (cells.size() < 7)
-      fail(line_no, line, line.size(), kColumns[cells.size()].name,
+// The pose of a data row in SI units; its time in `t`.
+Vector6d read_row(const detail::CsvReader& r, const detail::CsvLine& line, const std::array<double, 7>& factor,
+                  double& t) {
+  const std::vector<detail::CsvCell> cells = detail::split_csv(line.text);
+  if (cells.size() < 7)
+    r.fail(line.number, line.text, line.text.size(), kColumns[cells.size()].name,
            fmt::format("missing; the row has {} cells, expected 7 (t, x, y, z, roll, pitch, yaw)", cells.size()));
-    if (cells.size() > 7)
-      fail(line_no, line, cells[7].offset, "yaw",
+  if (cells.size() > 7)
+    r.fail(line.number, line.text, cells[7].offset, "yaw",
            fmt::format("extra cell '{}' after 'yaw'; the row has {} cells, expected 7 (t, x, y, z, roll, pitch, yaw)",
-                       printable(cells[7].text, 40), cells.size()));
-    std::array<double, 7> v{};
-    for (std::size_t c = 0; c < 7; ++c) {
-      const Cell& cell = cells[c];
-      const char* name = kColumns[c].name;
-      std::string_view text = cell.text;
-      if (text.empty()) fail(line_no, line, cell.offset, name, "empty cell; expected a number");
-      // from_chars takes no leading '+', a person may type one.
-      if (text.size() > 1 && text[0] == '+' && text[1] != '-' && text[1] != '+') text.remove_prefix(1);
-      double x = 0.0;
-      const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), x);
-      const std::string shown = printable(cell.text, 40);
-      if (ec == std::errc::result_out_of_range && end == text.data() + text.size())
-        fail(line_no, line, cell.offset, name, fmt::format("number out of range, got '{}'", shown));
-      if (ec != std::errc() || end != text.data() + text.size())
-        fail(line_no, line, cell.offset, name, fmt::format("expected a number, got '{}'", shown));
-      if (!std::isfinite(x))
-        fail(line_no, line, cell.offset, name, fmt::format("expected a finite number, got '{}'", shown));
-      v[c] = x * factor[c];
-      if (!std::isfinite(v[c]))
-        fail(line_no, line, cell.offset, name,
-             fmt::format("number out of range after unit conversion, got '{}'", shown));
-    }
-    t = v[0];
-    Vector6d q;
-    for (int k = 0; k < 6; ++k) q[k] = v[static_cast<std::size_t>(k) + 1];
-    return q;
-  }
-
-  const std::string& source() const { return source_; }
-
- private:
-  std::string source_;
-};
+                       detail::printable(cells[7].text, 40), cells.size()));
+  t = r.number(line, cells[0], kColumns[0].name, factor[0]);
+  Vector6d q;
+  for (std::size_t c = 1; c < 7; ++c)
+    q[static_cast<int>(c) - 1] = r.number(line, cells[c], kColumns[c].name, factor[c]);
+  return q;
+}
 
 }  // namespace
 
 TimedPoses parse_trajectory_csv(std::string_view text, std::string_view source) {
-  const CsvReader r(source);
-  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte-order mark (spreadsheets)
-
-  TimedPoses out;
-  std::array<double, 7> factor{};
-  bool have_header = false;
-  int line_no = 0, header_line = 0;
-  std::string_view last_line;
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    std::size_t nl = text.find('\n', pos);
-    if (nl == std::string_view::npos) nl = text.size();
-    std::string_view line = text.substr(pos, nl - pos);
-    pos = nl + 1;
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    std::size_t first = 0;
-    while (first < line.size() && blank(line[first])) ++first;
-    if (first == line.size() || line[first] == '#') continue;
-
-    if (!have_header) {
-      factor = r.header(line_no, line);
-      have_header = true;
-      header_line = line_no;
-      last_line = line;
-      continue;
-    }
-    double t = 0.0;
-    const Vector6d q = r.row(line_no, line, factor, t);
-    if (!out.t.empty() && !(t > out.t.back())) {
-      const std::size_t at = split(line)[0].offset;
-      r.fail(line_no, line, at, "t",
-             fmt::format("time {} s is not after {} s on line {}; times must be strictly increasing", t, out.t.back(),
-                         out.lines.back()));
-    }
-    out.t.push_back(t);
-    out.poses.push_back(Pose::from_vector(q));
-    out.lines.push_back(line_no);
-    last_line = line;
-  }
-
-  if (!have_header)
+  const detail::CsvReader r(source);
+  text = detail::without_bom(text);
+  const std::vector<detail::CsvLine> lines = detail::csv_lines(text);
+  if (lines.empty())
     r.fail(1, {}, 0, "t",
            fmt::format("{}; expected {} and at least 2 data rows",
                        text.empty() ? "empty text" : "no header row (only blank or comment lines)", kHeaderWhat));
+  const std::array<double, 7> factor = read_header(r, lines[0]);
+
+  TimedPoses out;
+  for (std::size_t k = 1; k < lines.size(); ++k) {
+    const detail::CsvLine& line = lines[k];
+    double t = 0.0;
+    const Vector6d q = read_row(r, line, factor, t);
+    if (!out.t.empty() && !(t > out.t.back()))
+      r.fail(line.number, line.text, detail::split_csv(line.text)[0].offset, "t",
+             fmt::format("time {} s is not after {} s on line {}; times must be strictly increasing", t, out.t.back(),
+                         out.lines.back()));
+    out.t.push_back(t);
+    out.poses.push_back(Pose::from_vector(q));
+    out.lines.push_back(line.number);
+  }
   if (out.t.size() < 2)
-    r.fail(out.t.empty() ? header_line : out.lines.back(), last_line, 0, "t",
+    r.fail(lines.back().number, lines.back().text, 0, "t",
            fmt::format("{} data row{}; a trajectory needs at least 2 rows (times)", out.t.size(),
                        out.t.size() == 1 ? "" : "s"));
   return out;
@@ -414,42 +333,41 @@ TimedPoses parse_trajectory_csv(std::string_view text, std::string_view source) 
 
 // ---- resampling -----------------------------------------------------------------------------
 
-Trajectory resample(const TimedPoses& samples, double dt) {
-  const std::vector<double>& t = samples.t;
-  if (!std::isfinite(dt) || dt <= 0.0) throw Error(fmt::format("resample: dt must be finite and > 0 s, got {}", dt));
-  if (t.size() != samples.poses.size())
-    throw Error(fmt::format("resample: {} times but {} poses", t.size(), samples.poses.size()));
-  if (t.size() < 2) throw Error(fmt::format("resample: need at least 2 samples, got {}", t.size()));
-  const std::size_t m = t.size();
-  // Where a sample came from, for messages.
-  const auto at = [&](std::size_t i) {
-    return i < samples.lines.size() ? fmt::format("sample {} (line {})", i, samples.lines[i])
-                                    : fmt::format("sample {}", i);
-  };
-  std::vector<Vector6d> q(m);
-  for (std::size_t i = 0; i < m; ++i) {
-    if (!std::isfinite(t[i])) throw Error(fmt::format("resample: {}: time is not finite ({})", at(i), t[i]));
-    if (i > 0 && !(t[i] > t[i - 1]))
-      throw Error(fmt::format("resample: {}: time {} s is not after {} s", at(i), t[i], t[i - 1]));
-    if (!samples.poses[i].is_finite()) throw Error(fmt::format("resample: {}: pose is not finite", at(i)));
-    q[i] = samples.poses[i].to_vector();
-  }
+namespace {
 
-  // Slopes (Fritsch-Carlson monotone cubic, "PCHIP", per coordinate): a weighted harmonic mean
-  // of the two neighbouring secants where they agree in sign, else 0; at the ends, the three-point
-  // one-sided slope, limited the same way. The curve then never overshoots the samples: a hold
-  // stays a hold and a move does not swing past its end (waypoint files are common input).
-  // Lines are reproduced exactly.
-  std::vector<Vector6d> slope(m);
-  const auto secant = [&](std::size_t i) -> Vector6d { return (q[i + 1] - q[i]) / (t[i + 1] - t[i]); };
-  if (m == 2) {
-    slope[0] = slope[1] = secant(0);
-  } else {
+// The monotone piecewise-cubic Hermite interpolant of Fritsch and Carlson ("PCHIP") through
+// the samples, per coordinate; `what` names the caller in messages.
+class Pchip {
+ public:
+  Pchip(const TimedPoses& samples, const char* what) : samples_(samples), t_(samples.t), what_(what) {
+    const std::size_t m = t_.size();
+    if (m != samples.poses.size()) throw Error(fmt::format("{}: {} times but {} poses", what, m, samples.poses.size()));
+    if (m < 2) throw Error(fmt::format("{}: need at least 2 samples, got {}", what, m));
+    const auto at = [&](std::size_t i) { return where(i); };
+    q_.resize(m);
+    for (std::size_t i = 0; i < m; ++i) {
+      if (!std::isfinite(t_[i])) throw Error(fmt::format("{}: {}: time is not finite ({})", what, at(i), t_[i]));
+      if (i > 0 && !(t_[i] > t_[i - 1]))
+        throw Error(fmt::format("{}: {}: time {} s is not after {} s", what, at(i), t_[i], t_[i - 1]));
+      if (!samples.poses[i].is_finite()) throw Error(fmt::format("{}: {}: pose is not finite", what, at(i)));
+      q_[i] = samples.poses[i].to_vector();
+    }
+
+    // Slopes: a weighted harmonic mean of the two neighbouring secants where they agree in sign,
+    // else 0; at the ends, the three-point one-sided slope, limited the same way. The curve then
+    // never overshoots the samples: a hold stays a hold and a move does not swing past its end
+    // (waypoint files are common input). Lines are reproduced exactly.
+    slope_.resize(m);
+    const auto secant = [&](std::size_t i) -> Vector6d { return (q_[i + 1] - q_[i]) / (t_[i + 1] - t_[i]); };
+    if (m == 2) {
+      slope_[0] = slope_[1] = secant(0);
+      return;
+    }
     for (std::size_t i = 1; i + 1 < m; ++i) {
-      const double h0 = t[i] - t[i - 1], h1 = t[i + 1] - t[i];
+      const double h0 = t_[i] - t_[i - 1], h1 = t_[i + 1] - t_[i];
       const Vector6d d0 = secant(i - 1), d1 = secant(i);
       const double w0 = 2.0 * h1 + h0, w1 = h1 + 2.0 * h0;
-      for (int c = 0; c < 6; ++c) slope[i][c] = d0[c] * d1[c] > 0.0 ? (w0 + w1) / (w0 / d0[c] + w1 / d1[c]) : 0.0;
+      for (int c = 0; c < 6; ++c) slope_[i][c] = d0[c] * d1[c] > 0.0 ? (w0 + w1) / (w0 / d0[c] + w1 / d1[c]) : 0.0;
     }
     const auto end_slope = [](double h0, double h1, double d0, double d1) {
       double e = ((2.0 * h0 + h1) * d0 - h0 * d1) / (h0 + h1);
@@ -459,11 +377,53 @@ Trajectory resample(const TimedPoses& samples, double dt) {
     };
     const Vector6d a0 = secant(0), a1 = secant(1), z0 = secant(m - 2), z1 = secant(m - 3);
     for (int c = 0; c < 6; ++c) {
-      slope[0][c] = end_slope(t[1] - t[0], t[2] - t[1], a0[c], a1[c]);
-      slope[m - 1][c] = end_slope(t[m - 1] - t[m - 2], t[m - 2] - t[m - 3], z0[c], z1[c]);
+      slope_[0][c] = end_slope(t_[1] - t_[0], t_[2] - t_[1], a0[c], a1[c]);
+      slope_[m - 1][c] = end_slope(t_[m - 1] - t_[m - 2], t_[m - 2] - t_[m - 3], z0[c], z1[c]);
     }
   }
 
+  // The pose at `tk` in [t.front(), t.back()]; within `snap` of a sample time, that sample's pose.
+  // `i` is a hint: the interval [t[i], t[i+1]] searched from (advanced as tk grows).
+  Pose at(double tk, double snap, std::size_t& i) const {
+    const std::size_t m = t_.size();
+    if (i + 1 >= m || t_[i] > tk + snap) i = 0;
+    while (i + 2 < m && t_[i + 1] <= tk + snap) ++i;
+    if (std::abs(tk - t_[i]) <= snap) return samples_.poses[i];
+    if (std::abs(tk - t_[i + 1]) <= snap) return samples_.poses[i + 1];
+    // Cubic Hermite on [t[i], t[i+1]] in s = (t - t[i]) / h.
+    const double h = t_[i + 1] - t_[i];
+    const double s = std::clamp((tk - t_[i]) / h, 0.0, 1.0);
+    const double s2 = s * s, s3 = s2 * s;
+    const double h00 = 2.0 * s3 - 3.0 * s2 + 1.0, h10 = s3 - 2.0 * s2 + s;
+    const double h01 = -2.0 * s3 + 3.0 * s2, h11 = s3 - s2;
+    const Vector6d q = h00 * q_[i] + h10 * h * slope_[i] + h01 * q_[i + 1] + h11 * h * slope_[i + 1];
+    // Finite samples whose differences or rates overflow a double (1e308 m next to 0 m) give an
+    // infinite slope: no pose can be interpolated there.
+    if (!q.allFinite())
+      throw Error(fmt::format("{}: between {} and {}: the interpolation overflows a double (a value or its rate of "
+                              "change beyond 1e308)", what_, where(i), where(i + 1)));
+    return Pose::from_vector(q);
+  }
+
+ private:
+  // Where a sample came from, for messages.
+  std::string where(std::size_t i) const {
+    return i < samples_.lines.size() ? fmt::format("sample {} (line {})", i, samples_.lines[i])
+                                     : fmt::format("sample {}", i);
+  }
+
+  const TimedPoses& samples_;
+  const std::vector<double>& t_;
+  const char* what_;
+  std::vector<Vector6d> q_, slope_;
+};
+
+}  // namespace
+
+Trajectory resample(const TimedPoses& samples, double dt) {
+  if (!std::isfinite(dt) || dt <= 0.0) throw Error(fmt::format("resample: dt must be finite and > 0 s, got {}", dt));
+  const Pchip curve(samples, "resample");
+  const std::vector<double>& t = samples.t;
   const double span = t.back() - t.front();
   const double steps = std::floor(span / dt + 1e-9);
   if (!(steps + 1.0 <= kMaxSamples))
@@ -476,30 +436,31 @@ Trajectory resample(const TimedPoses& samples, double dt) {
   traj.poses.resize(n + 1);
   const double snap = 1e-9 * dt;  // a grid time this close to an input time is that time
   std::size_t i = 0;              // interval [t[i], t[i+1]] of the current grid time
-  for (std::size_t k = 0; k <= n; ++k) {
-    const double tk = std::min(traj.time(k), t.back());
-    while (i + 2 < m && t[i + 1] <= tk + snap) ++i;
-    if (std::abs(tk - t[i]) <= snap) {
-      traj.poses[k] = samples.poses[i];
-    } else if (std::abs(tk - t[i + 1]) <= snap) {
-      traj.poses[k] = samples.poses[i + 1];
-    } else {
-      // Cubic Hermite on [t[i], t[i+1]] in s = (t - t[i]) / h.
-      const double h = t[i + 1] - t[i];
-      const double s = std::clamp((tk - t[i]) / h, 0.0, 1.0);
-      const double s2 = s * s, s3 = s2 * s;
-      const double h00 = 2.0 * s3 - 3.0 * s2 + 1.0, h10 = s3 - 2.0 * s2 + s;
-      const double h01 = -2.0 * s3 + 3.0 * s2, h11 = s3 - s2;
-      const Vector6d qk = h00 * q[i] + h10 * h * slope[i] + h01 * q[i + 1] + h11 * h * slope[i + 1];
-      // Finite samples whose differences or rates overflow a double (1e308 m next to 0 m) give
-      // an infinite slope: no pose can be interpolated there.
-      if (!qk.allFinite())
-        throw Error(fmt::format("resample: between {} and {}: the interpolation overflows a double (a value or "
-                                "its rate of change beyond 1e308)", at(i), at(i + 1)));
-      traj.poses[k] = Pose::from_vector(qk);
-    }
-  }
+  for (std::size_t k = 0; k <= n; ++k) traj.poses[k] = curve.at(std::min(traj.time(k), t.back()), snap, i);
   return traj;
+}
+
+std::vector<Pose> interpolate(const TimedPoses& samples, std::span<const double> times) {
+  const Pchip curve(samples, "interpolate");
+  std::vector<Pose> poses;
+  poses.reserve(times.size());
+  std::size_t i = 0;
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    const double tk = times[k];
+    if (!(tk >= samples.t.front() && tk <= samples.t.back()))
+      throw Error(fmt::format("interpolate: time {} (number {}) is outside the samples' span [{}, {}] s", tk, k + 1,
+                              samples.t.front(), samples.t.back()));
+    poses.push_back(curve.at(tk, 0.0, i));
+  }
+  return poses;
+}
+
+TimedPoses timed_poses(const Trajectory& trajectory) {
+  TimedPoses out;
+  out.poses = trajectory.poses;
+  out.t.resize(trajectory.poses.size());
+  for (std::size_t k = 0; k < out.t.size(); ++k) out.t[k] = trajectory.time(k);
+  return out;
 }
 
 }  // namespace hexatwist

@@ -9,8 +9,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <initializer_list>
 #include <optional>
 #include <random>
+#include <string>
+#include <string_view>
 
 #include "hexatwist/hexatwist.hpp"
 
@@ -25,6 +28,25 @@ inline int stress(int count) {
   const char* s = std::getenv("HEXATWIST_STRESS");
   const int factor = s != nullptr ? std::atoi(s) : 1;
   return count * std::max(factor, 1);
+}
+
+/// `f` must throw hexatwist::Error whose message is one line, starts with `start` (e.g.
+/// "bad.csv:3:14: column 'pitch':") and contains every one of `parts`.
+template <class F>
+void expect_error_line(F&& f, std::string_view start, std::initializer_list<std::string_view> parts = {}) {
+  std::string msg;
+  try {
+    f();
+    ADD_FAILURE() << "no error was thrown; expected one starting with " << start;
+    return;
+  } catch (const Error& e) {
+    msg = e.what();
+  }
+  SCOPED_TRACE("message: " + msg);
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << "not a single line";
+  EXPECT_EQ(msg.find('\r'), std::string::npos) << "carries a carriage return";
+  EXPECT_EQ(msg.rfind(start, 0), 0u) << "does not start with " << start;
+  for (const std::string_view p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "does not name '" << p << "'";
 }
 
 /// Prints a measured residual (the tolerances are set about 10x these).
@@ -56,6 +78,13 @@ inline Pose random_valid_pose(const Model& model, std::mt19937_64& rng, double d
     const Pose p = random_pose(rng, dpos, drot);
     if (compute_commands(model, p, report) == Status::Ok) return p;
   }
+}
+
+/// The seed platform with zero errors (length offsets) drawn uniformly in [-max_offset, max_offset] [m].
+inline Model seed_with_offsets(std::mt19937_64& rng, double max_offset) {
+  ModelSpec spec = seed_model().spec();
+  for (LegSpec& leg : spec.legs) leg.length_offset = uniform(rng, -max_offset, max_offset);
+  return Model(spec);
 }
 
 /// A random, asymmetric but well-conditioned platform: joints scattered around two circles,

@@ -108,6 +108,32 @@ TEST(Compensation, RealTimePathAndFullReportReachTheSameLimitDecision) {
   EXPECT_LT(rejected, 2990);  // ... and inside them
 }
 
+TEST(Compensation, BothCommandsTakeTheLengthOffsetsOut) {
+  // A leg whose real length is its motor-side length + delta is commanded delta shorter, with
+  // the twist compensated or not; the compensated command still lands exactly on the pose.
+  std::mt19937_64 rng(kSeed + 21);
+  const Model offset = seed_with_offsets(rng, 1e-3);
+  const Vector6d& delta = offset.geometry().length_offset;
+  for (int n = 0; n < 200; ++n) {
+    const Pose p = random_valid_pose(seed_model(), rng, 0.4, deg2rad(25));
+    CommandReport plain, shifted;
+    ASSERT_EQ(compute_commands(seed_model(), p, plain), Status::Ok) << str(p);
+    ASSERT_EQ(compute_commands(offset, p, shifted), Status::Ok) << str(p);
+    EXPECT_LT((shifted.conventional - (plain.conventional - delta)).cwiseAbs().maxCoeff(), 1e-15) << str(p);
+    EXPECT_LT((shifted.compensated - (plain.compensated - delta)).cwiseAbs().maxCoeff(), 1e-15) << str(p);
+    for (const Strategy strategy : {Strategy::Conventional, Strategy::Compensated}) {
+      Vector6d command;
+      LimitReport lim;
+      ASSERT_EQ(motor_commands(offset, p, strategy, command, lim), Status::Ok) << str(p);
+      EXPECT_EQ(command, strategy == Strategy::Conventional ? shifted.conventional : shifted.compensated);
+    }
+    FkResult r;
+    ASSERT_EQ(forward_kinematics(offset, shifted.compensated, LengthKind::Motor, Placement{}, r), Status::Ok);
+    const PoseError e = pose_error(r.placement, placement_from_pose(p));
+    EXPECT_LT(std::max(e.position, e.rotation), 1e-11) << str(p);
+  }
+}
+
 TEST(Compensation, ZeroLeadMakesBothStrategiesEqual) {
   ModelSpec spec = seed_model().spec();
   for (LegSpec& l : spec.legs) l.lead = 0.0;

@@ -221,6 +221,29 @@ TEST(Config, PerLegScrewSettingsOverrideTheScrewBlock) {
   EXPECT_EQ(m.leg(4).driven, DrivenSide::Platform);
 }
 
+TEST(Config, LengthOffsetsGiveEveryLegItsZeroErrorInEitherForm) {
+  const std::string offsets = "length_offsets: [0.001, -0.0005, 0, 2.5e-4, -1e-3, 3e-6]\n";
+  const std::array<double, kLegs> expected{0.001, -0.0005, 0.0, 2.5e-4, -1e-3, 3e-6};
+  for (const std::string& form : {kSymmetric, seed_legs_yaml()}) {
+    const Model m = load_model(form + offsets, "offsets.yaml");
+    for (int i = 0; i < kLegs; ++i) EXPECT_EQ(m.leg(i).length_offset, expected[static_cast<std::size_t>(i)]) << i;
+    // Nothing else changes.
+    const Model plain = load_model(form, "plain.yaml");
+    expect_same_model(m, plain);
+    EXPECT_EQ(plain.geometry().length_offset, Vector6d::Zero());
+  }
+}
+
+TEST(Config, BadLengthOffsetsAreLocated) {
+  const int line = 17;  // appended after kSymmetric's 16 lines
+  expect_error(kSymmetric + "length_offsets: [0, 0, 0]\n", line, {"field 'length_offsets'", "6 numbers", "got 3"});
+  expect_error(kSymmetric + "length_offsets: 0.001\n", line, {"field 'length_offsets'", "6 numbers", "scalar"});
+  expect_error(kSymmetric + "length_offsets: [0, 0, x, 0, 0, 0]\n", line, {"field 'length_offsets[2]'", "number"});
+  // The model's own check (shorter than the stroke), at the entry it came from.
+  expect_error(kSymmetric + "length_offsets: [0, 0, 0, 1.5, 0, 0]\n", line,
+               {"field 'length_offsets[3]'", "stroke"});
+}
+
 TEST(Config, ZeroLeadLegsFormNeedsNoAxesAndNoThread) {
   // A plain Stewart platform: joints only.
   std::string yaml =
@@ -504,6 +527,91 @@ TEST(Config, RigSectionErrorsNameLineAndField) {
   }
   // The servo needs a screw on every leg.
   EXPECT_NE(config_error(test::replace_line(base, 9, "  lead: 0")).find("needs a lead screw"), std::string::npos);
+}
+
+
+// ---- corrected configuration (identify's output) ------------------------------------------------
+
+// What an identification changes: one lead and thread for all legs, offsets, the observation point.
+ModelSpec corrected_of(const ModelSpec& nominal) {
+  ModelSpec c = nominal;
+  c.name += " (identified from: 'a log.csv' # not a comment)";  // quoted as YAML needs
+  for (int i = 0; i < kLegs; ++i) {
+    LegSpec& leg = c.legs[static_cast<std::size_t>(i)];
+    leg.lead = 0.0105123456789;
+    leg.thread = ThreadSense::Left;
+    leg.length_offset = 1e-3 * (0.1 + 0.123456789 * i) * (i % 2 == 0 ? 1 : -1);
+  }
+  c.observation_P = Vector3d(1.2031234567, -0.0021, 0.00123);
+  return c;
+}
+
+// The corrected text loads to exactly the corrected model, and everything else as the original.
+void expect_corrected(const std::string& original, const std::string& source) {
+  const Config before = load_config(original, source);
+  const ModelSpec want = corrected_of(before.rig.model().spec());
+  const std::string text = corrected_config_yaml(original, source, want, "line one\nline two");
+  EXPECT_EQ(text.rfind("# line one\n# line two\n", 0), 0u) << text;
+  const Config after = load_config(text, "corrected.yaml");
+  const ModelSpec& got = after.rig.model().spec();
+  EXPECT_EQ(got.name, want.name);
+  EXPECT_EQ(got.home_height, want.home_height);
+  EXPECT_EQ(got.observation_P, want.observation_P);  // exact: numbers round trip
+  EXPECT_EQ(got.pivot_P, want.pivot_P);
+  EXPECT_EQ(got.limits.length_max, want.limits.length_max);
+  EXPECT_EQ(got.limits.bend_max, want.limits.bend_max);
+  for (std::size_t i = 0; i < kLegs; ++i) {
+    EXPECT_EQ(got.legs[i].lead, want.legs[i].lead) << i;
+    EXPECT_EQ(got.legs[i].thread, ThreadSense::Left) << i;
+    EXPECT_EQ(got.legs[i].driven, want.legs[i].driven) << i;
+    EXPECT_EQ(got.legs[i].length_offset, want.legs[i].length_offset) << i;
+    EXPECT_EQ(got.legs[i].base_B, want.legs[i].base_B) << i;
+    EXPECT_EQ(got.legs[i].platform_P, want.legs[i].platform_P) << i;
+    EXPECT_EQ(got.legs[i].axis_base_B, want.legs[i].axis_base_B) << i;
+  }
+  // The other sections are kept.
+  EXPECT_EQ(after.rig.servo().torque_limit, before.rig.servo().torque_limit);
+  EXPECT_EQ(after.rig.servo().pole_frequency, before.rig.servo().pole_frequency);  // the gains follow the lead
+  EXPECT_EQ(after.rig.servo().encoder_counts, before.rig.servo().encoder_counts);
+  EXPECT_EQ(after.rig.load().mass, before.rig.load().mass);
+  EXPECT_EQ(after.rig.control_period(), before.rig.control_period());
+  EXPECT_EQ(after.study.linear_amplitude, before.study.linear_amplitude);
+  EXPECT_EQ(after.study.dwell, before.study.dwell);
+  // Correcting again with the same values changes nothing.
+  EXPECT_EQ(corrected_config_yaml(text, "corrected.yaml", want, "line one\nline two"), text);
+}
+
+TEST(Config, CorrectedConfigOfTheSeedLoadsToTheCorrectedModel) {
+  expect_corrected(std::string(seed_config_yaml()), "seed.yaml");
+}
+
+TEST(Config, CorrectedConfigOfALegsFileWithRigSectionsLoadsToTheCorrectedModel) {
+  expect_corrected(test::seed_legs_yaml() + kRigSections, "legs.yaml");
+}
+
+TEST(Config, CorrectedConfigReplacesPerLegScrewKeys) {
+  // Leg 2 gives its own lead and thread: they are corrected too, or they would override the block.
+  std::string text = test::seed_legs_yaml();
+  const std::string anchor = "    platform_axis: ";
+  std::size_t at = text.find(anchor);
+  at = text.find(anchor, at + 1);  // leg 2
+  at = text.find('\n', at) + 1;
+  text.insert(at, "    lead: 0.012\n    thread: right\n    driven_side: platform\n");
+  ASSERT_EQ(load_model(text, "legs.yaml").leg(1).lead, 0.012);
+  const ModelSpec want = corrected_of(load_model(text, "legs.yaml").spec());
+  const Model got = load_model(corrected_config_yaml(text, "legs.yaml", want, ""), "corrected.yaml");
+  EXPECT_EQ(got.leg(1).lead, want.legs[1].lead);
+  EXPECT_EQ(got.leg(1).thread, ThreadSense::Left);
+  EXPECT_EQ(got.leg(1).driven, DrivenSide::Platform);  // kept
+}
+
+TEST(Config, CorrectedConfigRefusesBadTextAndLegsThatDiffer) {
+  const std::string seed(seed_config_yaml());
+  ModelSpec spec = corrected_of(test::seed_model().spec());
+  test::expect_error_line([&] { (void)corrected_config_yaml("screw: [", "bad.yaml", spec, ""); }, "bad.yaml:");
+  spec.legs[3].lead = 0.011;
+  test::expect_error_line([&] { (void)corrected_config_yaml(seed, "seed.yaml", spec, ""); }, "seed.yaml: corrected model:",
+                    {"leg 4", "one screw"});
 }
 
 }  // namespace

@@ -128,6 +128,31 @@ TEST(Forward, MotorModeDiffersFromGeometricModeByTheTwist) {
   EXPECT_LT(miss, 5e-3);
 }
 
+TEST(Forward, MotorModeTakesTheLengthOffsetsOutAndGeometricModeIgnoresThem) {
+  // Motor-side lengths m of a platform with offsets delta are m0 - delta, m0 those without: both
+  // models must give the same pose for their own lengths. Geometric lengths have no offset.
+  std::mt19937_64 rng(kSeed + 40);
+  const Model offset = seed_with_offsets(rng, 2e-3);
+  const Vector6d& delta = offset.geometry().length_offset;
+  double worst = 0.0;
+  for (int n = 0; n < 200; ++n) {
+    const Pose p = random_valid_pose(seed_model(), rng, 0.4, deg2rad(25));
+    Vector6d m0;
+    LimitReport lim;
+    ASSERT_EQ(motor_commands(seed_model(), p, Strategy::Compensated, m0, lim), Status::Ok);
+    FkResult a, b, g;
+    ASSERT_EQ(forward_kinematics(seed_model(), m0, LengthKind::Motor, Placement{}, a), Status::Ok);
+    ASSERT_EQ(forward_kinematics(offset, m0 - delta, LengthKind::Motor, Placement{}, b), Status::Ok);
+    const PoseError e = pose_error(a.placement, b.placement);
+    worst = std::max({worst, e.position, e.rotation});
+    ASSERT_EQ(forward_kinematics(offset, a.legs.length, LengthKind::Geometric, Placement{}, g), Status::Ok);
+    const PoseError eg = pose_error(a.placement, g.placement);
+    worst = std::max({worst, eg.position, eg.rotation});
+  }
+  report("pose difference [m or rad]", worst);
+  EXPECT_LT(worst, 1e-11);
+}
+
 TEST(Forward, ReportsNoConvergenceWhenIterationsRunOut) {
   Pose p;
   p.position = Vector3d(0.4, -0.2, 0.3);

@@ -126,6 +126,28 @@ TEST(Model, RejectsNonFiniteLead) {
   }
 }
 
+TEST(Model, RejectsNonFiniteLengthOffsetOrOneAsLongAsTheStroke) {
+  // A zero error of the motor-side length (theory §4) is finite and shorter than the stroke
+  // (1.05 m on the seed); the sign is free.
+  for (const double v : {kNaN, kInf, -kInf}) {
+    ModelSpec spec = seed_spec();
+    spec.legs[2].length_offset = v;
+    expect_rejected(spec, {"leg 3", "length_offset", "finite"});
+  }
+  for (const double v : {1.06, -1.06, 2.0}) {
+    ModelSpec spec = seed_spec();
+    spec.legs[4].length_offset = v;
+    expect_rejected(spec, {"leg 5", "length_offset", "stroke"});
+  }
+  ModelSpec spec = seed_spec();
+  spec.legs[4].length_offset = -1.04;
+  spec.legs[5].length_offset = 1e-3;
+  const Model m(spec);
+  EXPECT_EQ(m.leg(4).length_offset, -1.04);
+  EXPECT_EQ(m.geometry().length_offset[5], 1e-3);
+  EXPECT_EQ(m.geometry().length_offset[0], 0.0);
+}
+
 TEST(Model, RejectsNonFiniteOrNonPositiveHomeHeight) {
   for (const double v : {kNaN, kInf, -kInf, 0.0, -1.511}) {
     ModelSpec spec = seed_spec();

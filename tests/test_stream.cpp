@@ -236,6 +236,33 @@ TEST(Stream, RateLimitsBoundEveryStepAndReachTheTargetInTheTrapezoidTime) {
   }
 }
 
+TEST(Stream, RateLimitedStepsOfAPlatformWithLengthOffsetsMeanPosesOnTheWay) {
+  // The check of a limited step must read the command as the platform does: with offsets, a
+  // conventional command is the real length minus delta. Steps from home towards a target must
+  // mean poses between the two, not a pose delta away.
+  ModelSpec spec = seed_model().spec();
+  const std::array<double, kLegs> delta{2e-3, -2e-3, 1e-3, -1e-3, 2e-3, -2e-3};
+  for (std::size_t i = 0; i < delta.size(); ++i) spec.legs[i].length_offset = delta[i];
+  const Model model(spec);
+  for (const Strategy strategy : {Strategy::Compensated, Strategy::Conventional}) {
+    StreamSettings s = limited(0.05, 0.4);
+    s.strategy = strategy;
+    StreamState state;
+    ASSERT_EQ(start_stream(model, s, Pose{}, state), Status::Ok);
+    Pose target;
+    target.position.z() = 0.01;
+    StreamOutput out;
+    ASSERT_EQ(stream_pose(model, s, target, state, out), Status::Ok);
+    ASSERT_TRUE(out.rate_limited);
+    // The pose of the first limited step: a few micrometres up from home, level.
+    const Pose p = pose_from_placement(state.placement);
+    EXPECT_GT(p.position.z(), 0.0);
+    EXPECT_LT(p.position.z(), 1e-4);
+    EXPECT_LT(p.position.head<2>().norm(), 1e-9);
+    EXPECT_LT(p.rpy.norm(), 1e-9);
+  }
+}
+
 TEST(Stream, RateLimitedHoldKeepsMovingTowardsTheLastValidTarget) {
   const Model& model = seed_model();
   StreamSettings s = limited(0.05, kInf);

@@ -2,6 +2,8 @@
 // loop adds nothing to the servo's own error, and the twist error grows away from home.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "hexatwist/config.hpp"
 #include "hexatwist/study.hpp"
 
@@ -23,6 +25,29 @@ TEST(Study, ErrorStats) {
   const ErrorStats s = error_stats({3.0, 4.0, 0.0, 0.0});
   EXPECT_EQ(s.max, 4.0);
   EXPECT_DOUBLE_EQ(s.rms, 2.5);
+}
+
+TEST(Study, KeepAfterDropsTheTicksBeforeAndRecomputesTheStatistics) {
+  TestRun run;
+  for (StrategyRun* r : {&run.conventional, &run.compensated}) {
+    r->samples.resize(4);
+    for (int k = 0; k < 4; ++k) {
+      r->samples[static_cast<std::size_t>(k)].time = 0.5 * k;
+      r->samples[static_cast<std::size_t>(k)].error = r == &run.conventional ? 4.0 - k : 1.0 + k;
+      r->samples[static_cast<std::size_t>(k)].error_twist_only = 0.1 * k;
+    }
+  }
+  run.tracking_only = {9.0, 3.0, 0.0, 4.0};
+  keep_after(run, 0.5);  // ticks at 1.0 and 1.5 s stay
+  ASSERT_EQ(run.conventional.samples.size(), 2u);
+  ASSERT_EQ(run.compensated.samples.size(), 2u);
+  EXPECT_EQ(run.conventional.samples[0].time, 1.0);
+  EXPECT_EQ(run.tracking_only, (std::vector<double>{0.0, 4.0}));
+  EXPECT_EQ(run.conventional.total.max, 2.0);
+  EXPECT_EQ(run.compensated.total.max, 4.0);
+  EXPECT_DOUBLE_EQ(run.compensated.twist_only.rms, std::sqrt((0.04 + 0.09) / 2));
+  EXPECT_EQ(run.compensated.tracking_only.max, 4.0);
+  EXPECT_DOUBLE_EQ(run.conventional.tracking_only.rms, std::sqrt(8.0));
 }
 
 // One default test per parameter (the full seed test: about 0.8 s each).

@@ -499,21 +499,11 @@ TEST(Trajectory, CsvInSiUnitsReadsBackExactly) {
 // and containing every one of `parts`.
 void expect_csv_error(const std::string& text, int line, int column, std::string_view name,
                       std::initializer_list<std::string_view> parts = {}) {
-  std::string msg;
-  try {
-    (void)parse_trajectory_csv(text, "bad.csv");
-    ADD_FAILURE() << "parsed without error:\n" << text;
-    return;
-  } catch (const Error& e) {
-    msg = e.what();
-  }
-  SCOPED_TRACE("message: " + msg);
-  EXPECT_EQ(msg.find('\n'), std::string::npos) << "not a single line";
-  EXPECT_EQ(msg.find('\r'), std::string::npos) << "carries a carriage return";
-  const std::string where =
-      "bad.csv:" + std::to_string(line) + ":" + std::to_string(column) + ": column '" + std::string(name) + "':";
-  EXPECT_EQ(msg.rfind(where, 0), 0u) << "does not start with " << where;
-  for (const std::string_view p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "does not name '" << p << "'";
+  SCOPED_TRACE(text);
+  expect_error_line(
+      [&] { (void)parse_trajectory_csv(text, "bad.csv"); },
+      "bad.csv:" + std::to_string(line) + ":" + std::to_string(column) + ": column '" + std::string(name) + "':",
+      parts);
 }
 
 const std::string kHeader = "t, x, y, z, roll, pitch, yaw\n";
@@ -735,6 +725,72 @@ TEST(Trajectory, BadResampleInputsAreErrors) {
   huge.lines = {3, 5, 7};
   huge.poses[1].position.y() = 1e308;
   expect(error_of([&] { (void)resample(huge, 0.01); }), "between sample 0 (line 3) and sample 1 (line 5): the interpolation overflows");
+}
+
+// ---- waypoints and interpolation -------------------------------------------------------------
+
+TEST(Trajectory, WaypointMovesAreStraightJerkLimitedAndHeld) {
+  // Home, a 3-D translation, another, home: every sample on its segment, at the distance the
+  // jerk-limited move gives, the waypoints held for the dwell, the end exact.
+  const auto expect = [](const std::string& msg, std::string_view part) {
+    EXPECT_NE(msg.find(part), std::string::npos) << msg;
+  };
+  std::array<Vector6d, 4> w;
+  w[0].setZero();
+  w[1] << 0.1, -0.2, 0.05, 0, 0, 0;
+  w[2] << -0.1, 0.0, 0.15, 0, 0, 0;
+  w[3].setZero();
+  const MotionLimits limits{0.2, 0.5, 2.5};
+  const double dwell = 0.3, dt = 1e-3;
+  const Trajectory tr = waypoint_trajectory(w, limits, dwell, dt);
+  double t = dwell, worst = 0.0;
+  std::size_t k = 0;
+  for (std::size_t m = 0; m + 1 < w.size(); ++m) {
+    const Vector6d d = w[m + 1] - w[m];
+    const JerkLimitedMove move(d.norm(), limits);
+    for (; k < tr.poses.size() && tr.time(k) < t + move.duration() + dwell; ++k) {
+      const double s = move.sample(tr.time(k) - t).position;
+      const Vector6d expected = w[m] + d.normalized() * s;
+      worst = std::max(worst, (tr.poses[k].to_vector() - expected).cwiseAbs().maxCoeff());
+      if (tr.time(k) < t) {
+        ASSERT_EQ(tr.poses[k].to_vector(), tr.poses[k > 0 ? k - 1 : 0].to_vector()) << "held";
+      }
+    }
+    t += move.duration() + dwell;
+  }
+  report("waypoint sample off its move [m]", worst);
+  EXPECT_LT(worst, 1e-15);
+  EXPECT_EQ(tr.poses.back().to_vector(), w.back());
+  EXPECT_NEAR(tr.duration(), t, dt);
+  expect(error_of([&] { (void)waypoint_trajectory(std::span(w).first(1), limits, dwell, dt); }), "at least 2");
+  w[1][2] = std::numeric_limits<double>::quiet_NaN();
+  expect(error_of([&] { (void)waypoint_trajectory(w, limits, dwell, dt); }), "pose 2 is not finite");
+}
+
+TEST(Trajectory, InterpolateIsTheResampledCurveAtAnyTime) {
+  const auto expect = [](const std::string& msg, std::string_view part) {
+    EXPECT_NE(msg.find(part), std::string::npos) << msg;
+  };
+  std::mt19937_64 rng(kSeed + 213);
+  for (int n = 0; n < stress(50); ++n) {
+    const TimedPoses tp = polynomial_samples(random_times(rng, 3 + n % 10), 2);
+    const double dt = uniform(rng, 0.01, 0.1);
+    const Trajectory tr = resample(tp, dt);
+    // On the grid: resample's poses, bit for bit (the grid times that are not input times).
+    std::vector<double> grid;
+    for (std::size_t k = 0; k < tr.poses.size(); ++k) grid.push_back(tr.time(k));
+    const std::vector<Pose> at_grid = interpolate(tp, grid);
+    for (std::size_t k = 0; k < grid.size(); ++k)
+      ASSERT_LT((at_grid[k].to_vector() - tr.poses[k].to_vector()).cwiseAbs().maxCoeff(), 1e-15) << k;
+    // At the input times: the input poses exactly.
+    const std::vector<Pose> at_samples = interpolate(tp, tp.t);
+    for (std::size_t i = 0; i < tp.t.size(); ++i) ASSERT_EQ(at_samples[i].to_vector(), tp.poses[i].to_vector());
+  }
+  const TimedPoses tp = polynomial_samples({0.0, 1.0, 2.0}, 1);
+  const std::vector<double> outside{0.5, 2.5};
+  expect(error_of([&] { (void)interpolate(tp, outside); }),
+         "time 2.5 (number 2) is outside the samples' span [0, 2] s");
+  EXPECT_EQ(timed_poses(resample(tp, 0.5)).t, (std::vector<double>{0.0, 0.5, 1.0, 1.5, 2.0}));
 }
 
 }  // namespace

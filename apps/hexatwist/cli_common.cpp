@@ -50,6 +50,25 @@ std::string read_text_file(const std::string& path, const std::string& option, c
   return text.str();
 }
 
+void write_output_file(const std::string& file, std::string_view content) {
+  namespace fs = std::filesystem;
+  const fs::path path(file);
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out.write(content.data(), static_cast<std::streamsize>(content.size()));
+    out.close();
+    if (!out) {
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}'", path.string()));
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}': {}", path.string(), ec.message()));
+}
+
 Model load_model_from(const ModelOptions& opts) {
   try {
     if (opts.config.empty()) return default_model();

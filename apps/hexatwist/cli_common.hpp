@@ -20,6 +20,7 @@ enum ExitCode : int {
   kExitBadInput = 2,      ///< malformed input, bad configuration, unreadable file
   kExitOutOfLimit = 3,    ///< a pose outside a limit, or a forward-kinematics failure
   kExitOutputFailed = 4,  ///< an output file or figure could not be written
+  kExitNotIdentified = 5, ///< identify: the data do not determine the parameters, or the solver did not converge
 };
 
 /// A failure the tool reports as one line on stderr with its exit code.
@@ -51,6 +52,10 @@ Config load_config_from(const ModelOptions& opts);
 
 /// Reads a whole file; a missing, unreadable or directory path becomes ExitError(2) naming `option`.
 std::string read_text_file(const std::string& path, const std::string& option, const std::string& what);
+
+/// Writes `content` to the file whole: to a temporary name first, then renamed; ExitError(4)
+/// naming the file if it cannot be written.
+void write_output_file(const std::string& path, std::string_view content);
 
 /// Name of the platform source for messages.
 std::string model_source(const ModelOptions& opts);
@@ -84,5 +89,8 @@ Command make_config_command(CLI::App& root);
 Command make_study_command(CLI::App& root);
 Command make_simulate_command(CLI::App& root);
 Command make_stream_command(CLI::App& root);
+Command make_synth_command(CLI::App& root);
+Command make_measure_command(CLI::App& root);
+Command make_identify_command(CLI::App& root);
 
 }  // namespace hexatwist::cli

@@ -76,7 +76,7 @@ int run_config(const ConfigOptions& o) {
       axes ? j.vector(l.axis_platform_P) : j.null();
       j.field("lead", l.lead).field("thread", l.thread == ThreadSense::Right ? "right" : "left");
       j.field("driven_side", l.driven == DrivenSide::Base ? "base" : "platform").field("twist_gain", l.twist_gain);
-      j.field("length_home", l.length_home);
+      j.field("length_offset", l.length_offset).field("length_home", l.length_home);
       j.key("direction_home").vector(l.s_home_B);
       j.key("twist_home_absolute");
       axes ? j.value(l.theta_home) : j.null();
@@ -119,6 +119,8 @@ int run_config(const ConfigOptions& o) {
     out += fmt::format("  lead {:.4g} mm, {}-hand thread, driven at the {}; twist gain {:+.6g} mm/rad\n", 1e3 * l.lead,
                        l.thread == ThreadSense::Right ? "right" : "left",
                        l.driven == DrivenSide::Base ? "base" : "platform", 1e3 * l.twist_gain);
+    if (l.length_offset != 0.0)
+      out += fmt::format("  length offset {:+.4f} mm (real minus motor-side)\n", 1e3 * l.length_offset);
     out += fmt::format("  home length {:.6f} m, direction {} [B]", l.length_home, v3(l.s_home_B));
     if (!std::isnan(l.theta_home)) out += fmt::format(", absolute twist at home {:.4f} deg", rad2deg(l.theta_home));
     out += "\n";

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,6 +35,11 @@ class JsonWriter {
     return *this;
   }
   JsonWriter& value(int v) {
+    separator();
+    out_ += fmt::format("{}", v);
+    return *this;
+  }
+  JsonWriter& value(std::uint64_t v) {
     separator();
     out_ += fmt::format("{}", v);
     return *this;

@@ -1,7 +1,11 @@
 #include "study_report.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <array>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -31,30 +35,15 @@ constexpr PaperRow kPaperTable1[] = {
 };
 constexpr const char* kPaperColumns[4] = {"Lz", "Lx", "Rz", "Ry"};
 
-// Writes `content` to `path` whole: to a temporary name first, then renamed.
-void write_file(const fs::path& path, std::string_view content) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(content.data(), static_cast<std::streamsize>(content.size()));
-    out.close();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}'", path.string()));
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}': {}", path.string(), ec.message()));
-}
-
 // The swept coordinate of a sample as plotted: m for translations, deg for rotations, or time.
-double displacement(const ReportedTest& t, const SimulationSample& s) {
-  if (t.coordinate < 0) return s.time;
-  const double v = s.desired[t.coordinate];
+double displacement(const ReportedTest& t, double time, const Vector6d& desired) {
+  if (t.coordinate < 0) return time;
+  const double v = desired[t.coordinate];
   return t.coordinate < 3 ? v : rad2deg(v);
 }
+double displacement(const ReportedTest& t, const SimulationSample& s) { return displacement(t, s.time, s.desired); }
+
+const char* strategy_name(Strategy s) { return s == Strategy::Compensated ? "compensated" : "conventional"; }
 
 std::string displacement_label(const ReportedTest& t) {
   if (t.coordinate < 0) return "time [s]";
@@ -84,6 +73,26 @@ std::string csv(const ReportedTest& t, const StrategyRun& run, const Model& mode
     for (int i = 0; i < kLegs; ++i) fmt::format_to(out, ",{:.6g}", s.torque[i]);
     const double tracking = k < t.run.tracking_only.size() ? t.run.tracking_only[k] : NAN;
     fmt::format_to(out, ",{:.6g},{:.6g},{:.6g}\n", s.error, s.error_twist_only, tracking);
+  }
+  return fmt::to_string(b);
+}
+
+// The measured points: as measured, registered, commanded, their error and the simulated one.
+std::string measured_csv(const ReportedMeasurement& r) {
+  fmt::memory_buffer b;
+  auto out = std::back_inserter(b);
+  fmt::format_to(out,
+                 "t_s,line,registration_window,registration_point,x_T_m,y_T_m,z_T_m,x_B_m,y_B_m,z_B_m,desired_x_B_m,"
+                 "desired_y_B_m,desired_z_B_m,error_x_m,error_y_m,error_z_m,error_m,simulated_error_m\n");
+  const Measurement& m = r.measurement;
+  for (std::size_t k = 0; k < m.points.size(); ++k) {
+    const MeasuredPoint& p = m.points[k];
+    fmt::format_to(out, "{:.6f},{},{},{}", p.time, p.line, p.in_window ? 1 : 0, p.registered ? 1 : 0);
+    for (const Vector3d* v : {&p.p_T, &p.p_B, &p.desired_B, &p.error_B})
+      for (int a = 0; a < 3; ++a) fmt::format_to(out, ",{:.10g}", (*v)[a]);
+    fmt::format_to(out, ",{:.6g},", p.error_B.norm());
+    if (k >= m.window) fmt::format_to(out, "{:.6g}", r.simulated[k - m.window]);
+    fmt::format_to(out, "\n");
   }
   return fmt::to_string(b);
 }
@@ -125,6 +134,44 @@ void stats_json(JsonWriter& j, const StrategyRun& r, const Rig& rig) {
       .end_object();
 }
 
+// The log line of the registration point with the largest residual.
+int worst_line(const Measurement& m) {
+  return m.points[m.registered[static_cast<std::size_t>(m.registration.max_residual_index)]].line;
+}
+
+void measured_json(JsonWriter& j, const ReportedMeasurement& r) {
+  const Measurement& m = r.measurement;
+  const Registration& reg = m.registration;
+  int registered = 0;
+  for (const MeasuredPoint& p : m.points) registered += p.registered ? 1 : 0;
+  j.begin_object()
+      .field("points_file", r.source)
+      .field("strategy", strategy_name(r.strategy))
+      .field("points", static_cast<int>(m.points.size()))
+      .field("evaluated", static_cast<int>(m.points.size() - m.window));
+  j.key("registration").begin_object();
+  j.field("window", r.window)
+      .field("window_points", static_cast<int>(m.window))
+      .field("window_end", m.window_end)
+      .field("points", registered);
+  j.key("R_BT").begin_array();
+  for (int i = 0; i < 3; ++i) j.vector(reg.X_BT.R.row(i));
+  j.end_array();
+  j.key("t_BT").vector(reg.X_BT.t);
+  j.field("rms_residual", reg.rms_residual)
+      .field("max_residual", reg.max_residual)
+      .field("max_residual_line", worst_line(m))
+      .field("sigma", reg.sigma)
+      .field("condition", reg.condition)
+      .field("reflection", reg.reflection)
+      .end_object();
+  j.field("max_error", m.error.max).field("rms_error", m.error.rms);
+  j.key("max_error_axes").vector(Vector3d(m.axes[0].max, m.axes[1].max, m.axes[2].max));
+  j.key("rms_error_axes").vector(Vector3d(m.axes[0].rms, m.axes[1].rms, m.axes[2].rms));
+  j.field("simulated_max_error", r.simulated_stats.max).field("simulated_rms_error", r.simulated_stats.rms);
+  j.end_object();
+}
+
 std::string summary_json(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests) {
   JsonWriter j;
   j.begin_object()
@@ -144,6 +191,10 @@ std::string summary_json(const Rig& rig, const ReportOptions& o, const std::vect
     stats_json(j, t.run.conventional, rig);
     j.key("compensated");
     stats_json(j, t.run.compensated, rig);
+    if (t.measured) {
+      j.key("measured");
+      measured_json(j, *t.measured);
+    }
     j.end_object();
   }
   j.end_array().end_object();
@@ -198,6 +249,34 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
     }
     s += "\n";
   }
+  // The experiment: measured, and the simulation at the same instants.
+  if (std::any_of(tests.begin(), tests.end(), [](const ReportedTest& t) { return t.measured.has_value(); })) {
+    for (const bool simulated : {false, true}) {
+      s += fmt::format("| experiment | {} |", simulated ? "simulated at the measured times" : "measured");
+      for (const ReportedTest& t : tests) {
+        const ErrorStats* st = !t.measured ? nullptr
+                               : simulated ? &t.measured->simulated_stats
+                                           : &t.measured->measurement.error;
+        s += st != nullptr ? fmt::format(" {} | {} |", mm(st->max), mm(st->rms)) : std::string(" | |");
+      }
+      s += "\n";
+    }
+    for (const ReportedTest& t : tests) {
+      if (!t.measured) continue;
+      const ReportedMeasurement& r = *t.measured;
+      const Measurement& m = r.measurement;
+      const Registration& reg = m.registration;
+      s += fmt::format(
+          "\n**{}**: measured points `{}`, {} commands. The tracker frame was registered on the {} points at rest "
+          "among "
+          "the {} of {} (t <= {:.3f} s): rms residual {} mm, largest {} mm (line {}), noise estimate {} mm per axis, "
+          "condition {:.3g}. The {} points after them are evaluated (`{}_measured.csv`, `{}_measured.png`).\n",
+          t.name, r.source, strategy_name(r.strategy), reg.count, m.window, r.window, m.window_end,
+          mm(reg.rms_residual), mm(reg.max_residual),
+          worst_line(m), mm(reg.sigma), reg.condition,
+          m.points.size() - m.window, t.name, t.name);
+    }
+  }
   if (const std::string notes = report_notes(rig, tests); !notes.empty()) s += "\n" + notes;
   s += "\nTests:\n\n";
   for (const ReportedTest& t : tests)
@@ -214,6 +293,42 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
     (void)kPaperColumns;
   }
   return s;
+}
+
+// The experiment beside the simulation: the error against the swept coordinate (or time), and its
+// components in the base frame against time.
+Figure measured_figure(const fs::path& dir, const ReportedTest& t) {
+  const ReportedMeasurement& r = *t.measured;
+  const Measurement& m = r.measurement;
+  const char* strategy = strategy_name(r.strategy);
+  Series measured{fmt::format("measured ({})", strategy), {}, {}, Series::Style::Solid};
+  Series simulated{fmt::format("simulated ({}, closed loop)", strategy), {}, {}, Series::Style::Dashed};
+  std::array<Series, 3> axes;
+  for (int a = 0; a < 3; ++a)
+    axes[static_cast<std::size_t>(a)].label = fmt::format("{} (base frame)", kCoordinateNames[a]);
+  for (std::size_t k = m.window; k < m.points.size(); ++k) {
+    const MeasuredPoint& p = m.points[k];
+    const double x = displacement(t, p.time, p.desired);
+    measured.x.push_back(x);
+    measured.y.push_back(1e3 * p.error_B.norm());
+    simulated.x.push_back(x);
+    simulated.y.push_back(1e3 * r.simulated[k - m.window]);
+    for (int a = 0; a < 3; ++a) {
+      axes[static_cast<std::size_t>(a)].x.push_back(p.time);
+      axes[static_cast<std::size_t>(a)].y.push_back(1e3 * p.error_B[a]);
+    }
+  }
+  Figure f{(dir / (t.name + "_measured")).string(), "", {}};
+  f.panels.push_back({fmt::format("{} ({}): measured and simulated error of point A", t.name, t.description),
+                      displacement_label(t),
+                      "position error [mm]",
+                      {std::move(measured), std::move(simulated)}});
+  f.panels.push_back({fmt::format("Measured error by axis, registered on {} points (rms residual {:.4f} mm)",
+                                  m.registration.count, 1e3 * m.registration.rms_residual),
+                      "time [s]",
+                      "error [mm]",
+                      {axes.begin(), axes.end()}});
+  return f;
 }
 
 std::vector<Figure> figures_of(const fs::path& dir, const ReportedTest& t, const Model& model) {
@@ -292,10 +407,90 @@ std::vector<Figure> figures_of(const fs::path& dir, const ReportedTest& t, const
   }
   legs.panels.push_back(std::move(twist));
   legs.panels.push_back(std::move(length));
-  return {std::move(error), std::move(legs)};
+  std::vector<Figure> out{std::move(error), std::move(legs)};
+  if (t.measured) out.push_back(measured_figure(dir, t));
+  return out;
+}
+
+// A progress bar on stderr, drawn only on a terminal.
+class Progress {
+ public:
+  explicit Progress(std::size_t total) : total_(total), tty_(isatty(fileno(stderr)) != 0) {}
+  void update(std::size_t done, const std::string& what) {
+    if (!tty_ || total_ == 0) return;
+    const int percent = static_cast<int>(100.0 * static_cast<double>(done) / static_cast<double>(total_));
+    if (percent == last_) return;
+    last_ = percent;
+    const int filled = percent * 30 / 100;
+    std::fprintf(stderr, "\r[%s%s] %3d%%  %-24s", std::string(static_cast<std::size_t>(filled), '#').c_str(),
+                 std::string(static_cast<std::size_t>(30 - filled), '.').c_str(), percent, what.c_str());
+    std::fflush(stderr);
+  }
+  void finish() {
+    if (tty_ && last_ >= 0) std::fprintf(stderr, "\r%*s\r", 60, "");
+  }
+
+ private:
+  std::size_t total_;
+  bool tty_;
+  int last_ = -1;
+};
+
+std::string where(const ReportedTest& t, const SimulationIssue& issue) {
+  return fmt::format("{}: t = {:.3f} s", t.label, issue.time);
 }
 
 }  // namespace
+
+void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std::string& out_dir) {
+  for (const ReportedTest& t : tests) {
+    SimulationIssue issue;
+    if (const Status s = check_trajectory(rig, t.trajectory, issue); s != Status::Ok)
+      throw ExitError(kExitOutOfLimit,
+                      fmt::format("{}: {}; nothing was simulated", where(t, issue),
+                                  is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+  }
+  prepare_output_folder(out_dir);
+  std::size_t total = 0;
+  for (const ReportedTest& t : tests) total += 3 * t.trajectory.poses.size();
+  Progress bar(total);
+  std::size_t before = 0;
+  for (ReportedTest& t : tests) {
+    SimulationIssue issue;
+    const Status s = run_test(rig, t.trajectory, t.run, issue,
+                              [&](std::size_t done, std::size_t) { bar.update(before + done, t.name); });
+    if (s != Status::Ok) {
+      bar.finish();
+      throw ExitError(kExitOutOfLimit,
+                      fmt::format("{}: simulation stopped: {}; no report was written", where(t, issue),
+                                  is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+    }
+    before += 3 * t.trajectory.poses.size();
+  }
+  bar.finish();
+}
+
+std::string simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<ReportedTest>& tests,
+                                std::chrono::steady_clock::time_point start,
+                                const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation) {
+  simulate_tests(rig, tests, o.out_dir);
+  const double simulated = [&] {
+    double d = 0.0;
+    for (const ReportedTest& t : tests) d += 3.0 * t.trajectory.duration();
+    return d;
+  }();
+  const double sim_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::string preamble = after_simulation ? after_simulation(tests) : std::string();
+  const std::vector<std::string> files = write_report(rig, o, tests);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::string out = fmt::format("hexatwist {} on {}: {}\n", o.command, o.config_source, rig.model().spec().name);
+  out += preamble + "\n";
+  out += summary_table(tests);
+  out += report_notes(rig, tests);
+  out += fmt::format("\n{:.1f} s simulated ({} runs) in {:.1f} s; {} files written to {} in {:.1f} s in all\n",
+                     simulated, 3 * tests.size(), sim_wall, files.size(), o.out_dir, wall);
+  return out;
+}
 
 std::string summary_table(const std::vector<ReportedTest>& tests) {
   std::string s = fmt::format("{:<28}", "max. error of point A [mm]");
@@ -307,7 +502,46 @@ std::string summary_table(const std::vector<ReportedTest>& tests) {
     for (const ReportedTest& t : tests) s += fmt::format(" {:>10}", mm(row.stats(t).max));
     s += "\n";
   }
+  // The experiment: one row per strategy measured.
+  for (const Strategy strategy : {Strategy::Conventional, Strategy::Compensated}) {
+    const auto measured = [strategy](const ReportedTest& t) { return t.measured && t.measured->strategy == strategy; };
+    if (std::none_of(tests.begin(), tests.end(), measured)) continue;
+    s += fmt::format("{:<13} {:<14}", "experiment", strategy_name(strategy));
+    for (const ReportedTest& t : tests)
+      s += fmt::format(" {:>10}", measured(t) ? mm(t.measured->measurement.error.max) : std::string());
+    s += "\n";
+  }
   return s;
+}
+
+ReportedTest reported_test(const StudyTest& test) {
+  ReportedTest t;
+  t.name = test.name;
+  t.label = test.name;
+  t.description =
+      fmt::format("{}, +-{:g} {}", test.description, test.coordinate < 3 ? test.amplitude : rad2deg(test.amplitude),
+                  test.coordinate < 3 ? "m" : "deg");
+  t.coordinate = test.coordinate;
+  return t;
+}
+
+ReportedTest reported_trajectory_file(const std::string& path, double dt, TimedPoses* commanded) {
+  const std::string text = read_text_file(path, "--trajectory", "trajectory CSV file");
+  ReportedTest t;
+  try {
+    const TimedPoses poses = parse_trajectory_csv(text, path);
+    t.trajectory = resample(poses, dt);
+    if (commanded != nullptr) *commanded = poses;
+  } catch (const Error& e) {
+    throw ExitError(kExitBadInput, e.what());
+  }
+  // File-name-safe name from the file's stem.
+  for (const char c : fs::path(path).stem().string())
+    t.name += (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_') ? c : '_';
+  if (t.name.empty()) t.name = "trajectory";
+  t.description = fmt::format("trajectory {}", fs::path(path).filename().string());
+  t.label = printable(path);
+  return t;
 }
 
 void prepare_output_folder(const std::string& out_dir) {
@@ -336,7 +570,7 @@ std::vector<std::string> write_report(const Rig& rig, const ReportOptions& o, co
   prepare_output_folder(o.out_dir);
   std::vector<std::string> written;
   const auto put = [&](const fs::path& path, std::string_view content) {
-    write_file(path, content);
+    write_output_file(path.string(), content);
     written.push_back(path.string());
   };
   std::vector<Figure> figures;
@@ -345,6 +579,7 @@ std::vector<std::string> write_report(const Rig& rig, const ReportOptions& o, co
       put(dir / (t.name + "_conventional.csv"), csv(t, t.run.conventional, rig.model()));
       put(dir / (t.name + "_compensated.csv"), csv(t, t.run.compensated, rig.model()));
     }
+    if (t.measured) put(dir / (t.name + "_measured.csv"), measured_csv(*t.measured));
     if (o.figures)
       for (Figure& f : figures_of(dir, t, rig.model())) figures.push_back(std::move(f));
   }

@@ -2,12 +2,25 @@
 // summary.md, one CSV per test and strategy, and the figures.
 #pragma once
 
+#include <chrono>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "hexatwist/hexatwist.hpp"
 
 namespace hexatwist::cli {
+
+/// A point log measured on the test (`hexatwist measure`), reported beside the simulation.
+struct ReportedMeasurement {
+  std::string source;                         ///< the point log's file
+  Strategy strategy = Strategy::Compensated;  ///< the commands the platform ran
+  std::string window;                         ///< how the registration window was chosen, for the reader
+  Measurement measurement;
+  std::vector<double> simulated;  ///< simulated error of the same strategy at each evaluated point [m]
+  ErrorStats simulated_stats;     ///< statistics of `simulated` [m]
+};
 
 /// One simulated test with what is needed to report it.
 struct ReportedTest {
@@ -17,12 +30,22 @@ struct ReportedTest {
   int coordinate = -1;      ///< swept pose coordinate 0..5; -1 = a user trajectory (plotted against time)
   Trajectory trajectory;
   TestRun run;
+  std::optional<ReportedMeasurement> measured;  ///< with `measure`: the experiment
 };
+
+/// A study test to report: its name, label, description ("rotation about z, +-30 deg") and swept
+/// coordinate (the trajectory is the caller's).
+ReportedTest reported_test(const StudyTest& test);
+
+/// A trajectory CSV file to report: read, parsed and resampled at `dt` [s] (ExitError(2) with the
+/// parser's one-line message on a bad file), named after the file's stem (file-name safe); the
+/// poses as in the file go to `commanded` if given.
+ReportedTest reported_trajectory_file(const std::string& path, double dt, TimedPoses* commanded = nullptr);
 
 /// Where and how to write.
 struct ReportOptions {
   std::string out_dir;        ///< created if missing
-  std::string command;        ///< "study" or "simulate", for the summary
+  std::string command;        ///< "study", "simulate" or "measure", for the summary
   std::string config_source;  ///< where the configuration came from
   bool figures = true;        ///< draw PNG + SVG figures with gnuplot
   bool csv = true;            ///< write the per-tick CSVs
@@ -32,10 +55,24 @@ struct ReportOptions {
 /// Called before anything is simulated, so that a bad --out fails at once.
 void prepare_output_folder(const std::string& out_dir);
 
+/// Checks every test's trajectory against the limits first (ExitError(3) naming the test, time and
+/// limit, and nothing runs, if one fails), creates the output folder, then runs each test's three
+/// simulations (run_test), with a progress bar on stderr when it is a terminal.
+void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std::string& out_dir);
+
+/// What study, simulate and measure do once their tests are set up: simulate_tests, then
+/// `after_simulation` (may be empty; returns lines to print before the table, e.g. the
+/// measurement's registration), then write_report. Returns the text for the terminal: the platform,
+/// those lines, the table, the notes, and the time taken since `start`.
+std::string simulate_and_report(const Rig& rig, const ReportOptions& options, std::vector<ReportedTest>& tests,
+                                std::chrono::steady_clock::time_point start,
+                                const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation = {});
+
 /// Notes for the reader that the table does not show (torque saturation); empty if none.
 std::string report_notes(const Rig& rig, const std::vector<ReportedTest>& tests);
 
-/// The Table 1-like table for the terminal [mm].
+/// The Table 1-like table for the terminal [mm]: the simulation's rows, and an experiment row for
+/// the tests with a measurement.
 std::string summary_table(const std::vector<ReportedTest>& tests);
 
 /// Writes summary.json, summary.md, the CSVs and (optionally) the figures into out_dir; returns

@@ -9,8 +9,8 @@ namespace hexatwist {
 
 /// How motor-side commands are formed.
 enum class Strategy {
-  Conventional,  ///< command = IK length; the twist is ignored
-  Compensated,   ///< command = IK length - twist_gain * dtheta, Eq. (12)
+  Conventional,  ///< command = IK length - length_offset; the twist is ignored
+  Compensated,   ///< command = IK length - length_offset - twist_gain * dtheta, Eq. (12)
 };
 
 /// Length error of each leg caused by its twist, Eq. (10) with the configured sign:

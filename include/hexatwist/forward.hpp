@@ -9,7 +9,7 @@ namespace hexatwist {
 /// What the given lengths are.
 enum class LengthKind {
   Geometric,  ///< joint-to-joint leg lengths: solve |L_i(q)| = l_i
-  Motor,      ///< motor-side lengths: solve |L_i(q)| - twist_gain_i * dtheta_i(q) = m_i
+  Motor,      ///< motor-side lengths: solve |L_i(q)| - length_offset_i - twist_gain_i * dtheta_i(q) = m_i
 };
 
 /// Newton settings.

@@ -23,6 +23,7 @@ struct LegSpec {
   double lead = 0.0;                          ///< screw lead, travel per revolution [m]
   ThreadSense thread = ThreadSense::Right;    ///< thread hand
   DrivenSide driven = DrivenSide::Base;       ///< side whose motor turns the screw
+  double length_offset = 0.0;                 ///< real minus motor-side length at zero twist (theory §4) [m]
 };
 
 /// Motion limits (unvalidated).
@@ -61,6 +62,7 @@ struct Leg {
   double twist_gain;         ///< twist_sign * lead / 2pi: real minus motor-side length per rad [m/rad]
   ThreadSense thread;        ///< thread hand
   DrivenSide driven;         ///< driven side
+  double length_offset;      ///< real minus motor-side length at zero twist [m]
 };
 
 /// The legs' precomputed geometry with one leg per row, for code vectorised over legs.
@@ -73,6 +75,7 @@ struct LegGeometry {
   Vector6d cos_theta_home;     ///< cos of the absolute twist at home (1 without axes)
   Vector6d sin_theta_home;     ///< sin of the absolute twist at home (0 without axes)
   Vector6d twist_gain;         ///< real minus motor-side length per rad of twist [m/rad]
+  Vector6d length_offset;      ///< real minus motor-side length at zero twist [m]
   Vector6d has_axes;           ///< 1 for legs whose U-joint axes are given, else 0
 };
 

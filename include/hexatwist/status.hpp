@@ -22,6 +22,8 @@ enum class Status : int {
   MalformedInput,      ///< an input line is not six numbers (see LineParse)
   TooFewPoints,        ///< a point registration got fewer than three point pairs
   DegenerateRegistration,  ///< registration points are coincident or (nearly) collinear: the rotation is not determined
+  NotIdentifiable,     ///< the measurements do not determine every identified parameter
+  SolverNoConvergence, ///< the least-squares solver stopped before converging
 };
 
 /// True for the statuses that mean "this pose is outside a limit".

@@ -60,4 +60,8 @@ struct TestRun {
 [[nodiscard]] Status run_test(const Rig& rig, const Trajectory& trajectory, TestRun& run, SimulationIssue& issue,
                               const std::function<void(std::size_t, std::size_t)>& progress = {});
 
+/// Keeps the ticks of a run after time `t` [s] (e.g. a measured test after its calibration moves:
+/// the part that is compared with the measurement) and recomputes its statistics over them.
+void keep_after(TestRun& run, double t);
+
 }  // namespace hexatwist

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstddef>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -95,6 +96,17 @@ struct Trajectory {
 /// non-finite, dt <= 0 or non-finite, bad limits, or more than 1e8 samples.
 Trajectory sweep_trajectory(int coordinate, double amplitude, const MotionLimits& limits, double dwell, double dt);
 
+/// Straight-line moves through `waypoints` ([x, y, z, roll, pitch, yaw] relative to home [m, rad],
+/// at least 2): at rest at the first for `dwell` [s], then to each next one along the straight line
+/// between them in pose coordinates, each a JerkLimitedMove over the Euclidean distance between
+/// the two poses under `limits` (so give waypoints that differ in translations only, or in
+/// rotations only, for limits in one unit), with `dwell` after each. Sampled every `dt` [s] from
+/// t0 = 0 as sweep_trajectory is (which is this function through 0, +a, -a, 0 on one coordinate);
+/// the last pose is exactly the last waypoint. Throws hexatwist::Error for fewer than 2 or
+/// non-finite waypoints, and as sweep_trajectory for the rest.
+Trajectory waypoint_trajectory(std::span<const Vector6d> waypoints, const MotionLimits& limits, double dwell,
+                               double dt);
+
 /// Poses at arbitrary strictly increasing times, as read from a file.
 struct TimedPoses {
   std::vector<double> t;    ///< times [s], strictly increasing
@@ -129,5 +141,14 @@ TimedPoses parse_trajectory_csv(std::string_view text, std::string_view source);
 /// (finite samples whose difference or rate of change is beyond 1e308): it never returns a
 /// non-finite pose.
 Trajectory resample(const TimedPoses& samples, double dt);
+
+/// The poses at `times` [s] on the curve that `resample` samples (the same monotone cubic through
+/// `samples`), for times off a fixed grid, e.g. a tracker's. Each time must lie within
+/// [t.front(), t.back()]; a time equal to a sample's gives that sample's pose exactly. Throws
+/// hexatwist::Error as resample does, and for a time outside the span or not finite.
+std::vector<Pose> interpolate(const TimedPoses& samples, std::span<const double> times);
+
+/// The samples of a fixed-period trajectory with their times (for `interpolate`; no source lines).
+TimedPoses timed_poses(const Trajectory& trajectory);
 
 }  // namespace hexatwist
