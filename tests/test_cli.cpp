@@ -665,6 +665,9 @@ TEST(CliStream, BadOptionsAreOneLineErrors) {
   expect_error(run({"stream", "--rate=0"}, &none), 2, {"--rate"});
   expect_error(run({"stream", "--start=0,0,3,0,0,0"}, &none), 3, {"--start", "stroke_above_max"});
   expect_error(run({"stream", "--start=0,0,0,0,0"}, &none), 2, {"--start", "6"});
+  expect_error(run({"stream", "--busy-poll"}, &none), 2, {"--busy-poll", "udp://"});
+  expect_error(run({"stream", "--cpu=100000"}, &none), 2, {"--cpu 100000", "CPUs"});
+  expect_error(run({"stream", "--cpu=-3"}, &none), 2, {"--cpu -3", ">= 0"});
 }
 
 // A UDP socket of the test, bound to an ephemeral loopback port.
@@ -699,10 +702,13 @@ struct TestSocket {
   }
 };
 
-TEST(CliStream, UdpAnswersOneDatagramPerDatagramInOrder) {
+// Parameter: the stream's extra options (none; busy polling pinned to the first CPU).
+class CliStreamUdp : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(CliStreamUdp, AnswersOneDatagramPerDatagramInOrder) {
   TestSocket answers;
   const std::string command = shell_quote(HEXATWIST_CLI) + " stream --input=udp://127.0.0.1:0 --output=udp://127.0.0.1:" +
-                              std::to_string(answers.port()) + " --count=4 --idle-timeout=20 2>&1";
+                              std::to_string(answers.port()) + " --count=4 --idle-timeout=20 " + GetParam() + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   ASSERT_NE(pipe, nullptr);
   std::array<char, 512> line{};
@@ -732,6 +738,7 @@ TEST(CliStream, UdpAnswersOneDatagramPerDatagramInOrder) {
   }
   EXPECT_EQ(commands_of(csv_rows(got[0])[0]), commands_of(csv_rows(got[3])[0]));
 }
+INSTANTIATE_TEST_SUITE_P(Receive, CliStreamUdp, ::testing::Values("", "--busy-poll --cpu=0"));
 
 }  // namespace
 

@@ -113,8 +113,16 @@ void UdpSocket::set_receive_timeout(int timeout_ms) {
 }
 
 UdpSocket::Received UdpSocket::receive(std::span<char> buffer, std::size_t& size, bool& truncated) {
+  return receive_with(buffer, size, truncated, 0);
+}
+
+UdpSocket::Received UdpSocket::try_receive(std::span<char> buffer, std::size_t& size, bool& truncated) {
+  return receive_with(buffer, size, truncated, MSG_DONTWAIT);
+}
+
+UdpSocket::Received UdpSocket::receive_with(std::span<char> buffer, std::size_t& size, bool& truncated, int flags) {
   // MSG_TRUNC: the return value is the datagram's real length, also when it did not fit.
-  const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_TRUNC);
+  const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_TRUNC | flags);
   if (n < 0) {
     if (errno == EINTR) return Received::Interrupted;
     if (errno == EAGAIN || errno == EWOULDBLOCK) return Received::Timeout;

@@ -52,6 +52,8 @@ class UdpSocket {
   /// is its length and `truncated` says it was longer than the buffer. A signal ends the wait
   /// (Interrupted). Other failures throw ExitError.
   Received receive(std::span<char> buffer, std::size_t& size, bool& truncated);
+  /// As receive, without waiting: Timeout at once when no datagram is there (busy polling).
+  Received try_receive(std::span<char> buffer, std::size_t& size, bool& truncated);
 
   /// Sends one datagram. Returns false if the peer refused it (nobody listening on loopback);
   /// other failures throw ExitError.
@@ -62,6 +64,7 @@ class UdpSocket {
 
  private:
   explicit UdpSocket(int fd) : fd_(fd) {}
+  Received receive_with(std::span<char> buffer, std::size_t& size, bool& truncated, int flags);
   int fd_ = -1;
 };
 
