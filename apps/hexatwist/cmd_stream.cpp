@@ -180,7 +180,8 @@ void pin_to_cpu(int cpu) {
   cpu_set_t set;
   CPU_ZERO(&set);
   if (cpu >= CPU_SETSIZE)
-    throw ExitError(kExitBadInput, fmt::format("--cpu {}: no such CPU (this machine has {} CPUs online)", cpu, sysconf(_SC_NPROCESSORS_ONLN)));
+    throw ExitError(kExitBadInput, fmt::format("--cpu {}: no such CPU (this machine has {} CPUs online)", cpu,
+                                               sysconf(_SC_NPROCESSORS_ONLN)));
   CPU_SET(cpu, &set);
   if (sched_setaffinity(0, sizeof set, &set) != 0)
     throw ExitError(kExitBadInput, fmt::format("--cpu {}: cannot pin to it: {} (this machine has {} CPUs online)", cpu,
