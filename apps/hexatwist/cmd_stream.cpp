@@ -52,6 +52,7 @@ struct StreamOptions {
   double idle_timeout = 0;
   int rt_priority = 0;
   int cpu = -1;  // -1 = any
+  int receive_buffer = 4 << 20;  // bytes
   bool busy_poll = false;
   bool quiet = false;
 };
@@ -226,6 +227,7 @@ int run_stream(StreamOptions o) {
   if (is_udp(o.input)) {
     const UdpAddress local = parse_udp_address(o.input, "--input");
     in_udp = UdpSocket::bound(local, "--input");
+    in_udp->set_receive_buffer(o.receive_buffer, "--receive-buffer");
     in_text = udp_text(local.host, in_udp->local_port());  // the port it got, also for port 0
   } else if (o.input != "stdin" && o.input != "-") {
     throw ExitError(kExitBadInput, fmt::format("--input: '{}' is neither stdin nor udp://HOST:PORT", printable(o.input)));
@@ -358,6 +360,11 @@ Command make_stream_command(CLI::App& root) {
   app->add_option("--idle-timeout", o->idle_timeout, "UDP: stop after this many seconds without a datagram (0: wait)");
   app->add_option("--rt-priority", o->rt_priority, "run under SCHED_FIFO at this priority with memory locked (needs root)");
   app->add_option("--cpu", o->cpu, "pin the process to this CPU (0-based; default: any)");
+  app->add_option("--receive-buffer", o->receive_buffer,
+                  "UDP: socket receive buffer [bytes] (the kernel caps it at net.core.rmem_max): poses that arrive "
+                  "while the stream is held up wait here instead of being dropped")
+      ->check(CLI::Range(4096, 1 << 30))
+      ->capture_default_str();
   app->add_flag("--busy-poll", o->busy_poll,
                 "UDP: spin on a non-blocking receive instead of sleeping between datagrams (lower latency; one CPU "
                 "at 100 %)");

@@ -45,6 +45,9 @@ class UdpSocket {
 
   /// How long `receive` waits for a datagram [ms]; 0 (the default) waits forever.
   void set_receive_timeout(int timeout_ms);
+  /// Asks for a receive buffer of `bytes` (the kernel caps it at net.core.rmem_max); returns what
+  /// the socket got. ExitError(2) naming `option` on failure.
+  int set_receive_buffer(int bytes, const std::string& option);
 
   /// Result of a receive.
   enum class Received { Datagram, Timeout, Interrupted };
