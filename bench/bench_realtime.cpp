@@ -147,7 +147,9 @@ struct StreamProcess {
   int port = -1;
   std::string error;
 
-  StreamProcess(int answer_port, bool realtime) {
+  // mode: 0 normal scheduling, 1 --rt-priority, 2 --busy-poll pinned to CPU 1 (normal
+  // scheduling: a SCHED_FIFO task that never sleeps is throttled by the kernel).
+  StreamProcess(int answer_port, int mode) {
     int err[2];
     if (::pipe(err) != 0) {
       error = "pipe";
@@ -158,8 +160,14 @@ struct StreamProcess {
     posix_spawn_file_actions_adddup2(&fa, err[1], 2);
     posix_spawn_file_actions_addclose(&fa, err[0]);
     const std::string out = "--output=udp://127.0.0.1:" + std::to_string(answer_port);
-    const char* argv[] = {HEXATWIST_CLI, "stream", "--input=udp://127.0.0.1:0", out.c_str(),
-                          realtime ? "--rt-priority=50" : nullptr, nullptr};
+    const char* argv[] = {HEXATWIST_CLI,
+                          "stream",
+                          "--input=udp://127.0.0.1:0",
+                          out.c_str(),
+                          mode == 1 ? "--rt-priority=50" : "--busy-poll",
+                          "--cpu=1",
+                          nullptr};
+    if (mode == 0) argv[4] = nullptr;
     if (posix_spawn(&pid, HEXATWIST_CLI, &fa, nullptr, const_cast<char**>(argv), environ) != 0) pid = -1;
     posix_spawn_file_actions_destroy(&fa);
     ::close(err[1]);
@@ -195,14 +203,31 @@ bool fifo(int priority) {
   return pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
 }
 
+// The calling thread on CPU `cpu` only; false if refused.
+bool pin(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  return pthread_setaffinity_np(pthread_self(), sizeof set, &set) == 0;
+}
+
 // Sends `count` poses at `rate` per second (paced by absolute sleeps) and receives the answers on
 // another thread; latency = receive time - send time of the same input number. Bounded: at most
-// 30 s of waiting for answers. Third argument 1: the stream runs with --rt-priority and the
-// sender and receiver under SCHED_FIFO too, as a deployment would (skipped without root).
+// 30 s of waiting for answers. Third argument: 0 normal scheduling; 1 the stream runs with
+// --rt-priority and the sender and receiver under SCHED_FIFO too, as a deployment would (skipped
+// without root); 2 the stream busy-polls its socket pinned to CPU 1 (normal scheduling), the
+// receiver busy-polls on CPU 0 and the sender runs there under SCHED_FIFO: no CPU in the path
+// goes idle, which on a virtual machine makes a wake-up cost up to milliseconds (skipped with
+// fewer than 2 CPUs or without root).
 void BM_StreamUdpRoundTrip(benchmark::State& state) {
   const double rate = static_cast<double>(state.range(0));
   const std::size_t count = static_cast<std::size_t>(state.range(1));
-  const bool realtime = state.range(2) == 1;
+  const int mode = static_cast<int>(state.range(2));
+  const bool realtime = mode >= 1;
+  if (mode == 2 && (sysconf(_SC_NPROCESSORS_ONLN) < 2 || !pin(0))) {
+    state.SkipWithError("busy polling needs 2 CPUs");
+    return;
+  }
   ::prctl(PR_SET_TIMERSLACK, 1UL);  // wake on time, not up to 50 us late
   const auto& lines = motion_lines();
   if (realtime && !fifo(40)) {
@@ -211,7 +236,7 @@ void BM_StreamUdpRoundTrip(benchmark::State& state) {
   }
   for (auto _ : state) {
     const int rx = udp_socket(0), tx = udp_socket(0);
-    StreamProcess proc(local_port(rx), realtime);
+    StreamProcess proc(local_port(rx), mode);
     if (!proc.error.empty() || rx < 0 || tx < 0) {
       state.SkipWithError(proc.error.empty() ? "socket" : proc.error.c_str());
       return;
@@ -225,16 +250,33 @@ void BM_StreamUdpRoundTrip(benchmark::State& state) {
     std::atomic<bool> done{false};
     std::size_t got = 0, bad = 0;
     std::thread receiver([&] {
-      if (realtime) fifo(40);
+      // Mode 2: the receiver spins too, at normal priority so that the SCHED_FIFO sender on the
+      // same CPU preempts it when its time comes (and that CPU never goes idle either).
+      if (mode == 2) {
+        sched_param other{};  // not the SCHED_FIFO it inherits from the sender
+        pthread_setschedparam(pthread_self(), SCHED_OTHER, &other);
+        pin(0);
+      }
       std::array<char, 2048> buf{};
       pollfd p{rx, POLLIN, 0};
       const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+      auto last = std::chrono::steady_clock::now();
       while (got < count && std::chrono::steady_clock::now() < deadline) {
-        if (::poll(&p, 1, 100) <= 0) {
-          if (done && ::poll(&p, 1, 2000) <= 0) break;  // all sent, nothing more for 2 s
-          continue;
+        ssize_t n = -1;
+        if (mode == 2) {
+          n = ::recv(rx, buf.data(), buf.size(), MSG_DONTWAIT);
+          if (n < 0) {
+            if (done && std::chrono::steady_clock::now() - last > std::chrono::seconds(2)) break;
+            continue;
+          }
+          last = std::chrono::steady_clock::now();
+        } else {
+          if (::poll(&p, 1, 100) <= 0) {
+            if (done && ::poll(&p, 1, 2000) <= 0) break;  // all sent, nothing more for 2 s
+            continue;
+          }
+          n = ::recv(rx, buf.data(), buf.size(), 0);
         }
-        const ssize_t n = ::recv(rx, buf.data(), buf.size(), 0);
         const std::uint64_t t = Latencies::now();
         std::size_t input = 0;
         const auto [ptr, ec] = std::from_chars(buf.data(), buf.data() + std::max<ssize_t>(n, 0), input);
@@ -275,19 +317,34 @@ void BM_StreamUdpRoundTrip(benchmark::State& state) {
     state.counters["answered"] = static_cast<double>(got);
     state.counters["lost"] = static_cast<double>(count - got);
     state.counters["bad_answers"] = static_cast<double>(bad);
-    if (got < count) state.SkipWithError("some poses were not answered");
+    if (got < count) {
+      static std::string why;  // SkipWithError keeps the pointer
+      why = std::to_string(count - got) + " of " + std::to_string(count) + " poses were not answered (" +
+            std::to_string(bad) + " bad answers)";
+      state.SkipWithError(why.c_str());
+    }
   }
   if (realtime) {
     sched_param p{};
     pthread_setschedparam(pthread_self(), SCHED_OTHER, &p);
   }
-  state.SetLabel(realtime ? "SCHED_FIFO" : "normal scheduling");
+  if (mode == 2) {
+    cpu_set_t all;
+    CPU_ZERO(&all);
+    for (int c = 0; c < sysconf(_SC_NPROCESSORS_ONLN) && c < CPU_SETSIZE; ++c) CPU_SET(c, &all);
+    pthread_setaffinity_np(pthread_self(), sizeof all, &all);
+  }
+  state.SetLabel(mode == 2 ? "busy polling: stream on CPU 1, client on CPU 0"
+                 : realtime ? "SCHED_FIFO"
+                            : "normal scheduling");
 }
 BENCHMARK(BM_StreamUdpRoundTrip)
     ->Args({10000, 30000, 0})
     ->Args({20000, 40000, 0})
     ->Args({10000, 30000, 1})
     ->Args({20000, 40000, 1})
+    ->Args({10000, 30000, 2})
+    ->Args({20000, 40000, 2})
     ->Iterations(1)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);

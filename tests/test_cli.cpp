@@ -665,6 +665,9 @@ TEST(CliStream, BadOptionsAreOneLineErrors) {
   expect_error(run({"stream", "--rate=0"}, &none), 2, {"--rate"});
   expect_error(run({"stream", "--start=0,0,3,0,0,0"}, &none), 3, {"--start", "stroke_above_max"});
   expect_error(run({"stream", "--start=0,0,0,0,0"}, &none), 2, {"--start", "6"});
+  expect_error(run({"stream", "--busy-poll"}, &none), 2, {"--busy-poll", "udp://"});
+  expect_error(run({"stream", "--cpu=100000"}, &none), 2, {"--cpu 100000", "CPUs"});
+  expect_error(run({"stream", "--cpu=-3"}, &none), 2, {"--cpu -3", ">= 0"});
 }
 
 // A UDP socket of the test, bound to an ephemeral loopback port.
@@ -699,10 +702,13 @@ struct TestSocket {
   }
 };
 
-TEST(CliStream, UdpAnswersOneDatagramPerDatagramInOrder) {
+// Parameter: the stream's extra options (none; busy polling pinned to the first CPU).
+class CliStreamUdp : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(CliStreamUdp, AnswersOneDatagramPerDatagramInOrder) {
   TestSocket answers;
   const std::string command = shell_quote(HEXATWIST_CLI) + " stream --input=udp://127.0.0.1:0 --output=udp://127.0.0.1:" +
-                              std::to_string(answers.port()) + " --count=4 --idle-timeout=20 2>&1";
+                              std::to_string(answers.port()) + " --count=4 --idle-timeout=20 " + GetParam() + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   ASSERT_NE(pipe, nullptr);
   std::array<char, 512> line{};
@@ -732,6 +738,7 @@ TEST(CliStream, UdpAnswersOneDatagramPerDatagramInOrder) {
   }
   EXPECT_EQ(commands_of(csv_rows(got[0])[0]), commands_of(csv_rows(got[3])[0]));
 }
+INSTANTIATE_TEST_SUITE_P(Receive, CliStreamUdp, ::testing::Values("", "--busy-poll --cpu=0"));
 
 }  // namespace
 
@@ -1018,4 +1025,35 @@ TEST(CliIdentify, BadRunsAndLogsAreOneLineErrors) {
   expect_error(run({"identify", "--points", write_file("nounits.csv", joined(rows)), "--stations", "40"}), 2,
                {"nounits.csv:1:", "units"});
   expect_error(run({"identify", "--points", log, "--stations", "40", "--lead-effect", "both"}), 2, {"--lead-effect"});
+}
+
+TEST(CliIdentify, TheRunWrittenBySynthIdentifiesAsTheStationsDo) {
+  // A real platform is driven through the file synth writes; identify then reads it as the run.
+  const std::string log = (temp_dir() / "five.csv").string(), file = (temp_dir() / "five-run.csv").string();
+  ASSERT_EQ(run({"synth", "--stations", "8", "--lead-error-pct", "1", "--offsets-mm", "0.5", "--out", log, "--run-out",
+                 file})
+                .code,
+            0);
+  const std::vector<std::string> rows = lines_of(read_file(file));
+  EXPECT_EQ(rows[0], "t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad");
+  const Outcome by_stations = run({"identify", "--points", log, "--stations", "8", "--json", "--out",
+                                   (temp_dir() / "a.yaml").string()});
+  const Outcome by_file = run({"identify", "--points", log, "--trajectory", file, "--json", "--out",
+                               (temp_dir() / "b.yaml").string()});
+  ASSERT_EQ(by_stations.code, 0) << by_stations.err;
+  ASSERT_EQ(by_file.code, 0) << by_file.err;
+  const YAML::Node a = json(by_stations), b = json(by_file);
+  // The rests are the same in both up to a tracker sample at the start of a rest (the file's
+  // samples are 10 ms apart, and a rest there starts at the first sample that holds it), and so are
+  // the estimates, to a small part of their standard deviations.
+  EXPECT_NEAR(a["observations"].as<int>(), b["observations"].as<int>(), 10);
+  EXPECT_EQ(a["poses"].as<int>(), 10);
+  EXPECT_EQ(b["poses"].as<int>(), 10);
+  const YAML::Node ea = a["estimate"], eb = b["estimate"];
+  std::printf("  lead difference %.3g sd\n",
+              std::abs(ea["lead"].as<double>() - eb["lead"].as<double>()) / ea["lead_sd"].as<double>());
+  EXPECT_LT(std::abs(ea["lead"].as<double>() - eb["lead"].as<double>()), 0.2 * ea["lead_sd"].as<double>());
+  for (int i = 0; i < 6; ++i)
+    EXPECT_LT(std::abs(ea["length_offsets"][i].as<double>() - eb["length_offsets"][i].as<double>()),
+              0.2 * ea["length_offsets_sd"][i].as<double>());
 }

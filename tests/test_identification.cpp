@@ -188,7 +188,13 @@ TEST(Identification, ReportedStandardDeviationsMatchTheActualErrorsOverSeeds) {
   // normal draws. The whole covariance is tested through the squared Mahalanobis distance
   // d^2 = err^T C^-1 err, a chi^2 with 16 degrees of freedom: mean(d^2)/16 = 1 within 4 of its
   // standard deviations sqrt(2 / (16 S)). Per parameter, z = err/sd: the mean within 4/sqrt(S),
-  // the mean square within 1 +- 4 sqrt(2/S). The sign must be right every time.
+  // and S times the mean square is a chi^2 with S degrees of freedom, whose tails are heavier than
+  // a normal law's: it must lie between its 1e-4 and 1 - 1e-4 quantiles (Wilson-Hilferty; for
+  // S = 40, 0.37 to 2.06 for the mean square). A rounding difference between compilers changes
+  // which random poses pass the limits and so the draws; a bound at 4 normal sd (1.89) was
+  // crossed by one parameter in the clang build (1.94, from one seed at 4.4 sd) while the gcc
+  // build passed. An sd off by 1.45 or more fails here; the whole covariance is held to 4 % by
+  // d^2. The sign must be right every time.
   const Model& nominal = seed_model();
   const int S = stress(40);
   double d2_sum = 0.0, smallest_ratio = std::numeric_limits<double>::infinity();
@@ -204,6 +210,11 @@ TEST(Identification, ReportedStandardDeviationsMatchTheActualErrorsOverSeeds) {
     const ParameterVector err = parameter_error(id.estimate, truth.p);
     d2_sum += err.dot(id.covariance.ldlt().solve(err));
     const ParameterVector z = err.cwiseQuotient(id.sd);
+    for (int j = 0; j < kIdentifiedParameters; ++j)
+      if (std::abs(z[j]) > 4.0)
+        std::printf("  seed %d: %s off by %.2f sd (cost ratio %.3g, iterations %d and %d, %s)\n", seed,
+                    std::string(parameter_name(j)).c_str(), z[j], id.cost_ratio, id.fits[0].iterations,
+                    id.fits[1].iterations, id.fits[id.estimate.twist_sign > 0 ? 0 : 1].message.c_str());
     z_sum += z;
     z2_sum += z.cwiseAbs2();
   }
@@ -214,9 +225,17 @@ TEST(Identification, ReportedStandardDeviationsMatchTheActualErrorsOverSeeds) {
   for (int j = 0; j < kIdentifiedParameters; ++j)
     std::printf("  %-14s mean z %+.3f, mean z^2 %.3f\n", std::string(parameter_name(j)).c_str(), z_mean[j], z2_mean[j]);
   EXPECT_NEAR(d2_mean, 1.0, 4 * std::sqrt(2.0 / (16.0 * S)));
+  // Quantile of chi^2 with k degrees of freedom at the standard normal quantile u, over k.
+  const auto chi2_mean_quantile = [](double k, double u) {
+    const double c = 1.0 - 2.0 / (9.0 * k) + u * std::sqrt(2.0 / (9.0 * k));
+    return c * c * c;
+  };
+  const double u = 3.719;  // 1 - 1e-4 of the standard normal law
+  const double low = chi2_mean_quantile(S, -u), high = chi2_mean_quantile(S, u);
   for (int j = 0; j < kIdentifiedParameters; ++j) {
     EXPECT_NEAR(z_mean[j], 0.0, 4 / std::sqrt(S)) << parameter_name(j);
-    EXPECT_NEAR(z2_mean[j], 1.0, 4 * std::sqrt(2.0 / S)) << parameter_name(j);
+    EXPECT_GT(z2_mean[j], low) << parameter_name(j);
+    EXPECT_LT(z2_mean[j], high) << parameter_name(j);
   }
 }
 

@@ -114,7 +114,25 @@ struct SynthOptions {
   std::string offsets_mm = "0";
   std::string point_offset_mm = "0,0,0";
   std::string out;
+  std::string run_out;
 };
+
+// The commanded run as a trajectory CSV that parse_trajectory_csv reads back (SI suffixes), one
+// row every `every` ticks and the last tick: a real platform can be driven through it, and
+// measure and identify take it as --trajectory. Rests stay exact (the interpolation is flat
+// between equal samples), so the same points count as at rest.
+std::string trajectory_csv(const Trajectory& trajectory, std::size_t every) {
+  fmt::memory_buffer b;
+  fmt::format_to(std::back_inserter(b), "t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad\n");
+  const std::size_t last = trajectory.poses.size() - 1;
+  for (std::size_t k = 0;; k = std::min(k + every, last)) {
+    const Vector6d q = trajectory.poses[k].to_vector();
+    fmt::format_to(std::back_inserter(b), "{},{},{},{},{},{},{}\n", trajectory.time(k), q[0], q[1], q[2], q[3], q[4],
+                   q[5]);
+    if (k == last) break;
+  }
+  return fmt::to_string(b);
+}
 
 std::string truth_json(const Config& config, const SynthOptions& o, const Run& run, const SynthesisOptions& so,
                        const SyntheticLog& log) {
@@ -203,6 +221,10 @@ int run_synth(const SynthOptions& o) {
   const std::string truth = (csv.parent_path() / (csv.stem().string() + ".truth.json")).string();
   write_output_file(out, fmt::to_string(b));
   write_output_file(truth, truth_json(config, o, run, so, log));
+  if (!o.run_out.empty())
+    write_output_file(o.run_out,
+                      trajectory_csv(run.test.trajectory,
+                                     static_cast<std::size_t>(std::llround(rig.simulation().control_rate / so.rate))));
 
   const Vector3d& origin = log.X_BT.t;
   std::string text = fmt::format("hexatwist synth on {}: {}\n", model_source(o.run.model), rig.model().spec().name);
@@ -215,7 +237,8 @@ int run_synth(const SynthOptions& o) {
                   mm_list(so.errors.observation_offset_P));
   text += fmt::format("tracker: origin ({:.3f}, {:.3f}, {:.3f}) m in the base frame, noise {:g} um per axis, seed {}\n",
                       origin.x(), origin.y(), origin.z(), o.noise_um, o.seed);
-  text += fmt::format("wrote {} and {}", out, truth);
+  text += o.run_out.empty() ? fmt::format("wrote {} and {}", out, truth)
+                            : fmt::format("wrote {}, {} and the run {}", out, truth, o.run_out);
   if (std::isfinite(run.calibration_end))
     text += fmt::format("; measure registers on the calibration moves, t <= {:.3f} s", run.calibration_end);
   std::puts(text.c_str());
@@ -553,6 +576,9 @@ Command make_synth_command(CLI::App& root) {
                   "Real minus modelled observation point, x,y,z [mm, platform]")
       ->capture_default_str();
   app->add_option("--out", o->out, "The CSV to write (default tracker_<test>.csv); the truth goes beside it");
+  app->add_option("--run-out", o->run_out,
+                  "Also write the commanded run as a trajectory CSV (t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad, at "
+                  "the tracker rate): to drive a real platform through it (e.g. a --stations run), or as --trajectory");
   return {app, [o] { return run_synth(*o); }};
 }
 

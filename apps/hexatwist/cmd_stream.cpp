@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <chrono>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -50,6 +51,9 @@ struct StreamOptions {
   std::uint64_t count = 0;
   double idle_timeout = 0;
   int rt_priority = 0;
+  int cpu = -1;  // -1 = any
+  int receive_buffer = 4 << 20;  // bytes
+  bool busy_poll = false;
   bool quiet = false;
 };
 
@@ -161,6 +165,30 @@ class AnswerSink {
   std::uint64_t refused_ = 0;
 };
 
+// True unless the kernel lets real-time tasks run without limit (sched_rt_runtime_us = -1).
+bool rt_throttled() {
+  std::FILE* f = std::fopen("/proc/sys/kernel/sched_rt_runtime_us", "r");
+  if (f == nullptr) return true;
+  long runtime = 0;
+  const bool read = std::fscanf(f, "%ld", &runtime) == 1;
+  std::fclose(f);
+  return !read || runtime != -1;
+}
+
+// Pins the process to one CPU (a real-time loop does not migrate).
+void pin_to_cpu(int cpu) {
+  if (cpu < 0) return;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (cpu >= CPU_SETSIZE)
+    throw ExitError(kExitBadInput, fmt::format("--cpu {}: no such CPU (this machine has {} CPUs online)", cpu,
+                                               sysconf(_SC_NPROCESSORS_ONLN)));
+  CPU_SET(cpu, &set);
+  if (sched_setaffinity(0, sizeof set, &set) != 0)
+    throw ExitError(kExitBadInput, fmt::format("--cpu {}: cannot pin to it: {} (this machine has {} CPUs online)", cpu,
+                                               std::strerror(errno), sysconf(_SC_NPROCESSORS_ONLN)));
+}
+
 void enter_realtime(int priority) {
   if (priority <= 0) return;
   sched_param p{};
@@ -199,6 +227,7 @@ int run_stream(StreamOptions o) {
   if (is_udp(o.input)) {
     const UdpAddress local = parse_udp_address(o.input, "--input");
     in_udp = UdpSocket::bound(local, "--input");
+    in_udp->set_receive_buffer(o.receive_buffer, "--receive-buffer");
     in_text = udp_text(local.host, in_udp->local_port());  // the port it got, also for port 0
   } else if (o.input != "stdin" && o.input != "-") {
     throw ExitError(kExitBadInput, fmt::format("--input: '{}' is neither stdin nor udp://HOST:PORT", printable(o.input)));
@@ -210,13 +239,21 @@ int run_stream(StreamOptions o) {
   } else if (o.output != "stdout" && o.output != "-") {
     throw ExitError(kExitBadInput, fmt::format("--output: '{}' is neither stdout nor udp://HOST:PORT", printable(o.output)));
   }
+  if (o.busy_poll && !in_udp) throw ExitError(kExitBadInput, "--busy-poll: only with --input udp://HOST:PORT");
+  if (o.busy_poll && o.rt_priority > 0 && rt_throttled())
+    throw ExitError(kExitBadInput,
+                    "--busy-poll with --rt-priority: the kernel throttles a SCHED_FIFO task that never sleeps (for "
+                    "50 ms each second, /proc/sys/kernel/sched_rt_runtime_us) and datagrams are lost then; use one "
+                    "of them, or set sched_rt_runtime_us to -1");
+  if (o.cpu < -1) throw ExitError(kExitBadInput, fmt::format("--cpu {}: expected a CPU number >= 0", o.cpu));
+  pin_to_cpu(o.cpu);
+  enter_realtime(o.rt_priority);
   if (in_udp && !o.quiet) {
     std::fprintf(stderr, "hexatwist stream: listening on %s, answering to %s\n", in_text.c_str(), out_text.c_str());
     std::fflush(stderr);
   }
   AnswerSink sink(std::move(out_udp));
   install_stop_handlers();
-  enter_realtime(o.rt_priority);
 
   if (o.header && format == StreamFormat::Csv) sink.write(kStreamCsvHeader);
   std::array<char, kMaxOutputLength> answer{};
@@ -225,7 +262,7 @@ int run_stream(StreamOptions o) {
   std::array<std::uint64_t, 3> by_action{};
   StreamOutput out;
   LineReader reader(STDIN_FILENO);
-  if (in_udp && o.idle_timeout > 0)  // at most about 23 days, the range of the timeout in ms
+  if (in_udp && o.idle_timeout > 0 && !o.busy_poll)  // at most about 23 days, the range of the timeout in ms
     in_udp->set_receive_timeout(std::max(1, static_cast<int>(std::min(o.idle_timeout, 2e6) * 1000.0)));
   std::string stop_reason = "end of input";
 
@@ -234,7 +271,19 @@ int run_stream(StreamOptions o) {
     if (in_udp) {
       std::size_t size = 0;
       bool truncated = false;
-      const auto r = in_udp->receive(datagram, size, truncated);
+      auto r = UdpSocket::Received::Timeout;
+      if (o.busy_poll) {
+        // Spin on a non-blocking receive: no sleep and wake-up between datagrams. The idle
+        // timeout is kept by the clock.
+        const auto since = std::chrono::steady_clock::now();
+        const auto idle = std::chrono::duration<double>(o.idle_timeout > 0 ? o.idle_timeout : 1e300);
+        while (!g_stop && (r = in_udp->try_receive(datagram, size, truncated)) == UdpSocket::Received::Timeout &&
+               std::chrono::steady_clock::now() - since < idle) {
+        }
+        if (g_stop) r = UdpSocket::Received::Interrupted;
+      } else {
+        r = in_udp->receive(datagram, size, truncated);
+      }
       if (r == UdpSocket::Received::Timeout) {
         stop_reason = fmt::format("no datagram for {} s (--idle-timeout)", o.idle_timeout);
         break;
@@ -310,6 +359,15 @@ Command make_stream_command(CLI::App& root) {
   app->add_option("--count", o->count, "stop after this many inputs (0: no limit)");
   app->add_option("--idle-timeout", o->idle_timeout, "UDP: stop after this many seconds without a datagram (0: wait)");
   app->add_option("--rt-priority", o->rt_priority, "run under SCHED_FIFO at this priority with memory locked (needs root)");
+  app->add_option("--cpu", o->cpu, "pin the process to this CPU (0-based; default: any)");
+  app->add_option("--receive-buffer", o->receive_buffer,
+                  "UDP: socket receive buffer [bytes] (the kernel caps it at net.core.rmem_max): poses that arrive "
+                  "while the stream is held up wait here instead of being dropped")
+      ->check(CLI::Range(4096, 1 << 30))
+      ->capture_default_str();
+  app->add_flag("--busy-poll", o->busy_poll,
+                "UDP: spin on a non-blocking receive instead of sleeping between datagrams (lower latency; one CPU "
+                "at 100 %)");
   app->add_flag("--quiet", o->quiet, "no summary on stderr");
   return {app, [o] {
             if (!(o->rate > 0) || !std::isfinite(o->rate))

@@ -112,9 +112,26 @@ void UdpSocket::set_receive_timeout(int timeout_ms) {
     throw ExitError(kExitBadInput, fmt::format("--idle-timeout: {}", std::strerror(errno)));
 }
 
+int UdpSocket::set_receive_buffer(int bytes, const std::string& option) {
+  if (::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &bytes, sizeof bytes) != 0)
+    throw ExitError(kExitBadInput, fmt::format("{}: {}", option, std::strerror(errno)));
+  int got = 0;
+  socklen_t len = sizeof got;
+  if (::getsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &got, &len) != 0) return -1;
+  return got;  // the kernel doubles the request for its bookkeeping
+}
+
 UdpSocket::Received UdpSocket::receive(std::span<char> buffer, std::size_t& size, bool& truncated) {
+  return receive_with(buffer, size, truncated, 0);
+}
+
+UdpSocket::Received UdpSocket::try_receive(std::span<char> buffer, std::size_t& size, bool& truncated) {
+  return receive_with(buffer, size, truncated, MSG_DONTWAIT);
+}
+
+UdpSocket::Received UdpSocket::receive_with(std::span<char> buffer, std::size_t& size, bool& truncated, int flags) {
   // MSG_TRUNC: the return value is the datagram's real length, also when it did not fit.
-  const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_TRUNC);
+  const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_TRUNC | flags);
   if (n < 0) {
     if (errno == EINTR) return Received::Interrupted;
     if (errno == EAGAIN || errno == EWOULDBLOCK) return Received::Timeout;

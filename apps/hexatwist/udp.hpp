@@ -45,6 +45,9 @@ class UdpSocket {
 
   /// How long `receive` waits for a datagram [ms]; 0 (the default) waits forever.
   void set_receive_timeout(int timeout_ms);
+  /// Asks for a receive buffer of `bytes` (the kernel caps it at net.core.rmem_max); returns what
+  /// the socket got. ExitError(2) naming `option` on failure.
+  int set_receive_buffer(int bytes, const std::string& option);
 
   /// Result of a receive.
   enum class Received { Datagram, Timeout, Interrupted };
@@ -52,6 +55,8 @@ class UdpSocket {
   /// is its length and `truncated` says it was longer than the buffer. A signal ends the wait
   /// (Interrupted). Other failures throw ExitError.
   Received receive(std::span<char> buffer, std::size_t& size, bool& truncated);
+  /// As receive, without waiting: Timeout at once when no datagram is there (busy polling).
+  Received try_receive(std::span<char> buffer, std::size_t& size, bool& truncated);
 
   /// Sends one datagram. Returns false if the peer refused it (nobody listening on loopback);
   /// other failures throw ExitError.
@@ -62,6 +67,7 @@ class UdpSocket {
 
  private:
   explicit UdpSocket(int fd) : fd_(fd) {}
+  Received receive_with(std::span<char> buffer, std::size_t& size, bool& truncated, int flags);
   int fd_ = -1;
 };
 
