@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "hexatwist/twist.hpp"
+#include "geometry.hpp"
 #include "linear_solve.hpp"
 #include "twist_internal.hpp"
 
@@ -49,7 +50,8 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
   out.iterations = 0;
   out.residual = INFINITY;
   out.placement = guess;
-  if (!lengths.allFinite() || !guess.t.allFinite() || !guess.R_BP.allFinite()) return Status::NonFiniteInput;
+  if (!detail::all_finite(lengths) || !detail::all_finite(guess.t) || !detail::all_finite(guess.R_BP))
+    return Status::NonFiniteInput;
 
   // The state at the iterate and at the trial point live in two buffers that trade places when
   // a step is accepted (copying a LegState is ~90 moves); *legs ends up in out.legs on return.

@@ -1,26 +1,28 @@
 #include "hexatwist/kinematics.hpp"
 
 #include "geometry.hpp"
+#include "lanes.hpp"
 
 namespace hexatwist {
 
 using detail::Array6d;
 
 Status inverse_kinematics(const Model& model, const Placement& x, LegState& out) noexcept {
-  if (!x.t.allFinite() || !x.R_BP.allFinite()) return Status::NonFiniteInput;
-  const LegGeometry& g = model.geometry();
+  if (!detail::all_finite(x.t) || !detail::all_finite(x.R_BP)) return Status::NonFiniteInput;
   out.R_BP = x.R_BP;
-  // Eq. (1)-(2), all legs at once: L_i = (pivot_home + t) + R_BP * arm_P,i - base_B,i.
-  out.arm_B = detail::rotate_rows(x.R_BP, g.arm_P);
-  out.axis_platform_B = detail::rotate_rows(x.R_BP, g.axis_platform_P);
-  const Vector3d origin_B = model.pivot_home_B() + x.t;
-  for (int k = 0; k < 3; ++k) out.leg_B.col(k) = (out.arm_B.col(k) - g.base_B.col(k)).array() + origin_B[k];
-  const Array6d length = detail::dot(out.leg_B, out.leg_B).sqrt();  // Eq. (4)
-  out.length = length.matrix();
-  out.s_B = detail::scale_rows(length.inverse(), out.leg_B);
-  if (length.minCoeff() > 0.0) return Status::Ok;
+  // Eq. (1)-(4), all legs at once (lanes.hpp).
+  #pragma GCC unroll 4
+  for (int k = 0; k < detail::kPackets; ++k) {
+    const detail::LegsAt legs = detail::legs_at(model, x.R_BP, x.t, k);
+    detail::store6(out.arm_B, legs.arm, k);
+    detail::store6(out.axis_platform_B, legs.axis_platform, k);
+    detail::store6(out.leg_B, legs.leg, k);
+    detail::store6(out.length.data(), legs.length, k);
+    detail::store6(out.s_B, (1.0 / legs.length) * legs.leg, k);
+  }
+  if (out.length.minCoeff() > 0.0) return Status::Ok;
   for (int i = 0; i < kLegs; ++i)
-    if (!(length[i] > 0.0)) out.s_B.row(i).setZero();
+    if (!(out.length[i] > 0.0)) out.s_B.row(i).setZero();
   return Status::StrokeBelowMin;
 }
 

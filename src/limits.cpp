@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "geometry.hpp"
+#include "lanes.hpp"
 
 namespace hexatwist {
 namespace {
@@ -37,22 +38,31 @@ Status check_limits(const Model& model, const LegState& state, LimitReport& r) n
   const double cos_bend = model.cos_bend_max();
   const double cos2_margin = model.cos2_singularity_margin();
   const LegVectors& s = state.s_B;
-  // All legs at once, without trigonometry: bend as cosines to the home direction seen from
-  // each end; singularity as (s . axis)^2 > cos^2(margin) for unit vectors.
-  const Array6d len = state.length.array();
-  const Array6d cos_base = detail::dot(s, g.s_home_B);
-  const Array6d cos_platform = detail::dot(s, detail::rotate_rows(state.R_BP, g.s_home_B));
-  const Array6d dot_a = detail::dot(s, g.axis_base_B);
-  const Array6d dot_d = detail::dot(s, state.axis_platform_B);
-  // Every slack below must be >= 0. Legs without axes have zero axis rows, so dot_a = dot_d = 0
-  // passes. NaN lanes could vanish in min(), so finiteness is tested on the sums.
-  const Array6d slack = (len - lim.length_min)
-                            .min(lim.length_max - len)
-                            .min(cos_base - cos_bend)
-                            .min(cos_platform - cos_bend)
-                            .min(cos2_margin - dot_a.square())
-                            .min(cos2_margin - dot_d.square());
-  if (slack.minCoeff() >= 0.0 && (len.sum() + cos_platform.sum() + dot_d.sum()) * 0.0 == 0.0) return Status::Ok;
+  // All legs at once (lanes.hpp).
+  detail::LimitTerms terms[detail::kPackets];
+  detail::lane_m ok = detail::all_set();
+  #pragma GCC unroll 4
+  for (int k = 0; k < detail::kPackets; ++k) {
+    const detail::lanes3 u = detail::load6(s, k);
+    terms[k] = detail::limit_terms(model, state.R_BP, u, detail::splat<detail::lane_v>(1.0),
+                                   detail::load6(state.length.data(), k),
+                                   detail::dot(u, detail::load_lanes(g.lanes.axis_base_B, k)),
+                                   detail::dot(u, detail::load6(state.axis_platform_B, k)), k);
+    ok &= detail::within_limits(model, terms[k]);
+  }
+  if (detail::all_lanes(ok)) return Status::Ok;
+  // Leg i's terms, as the test saw them.
+  const auto lane = [&](detail::lane_v detail::LimitTerms::*field, int i) {
+    return (terms[i / detail::kWidth].*field)[i % detail::kWidth];
+  };
+  Vector6d len, cos_base, cos_platform, dot_a, dot_d;
+  for (int i = 0; i < kLegs; ++i) {
+    len[i] = lane(&detail::LimitTerms::length, i);
+    cos_base[i] = lane(&detail::LimitTerms::cos_base, i);
+    cos_platform[i] = lane(&detail::LimitTerms::cos_platform, i);
+    dot_a[i] = lane(&detail::LimitTerms::dot_a, i);
+    dot_d[i] = lane(&detail::LimitTerms::dot_d, i);
+  }
 
   // Some leg is out: name the first, with the first limit it breaks (stroke, bend, singularity).
   for (int i = 0; i < kLegs; ++i) {
@@ -78,8 +88,10 @@ Status check_limits(const Model& model, const LegState& state, LimitReport& r) n
 Status check_stroke(const Model& model, const Vector6d& command, LimitReport& r) noexcept {
   r = LimitReport{};
   const LimitSpec& lim = model.spec().limits;
-  const Array6d c = command.array();
-  if ((c - lim.length_min).min(lim.length_max - c).minCoeff() >= 0.0 && c.sum() * 0.0 == 0.0) return Status::Ok;
+  detail::lane_m ok = detail::all_set();
+  #pragma GCC unroll 4
+  for (int k = 0; k < detail::kPackets; ++k) ok &= detail::within_stroke(model, detail::load6(command.data(), k));
+  if (detail::all_lanes(ok)) return Status::Ok;
   for (int i = 0; i < kLegs; ++i) {
     if (!std::isfinite(command[i])) return report_violation(r, Status::NonFiniteInput, i, command[i], 0.0);
     if (command[i] < lim.length_min) return report_violation(r, Status::StrokeBelowMin, i, command[i], lim.length_min);

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <utility>
 
+#include "fast_math.hpp"
 #include "hexatwist/types.hpp"
 
 namespace hexatwist::detail {
@@ -15,7 +16,7 @@ namespace hexatwist::detail {
 /// P A = L U, row-major.
 struct Lu6 {
   alignas(64) double a[6][8];  ///< U on and above the diagonal (below it: unspecified); columns 6
-                               ///< and 7 are unused padding
+                               ///< and 7 are zero padding
   double l[6][6];              ///< L's multipliers below the diagonal (unit diagonal implied)
   int perm[6];                 ///< row k of P A is row perm[k] of A
 };
@@ -25,7 +26,7 @@ struct Lu6 {
 inline double lu6_factor(const Matrix6d& A, Lu6& lu) noexcept {
   auto& a = lu.a;
   for (int i = 0; i < 6; ++i) {
-    for (int j = 0; j < 6; ++j) a[i][j] = A(i, j);
+    for (int j = 0; j < 8; ++j) a[i][j] = j < 6 ? A(i, j) : 0.0;  // padding 0: whole-row updates read it
     lu.perm[i] = i;
   }
   double pivot_min = INFINITY, pivot_max = 0.0;
@@ -46,12 +47,13 @@ inline double lu6_factor(const Matrix6d& A, Lu6& lu) noexcept {
     const double inv = 1.0 / pivot;
     for (int i = k + 1; i < 6; ++i) {
       // Only the columns from k+1 on matter (the solve reads U on and above the diagonal; the
-      // eliminated columns are never read again). Starting at the even column at or below k+1
-      // keeps the range whole 16-byte pairs, so it vectorises; with k unrolled it is constant.
+      // eliminated columns are never read again). Starting at the multiple of the vector width
+      // at or below k+1 keeps the range whole vectors (one per row with AVX-512, the padding
+      // columns included); with k unrolled it is constant.
       const double f = a[i][k] * inv;
-      using v2d = double __attribute__((vector_size(16)));  // as in fast_math.hpp
-      for (int j = (k + 1) & ~1; j < 6; j += 2) {
-        v2d ri, rk;
+      constexpr int kW = sizeof(lane_v) / sizeof(double);
+      for (int j = (k + 1) / kW * kW; j < 6; j += kW) {
+        lane_v ri, rk;
         std::memcpy(&ri, &a[i][j], sizeof ri);
         std::memcpy(&rk, &a[k][j], sizeof rk);
         ri -= f * rk;

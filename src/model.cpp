@@ -143,6 +143,22 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
     geometry_.length_offset[i] = leg.length_offset;
     geometry_.has_axes[i] = axes ? 1.0 : 0.0;
   }
+  LegLanes& lanes = geometry_.lanes;
+  for (int lane = 0; lane < 8; ++lane) {
+    const int i = lane < kLegs ? lane : 0;
+    for (int k = 0; k < 3; ++k) {
+      lanes.base_B[k][lane] = geometry_.base_B(i, k);
+      lanes.arm_P[k][lane] = geometry_.arm_P(i, k);
+      lanes.axis_base_B[k][lane] = geometry_.axis_base_B(i, k);
+      lanes.axis_platform_P[k][lane] = geometry_.axis_platform_P(i, k);
+      lanes.s_home_B[k][lane] = geometry_.s_home_B(i, k);
+    }
+    lanes.cos_theta_home[lane] = geometry_.cos_theta_home[i];
+    lanes.sin_theta_home[lane] = geometry_.sin_theta_home[i];
+    lanes.twist_gain[lane] = geometry_.twist_gain[i];
+    lanes.length_offset[lane] = geometry_.length_offset[i];
+    lanes.has_axes[lane] = geometry_.has_axes[i];
+  }
 
   // The six legs must hold the platform: the length Jacobian at home must be well conditioned.
   Matrix6d J;

@@ -19,22 +19,9 @@ Vector6d Pose::to_vector() const noexcept {
   return q;
 }
 
-bool Pose::is_finite() const noexcept {
-  // x * 0 is 0 for finite x and NaN otherwise: one test for all six components.
-  return (position.array() * 0.0).sum() + (rpy.array() * 0.0).sum() == 0.0;
-}
+bool Pose::is_finite() const noexcept { return detail::all_finite(position) && detail::all_finite(rpy); }
 
-Matrix3d rotation_from_rpy(const Vector3d& rpy) noexcept {
-  // Eq. (3): R = Rz(q6) Ry(q5) Rx(q4), written out to avoid three matrix products.
-  Vector3d sn, cs;
-  detail::sin_cos(rpy, sn, cs);
-  const double c4 = cs[0], s4 = sn[0], c5 = cs[1], s5 = sn[1], c6 = cs[2], s6 = sn[2];
-  Matrix3d R;
-  R << c5 * c6, s4 * s5 * c6 - c4 * s6, c4 * s5 * c6 + s4 * s6,  //
-      c5 * s6, s4 * s5 * s6 + c4 * c6, c4 * s5 * s6 - s4 * c6,   //
-      -s5, s4 * c5, c4 * c5;
-  return R;
-}
+Matrix3d rotation_from_rpy(const Vector3d& rpy) noexcept { return detail::rotation_from_rpy(rpy); }
 
 Vector3d rpy_from_rotation(const Matrix3d& R) noexcept {
   // roll = atan2(R21, R22), pitch = atan2(-R20, |(R00, R10)|), yaw = atan2(R10, R00), as one

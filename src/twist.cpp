@@ -2,19 +2,14 @@
 
 #include <cmath>
 
-#include "fast_math.hpp"
 #include "geometry.hpp"
+#include "lanes.hpp"
 #include "twist_internal.hpp"
 
 namespace hexatwist {
 namespace {
 
-using detail::Array6d;
-
-// Squared |s x ja| |s x jd| below which the U-joint's cross axis (Eq. 8) is undefined.
-constexpr double kSingularSin2 = 1e-24;
-
-// Called when the fast test of a packet failed: the singular joint of the leg nearest to a
+// Called when the fast test of the lanes failed: the singular joint of the leg nearest to a
 // singularity (legs without axes never are), by the scalar formula of geometry.hpp. Always
 // returns SingularBase or SingularPlatform, so no caller can mistake it for success.
 Status singular_joint(const Model& model, const LegState& st) noexcept {
@@ -41,60 +36,40 @@ Status singular_joint(const Model& model, const LegState& st) noexcept {
 // Wraps an angle to (-pi, pi].
 double wrap(double a) noexcept { return a - 2.0 * kPi * std::ceil((a - kPi) / (2.0 * kPi)); }
 
-// The twist terms of legs i and i+1 (one packet): the coordinates of docs/theory.md §3,
-// theta = atan2(y, x), and the products the Jacobian reuses, kept in registers.
-struct PacketTerms {
-  detail::v3d s, ja, jd;
-  detail::v2d ja_s, jd_s;
-  detail::v3d ja_x_jd;
-  detail::v2d x, y;
+// Packet k of the legs at the state, with their twist terms (lanes.hpp).
+struct LegTwist {
+  detail::lanes3 s, ja, jd;
+  detail::lane_v ja_s, jd_s;
 };
 
-PacketTerms packet_terms(const Model& model, const LegState& st, int i) noexcept {
+LegTwist leg_twist(const Model& model, const LegState& st, int k) noexcept {
   using namespace detail;
-  PacketTerms t;
-  t.s = load_rows(st.s_B, i);
-  t.ja = load_rows(model.geometry().axis_base_B, i);
-  t.jd = load_rows(st.axis_platform_B, i);
-  t.ja_s = dot(t.ja, t.s);
-  t.jd_s = dot(t.jd, t.s);
-  t.ja_x_jd = cross(t.ja, t.jd);
-  t.x = dot(t.ja, t.jd) - t.ja_s * t.jd_s;
-  t.y = dot(t.s, t.ja_x_jd);
-  return t;
+  LegTwist l;
+  l.s = load6(st.s_B, k);
+  l.ja = load_lanes(model.geometry().lanes.axis_base_B, k);
+  l.jd = load6(st.axis_platform_B, k);
+  l.ja_s = dot(l.s, l.ja);
+  l.jd_s = dot(l.s, l.jd);
+  return l;
 }
 
-// Lanes set where the leg is away from a U-joint singularity or has no axes (the fast path of
-// singular_joint; NaN fails it, and the slow path then names the joint). Callers AND the masks
-// of all packets and test once: extracting lanes costs more than the test itself.
-detail::v2m packet_regular(const PacketTerms& t, detail::v2d no_axes) noexcept {
-  return (t.x * t.x + t.y * t.y) + no_axes >= kSingularSin2;
+detail::TwistTerms terms_of(const LegTwist& l) noexcept {
+  return detail::twist_terms(l.s, l.ja, l.jd, l.ja_s, l.jd_s, detail::splat<detail::lane_v>(1.0));
 }
 
-bool all_lanes(detail::v2m m) noexcept { return (m[0] & m[1]) != 0; }
-
-}  // namespace
-
-namespace {
-
-// Absolute (relative = false) or home-relative twist of all legs, two legs per register.
+// Absolute (relative = false) or home-relative twist of all legs.
 Status twist_angles(const Model& model, const LegState& state, bool relative, Vector6d& out) noexcept {
   using namespace detail;
-  const LegGeometry& g = model.geometry();
-  v2d y_rot[3], x_rot[3];
-  v2m regular = bits(splat(-0.0)) | ~bits(splat(-0.0));  // all ones
-  for (int i = 0; i < kLegs; i += 2) {
-    const PacketTerms t = packet_terms(model, state, i);
-    regular &= packet_regular(t, 1.0 - load2(g.has_axes.data() + i));
-    // theta - theta_home in one atan2: rotate (x, y) by -theta_home.
-    const v2d c0 = relative ? load2(g.cos_theta_home.data() + i) : splat(1.0);
-    const v2d s0 = relative ? load2(g.sin_theta_home.data() + i) : splat(0.0);
-    y_rot[i / 2] = t.y * c0 - t.x * s0;
-    x_rot[i / 2] = t.x * c0 + t.y * s0;
+  TwistTerms t[kPackets];
+  lane_m regular = all_set();
+  #pragma GCC unroll 4
+  for (int k = 0; k < kPackets; ++k) {
+    t[k] = terms_of(leg_twist(model, state, k));
+    regular &= twist_regular(model, t[k].x, t[k].y, splat<lane_v>(1.0), k);
   }
   if (!all_lanes(regular)) return singular_joint(model, state);
-  for (int i = 0; i < kLegs; i += 2)
-    store2(out.data() + i, atan2(y_rot[i / 2], x_rot[i / 2]) * load2(g.has_axes.data() + i));
+  #pragma GCC unroll 4
+  for (int k = 0; k < kPackets; ++k) store6(out.data(), twist_angle(model, t[k].x, t[k].y, relative, k), k);
   return Status::Ok;
 }
 
@@ -118,46 +93,44 @@ Status twist_continued(const Model& model, const LegState& state, const Vector6d
 
 namespace {
 
-// Rows i, i+1 of the twist Jacobian (twist_jacobian), or, with kMotor, of the motor-side length
-// Jacobian [s^T, (arm x s)^T] - twist_gain * (twist Jacobian). Returns packet_regular's lane
-// mask; where a lane is clear the leg is near a U-joint singularity and J's rows are unspecified.
-template <bool kMotor>
-detail::v2m jacobian_rows(const Model& model, const LegState& state, int i, Matrix6d& J) noexcept {
-  using namespace detail;
-  const LegGeometry& g = model.geometry();
-  const PacketTerms t = packet_terms(model, state, i);
-  const v2d mask = load2(g.has_axes.data() + i);
-  const v2m regular = packet_regular(t, 1.0 - mask);
-  // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2), with the partials of y and x in s and jd:
-  // dy/ds = ja x jd, dx/ds = -(jd.s) ja - (ja.s) jd, dy/djd = s x ja, dx/djd = ja - (ja.s) s.
-  // Legs without axes have x = y = 0: give them n2 = 1 and mask their rows to zero.
-  const v2d n2 = t.x * t.x + t.y * t.y + (1.0 - mask);
-  const v2d fx = mask * t.x / n2, fy = mask * t.y / n2;
-  const v3d dx_ds = (-t.jd_s) * t.ja - t.ja_s * t.jd;
-  const v3d g_s = fx * t.ja_x_jd - fy * dx_ds;
-  const v3d g_jd = fx * cross(t.s, t.ja) - fy * (t.ja - t.ja_s * t.s);
-  // s = L/|L|: ds = (I - s s^T) dL / |L|; dL = dt + dw x arm; djd = dw x jd.
-  const v2d inv_length = 1.0 / load2(state.length.data() + i);
-  const v3d a = inv_length * (g_s - dot(g_s, t.s) * t.s);
-  const v3d arm = load_rows(state.arm_B, i);
-  const v3d b = cross(arm, a) + cross(t.jd, g_jd);
-  const v2d col[6] = {a.x, a.y, a.z, b.x, b.y, b.z};
-  if constexpr (kMotor) {
-    // J = length Jacobian - twist_gain * twist Jacobian (docs/theory.md §5).
-    const v2d gain = load2(g.twist_gain.data() + i);
-    const v3d arm_x_s = cross(arm, t.s);
-    const v2d length_col[6] = {t.s.x, t.s.y, t.s.z, arm_x_s.x, arm_x_s.y, arm_x_s.z};
-    for (int k = 0; k < 6; ++k) store2(J.data() + kLegs * k + i, length_col[k] - gain * col[k]);
-  } else {
-    for (int k = 0; k < 6; ++k) store2(J.data() + kLegs * k + i, col[k]);
-  }
-  return regular;
-}
-
+// The twist Jacobian (twist_jacobian), or, with kMotor, the motor-side length Jacobian
+// [s^T, (arm x s)^T] - twist_gain * (twist Jacobian), all rows at once. Where a leg is near a
+// U-joint singularity its row is unspecified and the result names the joint.
 template <bool kMotor>
 Status jacobian(const Model& model, const LegState& state, Matrix6d& J) noexcept {
-  const detail::v2m regular = jacobian_rows<kMotor>(model, state, 0, J) & jacobian_rows<kMotor>(model, state, 2, J) &
-                              jacobian_rows<kMotor>(model, state, 4, J);
+  using namespace detail;
+  const LegLanes& g = model.geometry().lanes;
+  lane_m regular = all_set();
+  #pragma GCC unroll 4
+  for (int k = 0; k < kPackets; ++k) {
+    const LegTwist l = leg_twist(model, state, k);
+    const TwistTerms t = terms_of(l);
+    regular &= twist_regular(model, t.x, t.y, splat<lane_v>(1.0), k);
+    const lane_v mask = load_lanes(g.has_axes, k);
+    // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2), with the partials of y and x in s and jd:
+    // dy/ds = ja x jd, dx/ds = -(jd.s) ja - (ja.s) jd, dy/djd = s x ja, dx/djd = ja - (ja.s) s.
+    // Legs without axes have x = y = 0: give them n2 = 1 and mask their rows to zero.
+    const lane_v n2 = t.x * t.x + t.y * t.y + (1.0 - mask);
+    const lane_v fx = mask * t.x / n2, fy = mask * t.y / n2;
+    const lanes3 dx_ds = (-l.jd_s) * l.ja - l.ja_s * l.jd;
+    const lanes3 g_s = fx * t.ja_x_jd - fy * dx_ds;
+    const lanes3 g_jd = fx * cross(l.s, l.ja) - fy * (l.ja - l.ja_s * l.s);
+    // s = L/|L|: ds = (I - s s^T) dL / |L|; dL = dt + dw x arm; djd = dw x jd.
+    const lane_v inv_length = 1.0 / load6(state.length.data(), k);
+    const lanes3 a = inv_length * (g_s - dot(g_s, l.s) * l.s);
+    const lanes3 arm = load6(state.arm_B, k);
+    const lanes3 b = cross(arm, a) + cross(l.jd, g_jd);
+    const lane_v col[6] = {a.x, a.y, a.z, b.x, b.y, b.z};
+    if constexpr (kMotor) {
+      // J = length Jacobian - twist_gain * twist Jacobian (docs/theory.md §5).
+      const lane_v gain = load_lanes(g.twist_gain, k);
+      const lanes3 arm_x_s = cross(arm, l.s);
+      const lane_v length_col[6] = {l.s.x, l.s.y, l.s.z, arm_x_s.x, arm_x_s.y, arm_x_s.z};
+      for (int c = 0; c < 6; ++c) store6(J.data() + kLegs * c, length_col[c] - gain * col[c], k);
+    } else {
+      for (int c = 0; c < 6; ++c) store6(J.data() + kLegs * c, col[c], k);
+    }
+  }
   return all_lanes(regular) ? Status::Ok : singular_joint(model, state);
 }
 

@@ -65,6 +65,22 @@ struct Leg {
   double length_offset;      ///< real minus motor-side length at zero twist [m]
 };
 
+/// The same numbers in the layout of the library's vectorised kernels: eight lanes per quantity
+/// (x, y, z for vectors), leg i in lane i, lanes 6 and 7 repeating leg 0; one aligned 512-bit
+/// load each.
+struct alignas(64) LegLanes {
+  double base_B[3][8];
+  double arm_P[3][8];
+  double axis_base_B[3][8];
+  double axis_platform_P[3][8];
+  double s_home_B[3][8];
+  double cos_theta_home[8];
+  double sin_theta_home[8];
+  double twist_gain[8];
+  double length_offset[8];
+  double has_axes[8];
+};
+
 /// The legs' precomputed geometry with one leg per row, for code vectorised over legs.
 struct LegGeometry {
   LegVectors base_B;           ///< base U-joint centres [m, B]
@@ -77,6 +93,7 @@ struct LegGeometry {
   Vector6d twist_gain;         ///< real minus motor-side length per rad of twist [m/rad]
   Vector6d length_offset;      ///< real minus motor-side length at zero twist [m]
   Vector6d has_axes;           ///< 1 for legs whose U-joint axes are given, else 0
+  LegLanes lanes;              ///< all of the above, padded to eight lanes
 };
 
 /// Immutable, validated platform model. Construction throws hexatwist::Error naming the leg and
