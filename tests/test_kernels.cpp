@@ -7,7 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cstring>
+#include <bit>
+#include <cstdint>
 #include <random>
 
 namespace hexatwist::detail {
@@ -81,8 +82,8 @@ TEST(FastMath, SmallAnglesSkipTheReductionWithTheSameResult) {
     sin_cos(x, s_full, c_full);
     sin_cos_reduced(x, s_short, c_short);
     for (int k = 0; k < 2; ++k) {
-      ASSERT_EQ(std::memcmp(&s_full[k], &s_short[k], sizeof(double)), 0) << x[k];
-      ASSERT_EQ(std::memcmp(&c_full[k], &c_short[k], sizeof(double)), 0) << x[k];
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(s_full[k]), std::bit_cast<std::uint64_t>(s_short[k])) << x[k];
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(c_full[k]), std::bit_cast<std::uint64_t>(c_short[k])) << x[k];
       worst = std::max({worst, std::abs(s_short[k] - std::sin(x[k])), std::abs(c_short[k] - std::cos(x[k]))});
     }
     const Vector3d a(x[0], x[1], -x[0]);
