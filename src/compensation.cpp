@@ -44,16 +44,23 @@ namespace {
 // and with the leg vectors L_i in place of the unit s_i, which spares a division on the
 // critical path (the tests and the twist's atan2 are homogeneous in the leg's scale). True,
 // with `command` written, if every test passes; false leaves the naming of the limit or joint
-// to the full path. The two decide alike except within rounding of a bound.
+// to the full path. The two decide alike except within rounding of a bound. The legs are kept in
+// `legs` for the Jacobian's condition, tested after the loop.
 bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, Vector6d& command) noexcept {
   using namespace detail;
   const LegLanes& g = model.geometry().lanes;
   const Matrix3d R = detail::rotation_from_rpy(pose.rpy);
   lane_m ok = all_set();
   Vector6d out;
+  LegState state;
+  state.R_BP = R;
 #pragma GCC unroll 4
   for (int k = 0; k < kPackets; ++k) {
     const LegsAt legs = legs_at(model, R, pose.position, k);
+    store6(state.arm_B, legs.arm, k);
+    store6(state.axis_platform_B, legs.axis_platform, k);
+    store6(state.length.data(), legs.length, k);
+    store6(state.s_B, (1.0 / legs.length) * legs.leg, k);
     const lanes3 ja = load_lanes(g.axis_base_B, k);
     const lane_v dot_a = dot(legs.leg, ja), dot_d = dot(legs.leg, legs.axis_platform);
     ok &= within_limits(model, limit_terms(model, R, legs.leg, legs.length, legs.length, dot_a, dot_d, k));
@@ -68,6 +75,9 @@ bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, V
     store6(out.data(), command_k, k);
   }
   if (!all_lanes(ok)) return false;
+  // The platform singularity last, once every leg passed (limits.hpp).
+  double condition;
+  if (jacobian_condition(model, state, condition) != Status::Ok) return false;
   command = out;
   return true;
 }

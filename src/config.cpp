@@ -408,17 +408,21 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
 
   const Field lim = Reader::child(top, "limits");
   r.require_map(lim, "length_min, length_max [m]");
-  r.only_keys(lim, {"length_min", "length_max", "bend_max_deg", "singularity_margin_deg"});
+  r.only_keys(lim, {"length_min", "length_max", "bend_max_deg", "singularity_margin_deg", "jacobian_condition_max"});
   const Field lmin = Reader::child(lim, "length_min"), lmax = Reader::child(lim, "length_max");
   const Field bend = Reader::child(lim, "bend_max_deg"), margin = Reader::child(lim, "singularity_margin_deg");
   spec.limits.length_min = r.number(lmin, "shortest leg [m]");
   spec.limits.length_max = r.number(lmax, "longest leg [m]");
   spec.limits.bend_max = deg2rad(r.number_or(bend, "largest U-joint bend [deg]", 30.0));
   spec.limits.singularity_margin = deg2rad(r.number_or(margin, "smallest leg-to-axis angle [deg]", 5.0));
+  const Field condition = Reader::child(lim, "jacobian_condition_max");
+  spec.limits.jacobian_condition_max =
+      r.number_or(condition, "largest condition number of the Jacobian [-]", kDefaultJacobianConditionMax);
   locs["limits.length_min"] = loc(lmin);
   locs["limits.length_max"] = loc(lmax);
   locs["limits.bend_max"] = loc(bend);
   locs["limits.singularity_margin"] = loc(margin);
+  locs["limits.jacobian_condition_max"] = loc(condition);
 
   const Field obs = Reader::child(top, "observation_point"), pivot = Reader::child(top, "pivot");
   if (obs.present()) spec.observation_P = r.vec3(obs, "point x, y, z [m, platform frame]");

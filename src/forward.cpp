@@ -1,5 +1,6 @@
 #include "hexatwist/forward.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -50,6 +51,8 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
   out.iterations = 0;
   out.residual = INFINITY;
   out.placement = guess;
+  out.condition = std::nan("");
+  out.det_sign = 0.0;
   if (!detail::all_finite(lengths) || !detail::all_finite(guess.t) || !detail::all_finite(guess.R_BP))
     return Status::NonFiniteInput;
 
@@ -71,12 +74,17 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
   Vector6d f_try, step;
   Matrix6d J;
   detail::Lu6 lu;
+  double det_sign_guess = 0.0;  // 0: not computed yet
   for (;;) {
     out.placement = x;
     out.residual = f.cwiseAbs().maxCoeff();
     if (out.residual <= options.tolerance) {
       out.pose = pose_from_placement(x);
-      return finish(Status::Ok);
+      // The assembly mode at the solution, against the guess's (theory §5).
+      if (const Status s = length_jacobian(model, *legs, kind, J); s != Status::Ok) return finish(s);
+      out.condition = detail::scaled_condition(J, model.condition_length(), out.det_sign);
+      if (det_sign_guess == 0.0) det_sign_guess = out.det_sign;  // no step taken: the guess is the solution
+      return finish(out.det_sign == det_sign_guess ? Status::Ok : Status::AssemblyModeChanged);
     }
     if (out.iterations >= options.max_iterations) return finish(Status::NoConvergence);
 
@@ -85,7 +93,13 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
     // steps was measured: more iterations, no gain, since two Newton steps usually suffice.)
     if (const Status s = length_jacobian(model, *legs, kind, J); s != Status::Ok) return finish(s);
     if (!(detail::lu6_factor(J, lu) > options.singular_ratio)) return finish(Status::SingularJacobian);
+    if (det_sign_guess == 0.0) det_sign_guess = detail::lu6_det_sign(lu);
     detail::lu6_solve(lu, -f, step);
+    // Step cap: near a singularity, or far from the solution, the Newton step can be far longer
+    // than the platform; shorten it (direction kept) to a length the linear model can be trusted over.
+    const double dt = step.head<3>().norm(), dw = step.tail<3>().norm();
+    if (dt > options.max_step_translation || dw > options.max_step_rotation)
+      step *= std::min(options.max_step_translation / dt, options.max_step_rotation / dw);
 
     // Backtracking: accept the first fraction of the step that lowers |f| (and stays away from
     // singular joints), so a far guess cannot throw the iterate to another assembly mode.
@@ -104,6 +118,19 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
     f = f_try;
     std::swap(legs, trial);
   }
+}
+
+Status forward_kinematics_tracked(const Model& model, const Vector6d& lengths, LengthKind kind, FkTracker& tracker,
+                                  FkResult& out, const FkOptions& options) noexcept {
+  const Placement guess = tracker.valid ? tracker.last : Placement{};
+  if (const Status s = forward_kinematics(model, lengths, kind, guess, out, options); s != Status::Ok) return s;
+  // The guess's mode is the tracker's unless the caller's tracker came from another kind of lengths.
+  if (tracker.valid && out.det_sign != tracker.det_sign) return Status::AssemblyModeChanged;
+  // Past the condition limit the lengths of a pose beyond a singularity can have a solution on
+  // this side of it (a fold): refuse it rather than follow (docs/theory.md §5).
+  if (!(out.condition <= model.spec().limits.jacobian_condition_max)) return Status::PlatformSingularity;
+  tracker = FkTracker{out.placement, out.det_sign, true};
+  return Status::Ok;
 }
 
 }  // namespace hexatwist

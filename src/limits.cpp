@@ -4,6 +4,8 @@
 
 #include "geometry.hpp"
 #include "lanes.hpp"
+#include "linear_solve.hpp"
+#include "twist_internal.hpp"
 
 namespace hexatwist {
 namespace {
@@ -21,6 +23,19 @@ Status report_violation(LimitReport& r, Status s, int leg, double value, double 
 }
 
 }  // namespace
+
+Status jacobian_condition(const Model& model, const LegState& state, double& condition) noexcept {
+  Matrix6d J;
+  condition = std::nan("");
+  if (model.has_twist()) {
+    if (const Status s = detail::motor_length_jacobian(model, state, J); s != Status::Ok) return s;
+  } else {
+    length_jacobian(state, J);
+  }
+  double det_sign;
+  condition = detail::scaled_condition(J, model.condition_length(), det_sign);
+  return condition <= model.spec().limits.jacobian_condition_max ? Status::Ok : Status::PlatformSingularity;
+}
 
 void bend_angles(const Model& model, const LegState& state, Vector6d& bend_base, Vector6d& bend_platform) noexcept {
   for (int i = 0; i < kLegs; ++i) {
@@ -50,7 +65,12 @@ Status check_limits(const Model& model, const LegState& state, LimitReport& r) n
                                    detail::dot(u, detail::load6(state.axis_platform_B, k)), k);
     ok &= detail::within_limits(model, terms[k]);
   }
-  if (detail::all_lanes(ok)) return Status::Ok;
+  if (detail::all_lanes(ok)) {
+    double condition;
+    if (const Status st = jacobian_condition(model, state, condition); st != Status::Ok)
+      return report_violation(r, st, -1, condition, lim.jacobian_condition_max);
+    return Status::Ok;
+  }
   // Leg i's terms, as the test saw them.
   const auto lane = [&](detail::lane_v detail::LimitTerms::*field, int i) {
     return (terms[i / detail::kWidth].*field)[i % detail::kWidth];

@@ -83,4 +83,45 @@ inline void lu6_solve(const Lu6& lu, const Vector6d& b, Vector6d& x) noexcept {
   }
 }
 
+/// Sign of det(A) from its factors: the product of the pivots' signs and the permutation's parity.
+inline double lu6_det_sign(const Lu6& lu) noexcept {
+  double sign = 1.0;
+  for (int k = 0; k < 6; ++k) {
+    if (lu.a[k][k] < 0.0) sign = -sign;
+    for (int j = k + 1; j < 6; ++j)
+      if (lu.perm[j] < lu.perm[k]) sign = -sign;  // each inversion flips the parity
+  }
+  return sign;
+}
+
+/// 1-norm condition number ||A||_1 ||A^-1||_1 of A = J diag(1, 1, 1, s, s, s) from the factors of
+/// J (lu6_factor(J) > 0): the inverse is diag(1, 1, 1, 1/s, 1/s, 1/s) J^-1, one column per solve.
+/// `column_sums` are the column sums of |J|.
+inline double lu6_scaled_condition(const Lu6& lu, const Vector6d& column_sums, double s) noexcept {
+  const double norm_a = std::max(column_sums.head<3>().maxCoeff(), s * column_sums.tail<3>().maxCoeff());
+  double norm_inv = 0.0;
+  Vector6d e, x;
+#pragma GCC unroll 6
+  for (int j = 0; j < 6; ++j) {
+    e.setZero();
+    e[j] = 1.0;
+    lu6_solve(lu, e, x);
+    norm_inv = std::max(norm_inv, x.head<3>().cwiseAbs().sum() + x.tail<3>().cwiseAbs().sum() / s);
+  }
+  return norm_a * norm_inv;
+}
+
+/// Condition number of a platform Jacobian J [-, m] (rows [s_i, arm_i x s_i] or the motor-side
+/// ones) with its rotation columns divided by `length` [m], by lu6_scaled_condition; `det_sign`
+/// gets the sign of det J. An exactly singular J gives inf and sign 0.
+inline double scaled_condition(const Matrix6d& J, double length, double& det_sign) noexcept {
+  Lu6 lu;
+  if (!(lu6_factor(J, lu) > 0.0)) {
+    det_sign = 0.0;
+    return INFINITY;
+  }
+  det_sign = lu6_det_sign(lu);
+  return lu6_scaled_condition(lu, J.cwiseAbs().colwise().sum().transpose(), 1.0 / length);
+}
+
 }  // namespace hexatwist::detail

@@ -4,9 +4,11 @@
 
 #include <Eigen/LU>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 
 #include "hexatwist/error.hpp"
+#include "hexatwist/limits.hpp"
 #include "geometry.hpp"
 
 namespace hexatwist {
@@ -56,6 +58,9 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
   if (lim.singularity_margin <= 0.0 || lim.singularity_margin >= kPi / 2)
     fail(fmt::format("limits.singularity_margin: expected an angle in (0, 90) deg, got {:.10g} deg",
                      rad2deg(lim.singularity_margin)));
+  require_finite(lim.jacobian_condition_max, "limits.jacobian_condition_max");
+  if (!(lim.jacobian_condition_max > 1.0))
+    fail(fmt::format("limits.jacobian_condition_max: expected a condition number > 1, got {}", lim.jacobian_condition_max));
   require_finite(spec.observation_P, "observation_point");
   require_finite(spec.pivot_P, "pivot");
 
@@ -142,7 +147,9 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
     geometry_.twist_gain[i] = leg.twist_gain;
     geometry_.length_offset[i] = leg.length_offset;
     geometry_.has_axes[i] = axes ? 1.0 : 0.0;
+    condition_length_ = std::max(i == 0 ? 0.0 : condition_length_, leg.arm_P.norm());
   }
+  if (!(condition_length_ > 0.0)) fail("legs: every platform joint sits at the pivot; expected a platform of some size");
   LegLanes& lanes = geometry_.lanes;
   for (int lane = 0; lane < 8; ++lane) {
     const int i = lane < kLegs ? lane : 0;
@@ -171,6 +178,13 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
   if (!(smin > 0.0) || smax / smin > kMaxHomeCondition)
     fail(fmt::format("legs: the six legs do not hold the platform at home (Jacobian condition number {:.3g})",
                      smin > 0.0 ? smax / smin : INFINITY));
+  // Home must pass the platform-singularity limit, as it passes the others.
+  LegState home;
+  double condition = INFINITY;
+  if (inverse_kinematics(*this, Placement{}, home) == Status::Ok &&
+      jacobian_condition(*this, home, condition) == Status::PlatformSingularity)
+    fail(fmt::format("limits.jacobian_condition_max: the Jacobian's condition number at home is {:.4g}, above the "
+                     "limit {:.4g}", condition, lim.jacobian_condition_max));
 }
 
 PerLeg<LegSpec> symmetric_legs(const SymmetricSpec& s) {

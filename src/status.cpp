@@ -21,6 +21,8 @@ std::string_view to_string(Status s) noexcept {
     case Status::DegenerateRegistration: return "degenerate_registration";
     case Status::NotIdentifiable: return "not_identifiable";
     case Status::SolverNoConvergence: return "solver_no_convergence";
+    case Status::PlatformSingularity: return "platform_singularity";
+    case Status::AssemblyModeChanged: return "assembly_mode_changed";
   }
   return "unknown";
 }
@@ -46,6 +48,10 @@ std::string_view describe(Status s) noexcept {
     case Status::NotIdentifiable:
       return "the measurements do not determine every identified parameter (rank-deficient Jacobian or too few points)";
     case Status::SolverNoConvergence: return "the least-squares solver stopped before it converged";
+    case Status::PlatformSingularity:
+      return "the pose is too close to a platform singularity: the Jacobian's condition number exceeds its limit";
+    case Status::AssemblyModeChanged:
+      return "forward kinematics found a solution on another assembly mode than its start (the Jacobian determinant changed sign)";
   }
   return "unknown status";
 }

@@ -279,6 +279,17 @@ TEST(Config, DefaultLimitsAreThirtyDegreesBendAndFiveDegreesMargin) {
   EXPECT_NEAR(rad2deg(m.spec().limits.singularity_margin), 5.0, 1e-12);
 }
 
+TEST(Config, JacobianConditionLimitIsOptionalAndValidated) {
+  EXPECT_EQ(load_model(kSymmetric, "default.yaml").spec().limits.jacobian_condition_max, kDefaultJacobianConditionMax);
+  EXPECT_EQ(seed_model().spec().limits.jacobian_condition_max, 50.0);  // configs/seed.yaml lists it
+  const Model m = load_model(kSymmetric + "  jacobian_condition_max: 30\n", "thirty.yaml");
+  EXPECT_EQ(m.spec().limits.jacobian_condition_max, 30.0);
+  expect_error(kSymmetric + "  jacobian_condition_max: 1\n", 17, {"field 'limits.jacobian_condition_max'", "> 1"});
+  expect_error(kSymmetric + "  jacobian_condition_max: .nan\n", 17, {"field 'limits.jacobian_condition_max'"});
+  expect_error(kSymmetric + "  jacobian_condition_max: many\n", 17, {"field 'limits.jacobian_condition_max'", "'many'"});
+  expect_error(kSymmetric + "  jacobian_condition_max: 4\n", 17, {"field 'limits.jacobian_condition_max'", "home"});
+}
+
 TEST(Config, ParseModelSpecLeavesValidationToModel) {
   // parse_model_spec reads; the Model validates. load_model does both and locates the error.
   const std::string yaml = replace_line(kSymmetric, 13, "  length_min: 2.5");

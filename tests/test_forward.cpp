@@ -1,5 +1,7 @@
 // Forward kinematics: round trips with IK (geometric and twist-aware), the residual Jacobian
 // against finite differences, warm starts, and failures that are reported rather than silent.
+#include <map>
+
 #include "support.hpp"
 
 namespace hexatwist::test {
@@ -185,6 +187,240 @@ TEST(Forward, RejectsNonFiniteInput) {
   bad.t.x() = INFINITY;
   EXPECT_EQ(forward_kinematics(seed_model(), seed_model().length_home(), LengthKind::Motor, bad, r),
             Status::NonFiniteInput);
+}
+
+// ---- robustness: step cap, assembly mode, convergence across the workspace ------------------
+
+// A pose of the seed platform inside every limit, drawn across its reachable workspace (which
+// reaches about 1 m sideways, 0.6 m up and down and 40 deg about each axis, not all at once): the
+// rotation box is scaled by a uniform factor so that large displacements with small rotations are
+// drawn as often as the reverse. Returns the pose and its compensated command.
+Pose workspace_pose(std::mt19937_64& rng, Vector6d& command) {
+  for (;;) {
+    Pose p;
+    p.position = Vector3d(uniform(rng, -1.0, 1.0), uniform(rng, -1.0, 1.0), uniform(rng, -0.6, 0.6));
+    const double r = deg2rad(45) * uniform(rng, 0, 1);
+    p.rpy = Vector3d(uniform(rng, -r, r), uniform(rng, -r, r), uniform(rng, -r, r));
+    LimitReport lim;
+    if (motor_commands(seed_model(), p, Strategy::Compensated, command, lim) == Status::Ok) return p;
+  }
+}
+
+TEST(Forward, ConvergesFromHomeOnAHundredThousandPosesAcrossTheReachableWorkspace) {
+  std::mt19937_64 rng(kSeed + 13);
+  const int count = stress(100000);
+  std::map<int, int> histogram;
+  int ok = 0;
+  double worst = 0.0;
+  for (int n = 0; n < count; ++n) {
+    Vector6d m;
+    const Pose p = workspace_pose(rng, m);
+    FkResult r;
+    const Status s = forward_kinematics(seed_model(), m, LengthKind::Motor, Placement{}, r);
+    const PoseError e = pose_error(r.placement, placement_from_pose(p));
+    if (s == Status::Ok && e.position < kRoundTripTol && e.rotation < kRoundTripTol) {
+      ++ok;
+      ++histogram[r.iterations];
+      worst = std::max({worst, e.position, e.rotation});
+    } else {
+      ADD_FAILURE() << to_string(s) << " for pose " << str(p) << " after " << r.iterations << " iterations";
+    }
+  }
+  std::printf("  Newton iterations from home (count):");
+  for (const auto& [iterations, n] : histogram) std::printf(" %d: %d", iterations, n);
+  std::printf("\n");
+  report("worst pose error [m or rad]", worst);
+  EXPECT_GE(ok, count - count / 10000) << "below 99.99 %";  // measured: all
+}
+
+// Motor-side lengths of a pose of `model`.
+Vector6d motor_lengths(const Model& model, const Pose& p) { return lengths_for(model, placement_from_pose(p), LengthKind::Motor); }
+
+TEST(Forward, ConvergesFromFarGuessesOnAsymmetricPlatforms) {
+  // Guess and solution both drawn inside every limit, up to 0.4 m and 30 deg apart. Newton may
+  // end on another solution with the same lengths; it must never call a pose with another
+  // determinant sign than the guess's Ok, and must find the drawn pose nearly always.
+  std::mt19937_64 rng(kSeed + 14);
+  int total = 0, found = 0, other_mode = 0;
+  for (int k = 0; k < 40; ++k) {
+    const Model model = random_platform(rng);
+    for (int n = 0; n < 50; ++n, ++total) {
+      const Pose p = random_valid_pose(model, rng, 0.2, deg2rad(15));
+      const Placement guess = placement_from_pose(random_valid_pose(model, rng, 0.2, deg2rad(15)));
+      FkResult r, at_guess;
+      const Status s = forward_kinematics(model, motor_lengths(model, p), LengthKind::Motor, guess, r);
+      ASSERT_EQ(forward_kinematics(model, lengths_for(model, guess, LengthKind::Motor), LengthKind::Motor, guess, at_guess),
+                Status::Ok);
+      if (s == Status::AssemblyModeChanged) {
+        EXPECT_NE(r.det_sign, at_guess.det_sign);
+        ++other_mode;
+        continue;
+      }
+      ASSERT_EQ(s, Status::Ok) << str(p) << " from " << str(pose_from_placement(guess));
+      EXPECT_EQ(r.det_sign, at_guess.det_sign);
+      EXPECT_LE(r.residual, FkOptions{}.tolerance);
+      found += pose_error(r.placement, placement_from_pose(p)).position < kRandomPlatformTol;
+    }
+  }
+  std::printf("  found the drawn pose %d of %d times; another assembly mode %d times\n", found, total, other_mode);
+  EXPECT_GE(found, total * 99 / 100);  // measured: all 2000
+}
+
+TEST(Forward, ConvergesNearPoorlyConditionedSolutionsOnAsymmetricPlatforms) {
+  // Poses whose Jacobian condition lies between half the limit and the limit, from home and from
+  // a guess 5 mm and 0.3 deg away.
+  std::mt19937_64 rng(kSeed + 15);
+  int total = 0, from_home = 0;
+  for (int k = 0; k < 40; ++k) {
+    const Model model = random_platform(rng);
+    const double bound = model.spec().limits.jacobian_condition_max;
+    for (int n = 0, tries = 0; n < 10 && tries < 20000; ++tries) {
+      const Pose p = random_pose(rng, 0.6, deg2rad(35));
+      CommandReport c;
+      double condition;
+      if (compute_commands(model, p, c) != Status::Ok || jacobian_condition(model, c.legs, condition) != Status::Ok ||
+          condition < 0.5 * bound)
+        continue;
+      ++n;
+      ++total;
+      Pose near = p;
+      near.position += Vector3d::Constant(5e-3 / std::sqrt(3.0));
+      near.rpy += Vector3d::Constant(deg2rad(0.3) / std::sqrt(3.0));
+      FkResult r;
+      ASSERT_EQ(forward_kinematics(model, c.compensated, LengthKind::Motor, placement_from_pose(near), r), Status::Ok) << str(p);
+      EXPECT_LT(pose_error(r.placement, placement_from_pose(p)).position, kRandomPlatformTol) << str(p);
+      EXPECT_NEAR(r.condition, condition, 1e-6 * condition);
+      const Status s = forward_kinematics(model, c.compensated, LengthKind::Motor, Placement{}, r);
+      from_home += s == Status::Ok && pose_error(r.placement, placement_from_pose(p)).position < kRandomPlatformTol;
+    }
+  }
+  std::printf("  %d poses; from home %d found\n", total, from_home);
+  EXPECT_GE(total, 100);
+  EXPECT_GE(from_home, total * 8 / 10);  // measured: 357 of 400
+}
+
+TEST(Forward, StepCapHoldsWhereTheNewtonStepIsHuge) {
+  // From a guess next to the seed's yaw-90 deg singularity the Newton step toward the yaw-30 deg
+  // lengths is far longer than the platform; the first step must stay within the cap.
+  Pose guess_pose;
+  guess_pose.rpy[2] = deg2rad(89.99);
+  const Placement guess = placement_from_pose(guess_pose);
+  Pose target;
+  target.rpy[2] = deg2rad(30);
+  const Vector6d m = motor_lengths(seed_model(), target);
+  LegState st;
+  Vector6d f;
+  Matrix6d J;
+  ASSERT_EQ(fk_residual(seed_model(), guess, m, LengthKind::Motor, st, f, &J), Status::Ok);
+  const Vector6d newton = J.partialPivLu().solve(-f);
+  report("uncapped first step [m]", newton.head<3>().norm());
+  EXPECT_GT(std::max(newton.head<3>().norm(), newton.tail<3>().norm()), 10.0);
+  FkOptions o;
+  o.max_iterations = 1;
+  FkResult r;
+  EXPECT_EQ(forward_kinematics(seed_model(), m, LengthKind::Motor, guess, r, o), Status::NoConvergence);
+  const PoseError step = pose_error(r.placement, guess);
+  EXPECT_LE(step.position, o.max_step_translation * (1 + 1e-12));
+  EXPECT_LE(step.rotation, o.max_step_rotation * (1 + 1e-12));
+  EXPECT_GT(step.position + step.rotation, 0.0);
+}
+
+// The seed platform with stroke and bend limits wide enough for a pure yaw to 90 deg: only the
+// platform-singularity limit stops it.
+Model seed_with_wide_limits() {
+  ModelSpec spec = seed_model().spec();
+  spec.limits.length_min = 0.5;
+  spec.limits.length_max = 4.0;
+  spec.limits.bend_max = deg2rad(89);
+  return Model(spec);
+}
+
+TEST(Forward, TrackedYawSweepStaysOnItsAssemblyModeUpToTheSingularityLimit) {
+  // Pure yaw 0 -> 93 deg at 1 kHz and 20 deg/s; the seed is singular at 90 deg. Ok while
+  // check_limits passes; past the limit, and past the singularity, never Ok, and a failure
+  // leaves the tracker. (Beyond about 94 deg the lengths equal those of a pose near 86 deg on
+  // this side, inside the limit: no forward kinematics can tell them apart.)
+  const Model model = seed_with_wide_limits();
+  FkTracker tracker;
+  FkResult r;
+  double last_inside = 0.0, first_refused = -1.0;
+  std::map<std::string, int> refused;
+  for (int k = 0; k <= 4650; ++k) {
+    Pose p;
+    p.rpy[2] = deg2rad(0.02 * k);
+    LegState st;
+    ASSERT_EQ(inverse_kinematics(model, p, st), Status::Ok);
+    LimitReport lim;
+    const Status limit = check_limits(model, st, lim);
+    const FkTracker before = tracker;
+    const Status s = forward_kinematics_tracked(model, motor_lengths(model, p), LengthKind::Motor, tracker, r);
+    if (limit == Status::Ok) {
+      ASSERT_EQ(first_refused, -1.0) << "the limit let a pose back in at yaw " << rad2deg(p.rpy[2]);
+      ASSERT_EQ(s, Status::Ok) << "yaw " << rad2deg(p.rpy[2]);
+      ASSERT_LT(pose_error(r.placement, placement_from_pose(p)).position, kRoundTripTol);
+      last_inside = p.rpy[2];
+      continue;
+    }
+    ASSERT_EQ(limit, Status::PlatformSingularity) << "yaw " << rad2deg(p.rpy[2]);
+    if (first_refused < 0) first_refused = p.rpy[2];
+    ASSERT_NE(s, Status::Ok) << "yaw " << rad2deg(p.rpy[2]) << " gave yaw " << rad2deg(r.pose.rpy[2]);
+    ++refused[std::string(to_string(s))];
+    EXPECT_EQ(tracker.det_sign, before.det_sign);
+    EXPECT_EQ(tracker.last.R_BP, before.last.R_BP);
+  }
+  std::printf("  last yaw inside the limits %.2f deg, first refused %.2f deg; refusals:", rad2deg(last_inside),
+              rad2deg(first_refused));
+  for (const auto& [status, n] : refused) std::printf(" %s %d", status.c_str(), n);
+  std::printf("\n");
+  EXPECT_GT(rad2deg(last_inside), 80.0);
+  EXPECT_LT(rad2deg(first_refused), 89.0);
+}
+
+TEST(Forward, CrossingOntoTheOtherAssemblyModeIsReported) {
+  // From guesses beyond the yaw-90 deg singularity (the other mode), lengths of poses on this
+  // side: Ok only on the guess's mode; a solution on this side is AssemblyModeChanged.
+  const Model model = seed_with_wide_limits();
+  int changed = 0;
+  for (const double guess_yaw : {92.0, 95.0, 100.0}) {
+    for (const double target_yaw : {30.0, 50.0, 70.0, 80.0, 85.0}) {
+      Pose guess, target;
+      guess.rpy[2] = deg2rad(guess_yaw);
+      target.rpy[2] = deg2rad(target_yaw);
+      FkResult at_guess, r;
+      ASSERT_EQ(forward_kinematics(model, motor_lengths(model, guess), LengthKind::Motor, placement_from_pose(guess), at_guess),
+                Status::Ok);
+      const Status s = forward_kinematics(model, motor_lengths(model, target), LengthKind::Motor, placement_from_pose(guess), r);
+      if (s == Status::Ok) EXPECT_EQ(r.det_sign, at_guess.det_sign) << guess_yaw << " -> " << target_yaw;
+      if (s != Status::AssemblyModeChanged) continue;
+      ++changed;
+      EXPECT_EQ(r.det_sign, -at_guess.det_sign);
+      EXPECT_LT(pose_error(r.placement, placement_from_pose(target)).position, kRoundTripTol);
+      FkTracker tracker{at_guess.placement, at_guess.det_sign, true};
+      EXPECT_EQ(forward_kinematics_tracked(model, motor_lengths(model, target), LengthKind::Motor, tracker, r),
+                Status::AssemblyModeChanged);
+      EXPECT_EQ(tracker.last.R_BP, at_guess.placement.R_BP);
+    }
+  }
+  // Measured: none found on this side (NoConvergence or a solution on the guess's side); the
+  // line search rarely lets Newton through a singularity, and the sign check catches it when it does.
+  std::printf("  AssemblyModeChanged in %d of 15 crossings\n", changed);
+}
+
+TEST(Forward, TrackedStartsFromHomeAndFollowsAMotion) {
+  FkTracker tracker;
+  FkResult r;
+  Pose p;
+  p.position = Vector3d(0.1, -0.05, 0.02);
+  ASSERT_EQ(forward_kinematics_tracked(seed_model(), motor_lengths(seed_model(), p), LengthKind::Motor, tracker, r), Status::Ok);
+  EXPECT_TRUE(tracker.valid);
+  EXPECT_EQ(tracker.det_sign, r.det_sign);
+  EXPECT_LT(pose_error(tracker.last, placement_from_pose(p)).position, kRoundTripTol);
+  // A failure (NaN lengths) leaves the tracker.
+  const FkTracker before = tracker;
+  Vector6d bad = seed_model().length_home();
+  bad[0] = std::nan("");
+  EXPECT_EQ(forward_kinematics_tracked(seed_model(), bad, LengthKind::Motor, tracker, r), Status::NonFiniteInput);
+  EXPECT_EQ(tracker.last.t, before.last.t);
 }
 
 TEST(Forward, HomeLengthsGiveHomeWithoutIterating) {

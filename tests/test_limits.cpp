@@ -1,4 +1,7 @@
-// Limits: stroke, bend and U-joint singularity, each reported with the right leg and value.
+// Limits: stroke, bend, U-joint and platform singularity, each reported with the right leg and value.
+#include <Eigen/LU>
+#include <Eigen/SVD>
+
 #include "support.hpp"
 
 namespace hexatwist::test {
@@ -101,6 +104,128 @@ TEST(Limits, CommandStrokeCheckNamesTheLeg) {
   cmd[2] = std::nan("");
   EXPECT_EQ(check_stroke(seed_model(), cmd, r), Status::NonFiniteInput);
   EXPECT_EQ(r.leg, 2);
+}
+
+// ---- platform (Jacobian) singularity --------------------------------------------------------
+
+// The condition number by Eigen: the Jacobian of twist_jacobian / length_jacobian, scaled, its
+// exact inverse, and the 1-norm as the largest column sum.
+double condition_by_eigen(const Model& model, const LegState& st) {
+  Matrix6d J, J_twist;
+  length_jacobian(st, J);
+  if (model.has_twist()) {
+    EXPECT_EQ(twist_jacobian(model, st, J_twist), Status::Ok);
+    J -= model.geometry().twist_gain.asDiagonal() * J_twist;
+  }
+  J.rightCols<3>() /= model.condition_length();
+  const auto norm1 = [](const Matrix6d& A) { return A.cwiseAbs().colwise().sum().maxCoeff(); };
+  return norm1(J) * norm1(J.fullPivLu().inverse());
+}
+
+TEST(Limits, JacobianConditionMatchesAnIndependentComputation) {
+  std::mt19937_64 rng(kSeed + 30);
+  double worst = 0.0;
+  for (int m = 0; m < 10; ++m) {
+    const Model model = m == 0 ? seed_model() : random_platform(rng);
+    for (int n = 0; n < 100; ++n) {
+      LegState st;
+      ASSERT_EQ(inverse_kinematics(model, random_pose(rng, 0.3, deg2rad(20)), st), Status::Ok);
+      double c;
+      if (jacobian_condition(model, st, c) == Status::SingularBase || std::isnan(c)) continue;
+      const double expected = condition_by_eigen(model, st);
+      worst = std::max(worst, std::abs(c - expected) / expected);
+    }
+  }
+  report("relative difference", worst);
+  EXPECT_LT(worst, 1e-10);
+}
+
+TEST(Limits, JacobianConditionIsBetweenTheTwoNormBoundsOfTheSvd) {
+  // ||A||_1 ||A^-1||_1 lies within a factor 6 of the 2-norm condition number (n = 6).
+  LegState st;
+  ASSERT_EQ(inverse_kinematics(seed_model(), Pose{}, st), Status::Ok);
+  double c;
+  ASSERT_EQ(jacobian_condition(seed_model(), st, c), Status::Ok);
+  Matrix6d J, J_twist;
+  length_jacobian(st, J);
+  ASSERT_EQ(twist_jacobian(seed_model(), st, J_twist), Status::Ok);
+  J -= seed_model().geometry().twist_gain.asDiagonal() * J_twist;
+  J.rightCols<3>() /= seed_model().condition_length();
+  const Eigen::JacobiSVD<Matrix6d> svd(J);
+  const double c2 = svd.singularValues()(0) / svd.singularValues()(5);
+  EXPECT_GE(c, c2 / 6);
+  EXPECT_LE(c, c2 * 6);
+}
+
+TEST(Limits, SeedWorkspaceIsFarInsideTheConditionLimit) {
+  // The paper's tests (about 9-10.5) and random poses inside the other limits (at most about 11)
+  // pass the default bound of 50 with a factor 4 to spare.
+  std::mt19937_64 rng(kSeed + 31);
+  ModelSpec spec = seed_model().spec();
+  spec.limits.jacobian_condition_max = 1e300;
+  const Model unbounded(spec);
+  double worst = 0.0;
+  for (int n = 0; n < 20000; ++n) {
+    const Pose p = random_valid_pose(unbounded, rng, 0.8, deg2rad(40));
+    LegState st;
+    ASSERT_EQ(inverse_kinematics(unbounded, p, st), Status::Ok);
+    double c;
+    ASSERT_EQ(jacobian_condition(unbounded, st, c), Status::Ok);
+    worst = std::max(worst, c);
+  }
+  report("largest condition number", worst);
+  EXPECT_LT(worst, seed_model().spec().limits.jacobian_condition_max / 4);
+}
+
+TEST(Limits, PureYawTowardsTheSingularityIsRefusedByTheConditionLimit) {
+  // With stroke and bend limits wide enough, pure yaw reaches the seed's singularity at 90 deg.
+  ModelSpec spec = seed_model().spec();
+  spec.limits.length_min = 0.5;
+  spec.limits.length_max = 4.0;
+  spec.limits.bend_max = deg2rad(89);
+  const Model model(spec);
+  double previous = 0.0, refused_at = 0.0;
+  for (int k = 0; k <= 900; ++k) {
+    Pose p;
+    p.rpy[2] = deg2rad(0.1 * k);
+    LegState st;
+    ASSERT_EQ(inverse_kinematics(model, p, st), Status::Ok);
+    double c;
+    const Status s = jacobian_condition(model, st, c);
+    if (k > 300) EXPECT_GT(c, previous) << "yaw " << 0.1 * k;  // from 30 deg on it rises towards 90 deg
+    previous = c;
+    if (k % 50 == 0) std::printf("  yaw %4.1f deg: condition %.4g\n", 0.1 * k, c);
+    LimitReport r;
+    EXPECT_EQ(check_limits(model, st, r), s);
+    if (s == Status::Ok) continue;
+    EXPECT_EQ(s, Status::PlatformSingularity);
+    EXPECT_EQ(r.leg, -1);
+    EXPECT_EQ(r.value, c);
+    EXPECT_EQ(r.bound, spec.limits.jacobian_condition_max);
+    if (refused_at == 0.0) refused_at = 0.1 * k;
+    // Neither the command functions nor compute_commands emit a command there.
+    Vector6d cmd = Vector6d::Constant(-1.0);
+    LimitReport lim;
+    EXPECT_EQ(motor_commands(model, p, Strategy::Compensated, cmd, lim), Status::PlatformSingularity);
+    EXPECT_EQ(motor_commands(model, p, Strategy::Conventional, cmd, lim), Status::PlatformSingularity);
+    EXPECT_EQ(cmd, Vector6d::Constant(-1.0));
+    CommandReport rep;
+    EXPECT_EQ(compute_commands(model, p, rep), Status::PlatformSingularity);
+  }
+  std::printf("  refused from yaw %.1f deg\n", refused_at);
+  EXPECT_GT(refused_at, 80.0);
+  EXPECT_LT(refused_at, 88.0);  // measured: 86.3 deg
+  EXPECT_GT(previous, 1e3);  // at 90 deg
+}
+
+TEST(Limits, ModelRefusesAHomeBeyondTheConditionLimit) {
+  ModelSpec spec = seed_model().spec();
+  spec.limits.jacobian_condition_max = 5.0;  // the seed's home is at 8.9
+  expect_error_line([&] { (void)Model(spec); }, "limits.jacobian_condition_max:", {"home", "8.8"});
+  spec.limits.jacobian_condition_max = 1.0;
+  expect_error_line([&] { (void)Model(spec); }, "limits.jacobian_condition_max:", {"> 1"});
+  spec.limits.jacobian_condition_max = std::nan("");
+  expect_error_line([&] { (void)Model(spec); }, "limits.jacobian_condition_max:", {"finite"});
 }
 
 }  // namespace

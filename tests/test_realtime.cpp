@@ -29,6 +29,9 @@ static_assert(noexcept(motor_commands(std::declval<const Model&>(), std::declval
                                       std::declval<Vector6d&>(), std::declval<LimitReport&>())));
 static_assert(noexcept(forward_kinematics(std::declval<const Model&>(), std::declval<const Vector6d&>(), LengthKind::Motor,
                                           std::declval<const Placement&>(), std::declval<FkResult&>())));
+static_assert(noexcept(forward_kinematics_tracked(std::declval<const Model&>(), std::declval<const Vector6d&>(), LengthKind::Motor,
+                                                  std::declval<FkTracker&>(), std::declval<FkResult&>())));
+static_assert(noexcept(jacobian_condition(std::declval<const Model&>(), std::declval<const LegState&>(), std::declval<double&>())));
 static_assert(noexcept(check_limits(std::declval<const Model&>(), std::declval<const LegState&>(), std::declval<LimitReport&>())));
 
 static_assert(noexcept(stream_line(std::declval<const Model&>(), std::declval<const StreamSettings&>(), std::string_view(),
@@ -43,7 +46,7 @@ TEST(RealTime, CountingAllocatorSeesAllocations) {
   EXPECT_GE(g_allocations.load() - before, 2);
 }
 
-TEST(RealTime, CommandsTwistLimitsAndWarmFkDoNotAllocate) {
+TEST(RealTime, CommandsTwistLimitsConditionAndFkDoNotAllocate) {
   const Model& model = seed_model();
   std::mt19937_64 rng(kSeed + 60);
   std::vector<Pose> poses;
@@ -57,6 +60,8 @@ TEST(RealTime, CommandsTwistLimitsAndWarmFkDoNotAllocate) {
   FkResult fk;
   Placement previous;
   Vector6d bb, bp;
+  FkTracker tracker;
+  double condition;
 
   const long before = g_allocations.load();
   int ok = 0;
@@ -67,12 +72,14 @@ TEST(RealTime, CommandsTwistLimitsAndWarmFkDoNotAllocate) {
     (void)twist_jacobian(model, st, J);
     length_jacobian(st, J);
     (void)check_limits(model, st, lim);
+    (void)jacobian_condition(model, st, condition);
     bend_angles(model, st, bb, bp);
     (void)compute_commands(model, p, rep);
     ok += motor_commands(model, p, Strategy::Conventional, cmd, lim) == Status::Ok;
     if (motor_commands(model, p, Strategy::Compensated, cmd, lim) == Status::Ok) {
       (void)forward_kinematics(model, cmd, LengthKind::Motor, previous, fk);  // warm-ish
       (void)forward_kinematics(model, cmd, LengthKind::Geometric, Placement{}, fk);  // cold
+      (void)forward_kinematics_tracked(model, cmd, LengthKind::Motor, tracker, fk);
       previous = fk.placement;
     }
   }

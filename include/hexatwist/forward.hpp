@@ -17,6 +17,10 @@ struct FkOptions {
   int max_iterations = 30;     ///< Newton iterations before NoConvergence
   double tolerance = 1e-12;    ///< max |residual| accepted [m]
   double singular_ratio = 1e-12;  ///< smallest |pivot| ratio of the LU before SingularJacobian
+  /// Step cap (docs/theory.md §5): a Newton step whose translation |dt| or rotation |dw| is
+  /// longer than these is shortened, direction kept, before the line search.
+  double max_step_translation = 0.5;  ///< longest translation of one step [m]
+  double max_step_rotation = 0.5;     ///< largest rotation of one step [rad]
 };
 
 /// Result of forward kinematics (caller-owned).
@@ -26,6 +30,19 @@ struct FkResult {
   int iterations = 0;        ///< Newton iterations taken
   double residual = 0.0;     ///< max_i |residual_i| at `placement` [m]
   LegState legs;             ///< inverse kinematics at the solution
+  /// Condition number of the Jacobian of the lengths of `kind` at the solution, defined as in
+  /// jacobian_condition (limits.hpp) [-]; NaN unless the status is Ok or AssemblyModeChanged.
+  double condition = 0.0;
+  /// Sign of det of that Jacobian at the solution (+1 or -1; 0 when it was not computed): the
+  /// assembly mode [-].
+  double det_sign = 0.0;
+};
+
+/// Caller-owned state of forward kinematics along a motion (forward_kinematics_tracked).
+struct FkTracker {
+  Placement last;        ///< the last solution, the next call's start [m, B]
+  double det_sign = 0;   ///< its assembly mode, the sign of the Jacobian's determinant [-]
+  bool valid = false;    ///< false until the first solution (the start is then home)
 };
 
 /// Jacobian of the lengths of `kind` at the state `legs` (inverse kinematics done) for the
@@ -40,10 +57,23 @@ struct FkResult {
                                  LengthKind kind, LegState& legs, Vector6d& f, Matrix6d* J_f_x) noexcept;
 
 /// Forward kinematics from `guess` (home by default in the CLI). Returns Ok, NoConvergence,
-/// SingularJacobian, SingularBase/SingularPlatform (an iterate crossed a U-joint singularity) or
-/// NonFiniteInput; `out.residual` and `out.iterations` are set in every case.
+/// SingularJacobian, SingularBase/SingularPlatform (an iterate crossed a U-joint singularity),
+/// NonFiniteInput, or AssemblyModeChanged when the solution's Jacobian determinant has another
+/// sign than the guess's (the pose found is on another assembly mode: out.placement holds it, but
+/// it is not the pose the guess was near). `out.residual` and `out.iterations` are set in every
+/// case; on failure `out.placement` is the best iterate.
 [[nodiscard]] Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKind kind,
                                         const Placement& guess, FkResult& out,
                                         const FkOptions& options = {}) noexcept;
+
+/// Forward kinematics along a motion: from tracker.last (home while !tracker.valid), Ok only when
+/// converged on the same assembly mode as the tracker's (home's while !valid) and with the
+/// Jacobian's condition inside limits.jacobian_condition_max (else PlatformSingularity: near a
+/// singularity the lengths no longer tell on which side the platform is). On Ok it stores
+/// the solution in `tracker`; on failure it leaves `tracker` as it was and returns the status of
+/// forward_kinematics (AssemblyModeChanged, NoConvergence, SingularJacobian, ...).
+[[nodiscard]] Status forward_kinematics_tracked(const Model& model, const Vector6d& lengths, LengthKind kind,
+                                                FkTracker& tracker, FkResult& out,
+                                                const FkOptions& options = {}) noexcept;
 
 }  // namespace hexatwist

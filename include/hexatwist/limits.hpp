@@ -1,4 +1,5 @@
-// Limit check of a pose: leg stroke, U-joint bend and U-joint singularity.
+// Limit check of a pose: leg stroke, U-joint bend, U-joint singularity and platform (Jacobian)
+// singularity.
 #pragma once
 
 #include "hexatwist/kinematics.hpp"
@@ -9,8 +10,8 @@ namespace hexatwist {
 struct LimitReport {
   Status status = Status::Ok;  ///< Ok, or the limit status (see is_limit)
   int leg = -1;                ///< offending leg, 0-based; -1 if none
-  double value = 0.0;          ///< the offending quantity [m or rad]
-  double bound = 0.0;          ///< the limit it crossed [m or rad]
+  double value = 0.0;          ///< the offending quantity [m, rad, or - for a condition number]
+  double bound = 0.0;          ///< the limit it crossed [m, rad, or -]
 };
 
 /// U-joint bend angles: base, angle between s_i and its home direction; platform, the same seen
@@ -18,8 +19,17 @@ struct LimitReport {
 void bend_angles(const Model& model, const LegState& state, Vector6d& bend_base,
                  Vector6d& bend_platform) noexcept;
 
+/// Condition number of the platform Jacobian at `state` (inverse kinematics done): the motor-side
+/// Jacobian when the model has twist, else the geometric one, rotation columns divided by
+/// model.condition_length(), in the 1-norm, ||A||_1 ||A^-1||_1 (docs/theory.md §6) [-].
+/// Returns Ok, PlatformSingularity when `condition` exceeds limits.jacobian_condition_max (also
+/// for an exactly singular Jacobian: condition = inf), or SingularBase/SingularPlatform where the
+/// twist's Jacobian is undefined (condition = NaN).
+[[nodiscard]] Status jacobian_condition(const Model& model, const LegState& state, double& condition) noexcept;
+
 /// Checks each leg in order for stroke, then bend, then singularity, and reports the first
-/// violation. Uses no trigonometry (cosine / sine comparisons).
+/// violation; then, if every leg passed, the Jacobian's condition number (jacobian_condition,
+/// reported with leg -1). The leg tests use no trigonometry (cosine / sine comparisons).
 [[nodiscard]] Status check_limits(const Model& model, const LegState& state, LimitReport& report) noexcept;
 
 /// Checks that motor-side commands lie inside the stroke [m]; report names the first bad leg.

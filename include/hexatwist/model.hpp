@@ -26,12 +26,18 @@ struct LegSpec {
   double length_offset = 0.0;                 ///< real minus motor-side length at zero twist (theory §4) [m]
 };
 
+/// Default of LimitSpec::jacobian_condition_max (docs/theory.md §6: chosen on the seed platform).
+inline constexpr double kDefaultJacobianConditionMax = 50.0;
+
 /// Motion limits (unvalidated).
 struct LimitSpec {
   double length_min = 0.0;          ///< shortest leg [m]
   double length_max = 0.0;          ///< longest leg [m]
   double bend_max = 0.0;            ///< largest U-joint bend away from its home direction [rad]
   double singularity_margin = 0.0;  ///< smallest angle between a leg and a fixed U-joint axis [rad]
+  /// largest 1-norm condition number of the (motor-side) Jacobian, rotation columns divided by
+  /// Model::condition_length() (limits.hpp, jacobian_condition) [-]
+  double jacobian_condition_max = kDefaultJacobianConditionMax;
 };
 
 /// Everything a Model is built from. Frames: B is the base frame; P is the platform frame, equal
@@ -121,6 +127,9 @@ class Model {
   double cos_bend_max() const noexcept { return cos_bend_max_; }
   /// cos(singularity_margin)^2, precomputed for the limit check.
   double cos2_singularity_margin() const noexcept { return cos2_singularity_margin_; }
+  /// Characteristic length of the platform, the largest distance of a platform joint from the
+  /// pivot: the Jacobian's rotation columns are divided by it for its condition number [m].
+  double condition_length() const noexcept { return condition_length_; }
 
  private:
   ModelSpec spec_;
@@ -130,6 +139,7 @@ class Model {
   Vector6d length_home_;
   double cos_bend_max_ = 1.0;
   double cos2_singularity_margin_ = 1.0;
+  double condition_length_ = 1.0;
   bool has_twist_ = false;
 };
 

@@ -24,13 +24,15 @@ enum class Status : int {
   DegenerateRegistration,  ///< registration points are coincident or (nearly) collinear: the rotation is not determined
   NotIdentifiable,     ///< the measurements do not determine every identified parameter
   SolverNoConvergence, ///< the least-squares solver stopped before converging
+  PlatformSingularity, ///< the pose is too close to a platform (Jacobian) singularity: the motor-side Jacobian's condition number exceeds limits.jacobian_condition_max
+  AssemblyModeChanged, ///< forward kinematics found a solution on another assembly mode than its start (the Jacobian determinant changed sign)
 };
 
 /// True for the statuses that mean "this pose is outside a limit".
 constexpr bool is_limit(Status s) noexcept {
   return s == Status::StrokeBelowMin || s == Status::StrokeAboveMax || s == Status::BendBase ||
          s == Status::BendPlatform || s == Status::SingularBase || s == Status::SingularPlatform ||
-         s == Status::MotorSpeedAboveMax || s == Status::TorqueAboveMax;
+         s == Status::MotorSpeedAboveMax || s == Status::TorqueAboveMax || s == Status::PlatformSingularity;
 }
 
 /// Stable snake_case name of a status, as written in JSON (`"stroke_above_max"`).
