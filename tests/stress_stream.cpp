@@ -354,8 +354,10 @@ void check_answer(const Context& c, Session& s, const StreamOutput& out, Status 
   }
   if (!r.pose.is_finite() && r.has_pose && out.status != Status::NonFiniteInput)
     return fail(c, out, "non-finite pose not rejected as such");
-  if (is_limit(out.status) && !(out.limit.leg >= 0 && out.limit.leg < kLegs && std::isfinite(out.limit.value) &&
-                                std::isfinite(out.limit.bound)))
+  // The platform-singularity limit concerns the whole platform: leg -1.
+  const bool leg_ok = out.status == Status::PlatformSingularity ? out.limit.leg == -1
+                                                                : out.limit.leg >= 0 && out.limit.leg < kLegs;
+  if (is_limit(out.status) && !(leg_ok && std::isfinite(out.limit.value) && std::isfinite(out.limit.bound)))
     return fail(c, out, "limit rejection without a leg, value and bound");
   if (out.status != Status::Ok && expected != Status::Ok && r.has_pose && out.limit.leg != expected_limit.leg)
     return fail(c, out, "limit rejection names another leg than motor_commands");
