@@ -120,6 +120,18 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
   }
 }
 
+Status fk_tracker_set(const Model& model, const Placement& x, LengthKind kind, FkTracker& tracker) noexcept {
+  LegState legs;
+  if (const Status s = inverse_kinematics(model, x, legs); s != Status::Ok) return s;
+  Matrix6d J;
+  if (const Status s = length_jacobian(model, legs, kind, J); s != Status::Ok) return s;
+  double det_sign = 0.0;
+  detail::scaled_condition(J, model.condition_length(), det_sign);
+  if (det_sign == 0.0) return Status::SingularJacobian;
+  tracker = FkTracker{x, det_sign, true};
+  return Status::Ok;
+}
+
 Status forward_kinematics_tracked(const Model& model, const Vector6d& lengths, LengthKind kind, FkTracker& tracker,
                                   FkResult& out, const FkOptions& options) noexcept {
   const Placement guess = tracker.valid ? tracker.last : Placement{};

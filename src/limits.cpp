@@ -105,6 +105,40 @@ Status check_limits(const Model& model, const LegState& state, LimitReport& r) n
   return report_violation(r, Status::NonFiniteInput, -1, 0.0, 0.0);  // NaN in the leg axes
 }
 
+void nearest_limit(const Model& model, const LegState& state, double condition, LimitReport& nearest,
+                   double& margin) noexcept {
+  const LimitSpec& lim = model.spec().limits;
+  margin = INFINITY;
+  nearest = LimitReport{};
+  const auto consider = [&](double m, Status s, int leg, double value, double bound) {
+    if (m < margin || std::isnan(m)) {
+      margin = m;
+      nearest = LimitReport{s, leg, value, bound};
+    }
+  };
+  const double half_stroke = 0.5 * (lim.length_max - lim.length_min);
+  for (int i = 0; i < kLegs; ++i) {
+    const double len = state.length[i];
+    consider((len - lim.length_min) / half_stroke, Status::StrokeBelowMin, i, len, lim.length_min);
+    consider((lim.length_max - len) / half_stroke, Status::StrokeAboveMax, i, len, lim.length_max);
+    const Vector3d s = state.s_B.row(i).transpose();
+    const double bend_base = angle_between(s, model.leg(i).s_home_B);
+    const double bend_platform = angle_between(state.R_BP.transpose() * s, model.leg(i).s_home_B);
+    consider(1.0 - bend_base / lim.bend_max, Status::BendBase, i, bend_base, lim.bend_max);
+    consider(1.0 - bend_platform / lim.bend_max, Status::BendPlatform, i, bend_platform, lim.bend_max);
+    if (model.geometry().has_axes[i] == 0.0) continue;
+    const double free_range = kPi / 2 - lim.singularity_margin;
+    const double a = line_axis_angle(s, model.leg(i).axis_base_B);
+    const double d = line_axis_angle(s, state.axis_platform_B.row(i).transpose());
+    consider((a - lim.singularity_margin) / free_range, Status::SingularBase, i, a, lim.singularity_margin);
+    consider((d - lim.singularity_margin) / free_range, Status::SingularPlatform, i, d, lim.singularity_margin);
+  }
+  const double log_max = std::log(lim.jacobian_condition_max);
+  const double c = std::isnan(condition) ? INFINITY : std::max(condition, 1.0);  // NaN: no Jacobian there
+  consider(1.0 - std::log(c) / log_max, Status::PlatformSingularity, -1, condition,
+           lim.jacobian_condition_max);
+}
+
 Status check_stroke(const Model& model, const Vector6d& command, LimitReport& r) noexcept {
   r = LimitReport{};
   const LimitSpec& lim = model.spec().limits;

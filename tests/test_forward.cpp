@@ -390,7 +390,9 @@ TEST(Forward, CrossingOntoTheOtherAssemblyModeIsReported) {
       ASSERT_EQ(forward_kinematics(model, motor_lengths(model, guess), LengthKind::Motor, placement_from_pose(guess), at_guess),
                 Status::Ok);
       const Status s = forward_kinematics(model, motor_lengths(model, target), LengthKind::Motor, placement_from_pose(guess), r);
-      if (s == Status::Ok) EXPECT_EQ(r.det_sign, at_guess.det_sign) << guess_yaw << " -> " << target_yaw;
+      if (s == Status::Ok) {
+        EXPECT_EQ(r.det_sign, at_guess.det_sign) << guess_yaw << " -> " << target_yaw;
+      }
       if (s != Status::AssemblyModeChanged) continue;
       ++changed;
       EXPECT_EQ(r.det_sign, -at_guess.det_sign);

@@ -192,7 +192,9 @@ TEST(Limits, PureYawTowardsTheSingularityIsRefusedByTheConditionLimit) {
     ASSERT_EQ(inverse_kinematics(model, p, st), Status::Ok);
     double c;
     const Status s = jacobian_condition(model, st, c);
-    if (k > 300) EXPECT_GT(c, previous) << "yaw " << 0.1 * k;  // from 30 deg on it rises towards 90 deg
+    if (k > 300) {  // from 30 deg on it rises towards 90 deg
+      EXPECT_GT(c, previous) << "yaw " << 0.1 * k;
+    }
     previous = c;
     if (k % 50 == 0) std::printf("  yaw %4.1f deg: condition %.4g\n", 0.1 * k, c);
     LimitReport r;

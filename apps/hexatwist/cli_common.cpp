@@ -69,6 +69,14 @@ void write_output_file(const std::string& file, std::string_view content) {
   if (ec) throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}': {}", path.string(), ec.message()));
 }
 
+void write_stdout(std::string_view text) {
+  errno = 0;
+  const bool written = std::fwrite(text.data(), 1, text.size(), stdout) == text.size();
+  if (std::fflush(stdout) != 0 || !written || std::ferror(stdout))
+    throw ExitError(kExitOutputFailed, fmt::format("cannot write to standard output: {}",
+                                                   errno != 0 ? std::strerror(errno) : "write error"));
+}
+
 Model load_model_from(const ModelOptions& opts) {
   try {
     if (opts.config.empty()) return default_model();

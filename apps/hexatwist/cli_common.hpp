@@ -57,6 +57,10 @@ std::string read_text_file(const std::string& path, const std::string& option, c
 /// naming the file if it cannot be written.
 void write_output_file(const std::string& path, std::string_view content);
 
+/// Writes `text` to standard output and flushes it; ExitError(4) if it could not be written whole
+/// (a full disk, a closed pipe).
+void write_stdout(std::string_view text);
+
 /// Name of the platform source for messages.
 std::string model_source(const ModelOptions& opts);
 
@@ -92,5 +96,6 @@ Command make_stream_command(CLI::App& root);
 Command make_synth_command(CLI::App& root);
 Command make_measure_command(CLI::App& root);
 Command make_identify_command(CLI::App& root);
+Command make_linuxcnc_command(CLI::App& root);
 
 }  // namespace hexatwist::cli

@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
   const std::vector<Command> commands{make_study_command(app),   make_simulate_command(app), make_synth_command(app),
                                       make_measure_command(app), make_identify_command(app), make_stream_command(app),   make_ik_command(app),
-                                      make_fk_command(app),      make_config_command(app)};
+                                      make_fk_command(app),      make_config_command(app),   make_linuxcnc_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
       for (const Command& c : commands) chosen = chosen || c.app->get_name() == word;
       if (chosen) break;
       print_error("hexatwist: error: ", fmt::format("unknown subcommand '{}'; expected study, simulate, synth, "
-                                                    "measure, identify, stream, ik, fk or config (see --help)",
+                                                    "measure, identify, stream, ik, fk, config or linuxcnc (see --help)",
                                                     word));
       return kExitBadInput;
     }

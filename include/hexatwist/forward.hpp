@@ -76,4 +76,9 @@ struct FkTracker {
                                                 FkTracker& tracker, FkResult& out,
                                                 const FkOptions& options = {}) noexcept;
 
+/// Sets `tracker` to a known placement (after homing, or as a fallback start) with that
+/// placement's assembly mode for lengths of `kind`. Returns the status of inverse kinematics or of
+/// the Jacobian (SingularJacobian where its determinant is zero); `tracker` is unchanged then.
+[[nodiscard]] Status fk_tracker_set(const Model& model, const Placement& x, LengthKind kind, FkTracker& tracker) noexcept;
+
 }  // namespace hexatwist

@@ -24,3 +24,4 @@
 #include "hexatwist/trajectory.hpp"
 #include "hexatwist/twist.hpp"
 #include "hexatwist/types.hpp"
+#include "hexatwist/workspace.hpp"

@@ -35,4 +35,16 @@ void bend_angles(const Model& model, const LegState& state, Vector6d& bend_base,
 /// Checks that motor-side commands lie inside the stroke [m]; report names the first bad leg.
 [[nodiscard]] Status check_stroke(const Model& model, const Vector6d& command, LimitReport& report) noexcept;
 
+/// The limit a pose is nearest to: over every leg's stroke (either end), U-joint bends and
+/// U-joint singularity margins, and the platform's Jacobian condition, the one with the smallest
+/// share of its range left. `margin` is that share: 1 far from every limit (mid-stroke, no bend,
+/// leg perpendicular to both fixed axes, condition 1), 0 on the limit, negative past it. For
+/// the stroke the range is half the stroke; for a bend, 0 to bend_max; for a singularity margin,
+/// 90 deg down to the margin; for the condition number, its logarithm from 0 to log(max).
+/// `nearest` names the leg (-1 for the condition), the value and the bound as check_limits does.
+/// `condition` is the Jacobian condition number at `state` (jacobian_condition). Not real-time
+/// critical: it takes a few inverse cosines per leg.
+void nearest_limit(const Model& model, const LegState& state, double condition, LimitReport& nearest,
+                   double& margin) noexcept;
+
 }  // namespace hexatwist

@@ -1,0 +1,146 @@
+// hexatwist linuxcnc: a LinuxCNC INI file for a platform driven by the hexatwistkins module, with
+// the numbers a LinuxCNC configuration needs from the kinematics ([TRAJ] HOME, each joint's HOME,
+// HOME_OFFSET and limits, each axis' reach).
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <memory>
+
+#include "cli_common.hpp"
+
+namespace hexatwist::cli {
+namespace {
+
+struct LinuxcncOptions {
+  ModelOptions model;
+  std::string units = "mm";
+  std::string strategy = "compensated";
+  std::string display = "axis";
+  std::string out;
+};
+
+// LinuxCNC's own name of each world coordinate.
+constexpr const char* kAxisNames[6] = {"X", "Y", "Z", "A", "B", "C"};
+
+// Nine decimals: a nanometre of a length in mm, well below what LinuxCNC resolves.
+std::string fixed(double v) { return fmt::format("{:.9f}", tidy(v)); }
+
+std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::string& command_line) {
+  const Model& model = config.rig.model();
+  const double unit = o.units == "mm" ? 1000.0 : o.units == "inch" ? 1.0 / 0.0254 : 1.0;
+  const Strategy strategy = o.strategy == "conventional" ? Strategy::Conventional : Strategy::Compensated;
+  const LimitSpec& lim = model.spec().limits;
+  const double home_z = model.spec().home_height;
+  const Vector6d home_motor = model.length_home() - model.geometry().length_offset;
+
+  std::string kins = "hexatwistkins";
+  if (!o.model.config.empty()) kins += " config=" + std::filesystem::absolute(o.model.config).string();
+  if (o.strategy != "compensated") kins += " strategy=" + o.strategy;
+  if (o.units != "mm") kins += " units=" + o.units;
+
+  // Speeds: the motors' from the servo section, the axes' from the study's motion profile.
+  const ServoSpec& servo = config.rig.servo();
+  const double joint_velocity = servo.max_speed * config.rig.motor_gain().minCoeff();  // [m/s]
+  const StudySpec& study = config.study;
+
+  std::string t = fmt::format(
+      "# LinuxCNC configuration for \"{}\" with the hexatwistkins kinematics module.\n"
+      "# Written by: {}\n"
+      "# Units: X Y Z and the joints in {} (Z is the height of the platform frame above the base frame),\n"
+      "# A B C in degrees (roll, pitch, yaw; R = Rz(C) Ry(B) Rx(A)); joints are motor-side leg lengths.\n"
+      "# Joints are simulated (basic_sim.tcl): for real drives, replace the HALFILE with your own HAL file.\n\n",
+      model.spec().name, command_line, o.units);
+  t += fmt::format(
+      "[EMC]\nVERSION = 1.1\nMACHINE = hexatwist hexapod\n\n"
+      "[DISPLAY]\nDISPLAY = {}\nPOSITION_OFFSET = RELATIVE\nPOSITION_FEEDBACK = ACTUAL\nCYCLE_TIME = 0.100\n\n"
+      "[RS274NGC]\nPARAMETER_FILE = hexatwist.var\n\n"
+      "[EMCMOT]\nEMCMOT = motmod\nCOMM_TIMEOUT = 1.0\nSERVO_PERIOD = 1000000\n\n"
+      "[TASK]\nTASK = milltask\nCYCLE_TIME = 0.010\n\n"
+      "[HAL]\nHALFILE = LIB:basic_sim.tcl -no_use_hal_manualtoolchange -no_simulated_home -no_sim_spindle\n\n"
+      "[EMCIO]\nEMCIO = io\nCYCLE_TIME = 0.100\nTOOL_TABLE = hexatwist.tbl\n\n",
+      o.display);
+  t += fmt::format(
+      "[TRAJ]\nCOORDINATES = X Y Z A B C\nLINEAR_UNITS = {}\nANGULAR_UNITS = degree\n"
+      "# Home: the platform frame at home_height above the base, no rotation.\n"
+      "HOME = 0 0 {} 0 0 0\n"
+      "# Speeds of the configuration's study motion (study.linear, study.angular_deg).\n"
+      "DEFAULT_LINEAR_VELOCITY = {}\nMAX_LINEAR_VELOCITY = {}\nDEFAULT_LINEAR_ACCELERATION = {}\n"
+      "MAX_LINEAR_ACCELERATION = {}\nDEFAULT_ANGULAR_VELOCITY = {}\nMAX_ANGULAR_VELOCITY = {}\n"
+      "DEFAULT_ANGULAR_ACCELERATION = {}\nMAX_ANGULAR_ACCELERATION = {}\n\n",
+      o.units, fixed(home_z * unit), fixed(study.linear.velocity * unit), fixed(study.linear.velocity * unit),
+      fixed(study.linear.acceleration * unit), fixed(study.linear.acceleration * unit),
+      fixed(rad2deg(study.angular.velocity)), fixed(rad2deg(study.angular.velocity)),
+      fixed(rad2deg(study.angular.acceleration)), fixed(rad2deg(study.angular.acceleration)));
+  t += fmt::format("[KINS]\nKINEMATICS = {}\nJOINTS = 6\n\n", kins);
+
+  for (int i = 0; i < kLegs; ++i) {
+    t += fmt::format(
+        "[JOINT_{}]\n# Leg {}: motor-side length. At home {} {}; the stroke limits.length_min .. length_max.\n"
+        "TYPE = LINEAR\nHOME = {}\nHOME_OFFSET = {}\nHOME_SEQUENCE = 0\nMIN_LIMIT = {}\nMAX_LIMIT = {}\n"
+        "# Motor speed limit (servo.max_speed_rpm, lead, gear_ratio); full speed in 0.1 s (not in the config).\n"
+        "MAX_VELOCITY = {}\nMAX_ACCELERATION = {}\n\n",
+        i, i + 1, fixed(home_motor[i] * unit), o.units, fixed(home_motor[i] * unit), fixed(home_motor[i] * unit),
+        fixed(lim.length_min * unit), fixed(lim.length_max * unit), fixed(joint_velocity * unit),
+        fixed(10.0 * joint_velocity * unit));
+  }
+  for (int k = 0; k < 6; ++k) {
+    AxisRange range;
+    if (const Status s = axis_range(model, k, strategy, range); s != Status::Ok)
+      throw ExitError(kExitOutOfLimit, fmt::format("home is outside a limit: {}", describe_limit(range.upper_limit)));
+    const bool linear = k < 3;
+    const double scale = linear ? unit : rad2deg(1.0);
+    const double offset = k == 2 ? home_z * unit : 0.0;
+    const auto end = [&](const LimitReport& r) {
+      return r.status == Status::Ok ? std::string("search bound") : describe_limit(r);
+    };
+    t += fmt::format(
+        "[AXIS_{}]\n# Reach along {} alone from home: below, {}; above, {}.\nMIN_LIMIT = {}\nMAX_LIMIT = {}\n"
+        "MAX_VELOCITY = {}\nMAX_ACCELERATION = {}\n\n",
+        kAxisNames[k], kAxisNames[k], end(range.lower_limit), end(range.upper_limit),
+        fixed(offset + range.lower * scale), fixed(offset + range.upper * scale),
+        fixed((linear ? study.linear.velocity : study.angular.velocity) * scale),
+        fixed((linear ? study.linear.acceleration : study.angular.acceleration) * scale));
+  }
+  return t;
+}
+
+int run_linuxcnc(const LinuxcncOptions& o, const std::string& command_line) {
+  const Config config = load_config_from(o.model);
+  const std::string text = ini_text(o, config, command_line);
+  if (o.out.empty()) {
+    write_stdout(text);
+  } else {
+    write_output_file(o.out, text);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Command make_linuxcnc_command(CLI::App& root) {
+  auto opts = std::make_shared<LinuxcncOptions>();
+  CLI::App* app = root.add_subcommand(
+      "linuxcnc",
+      "A LinuxCNC INI file for the platform with the hexatwistkins kinematics module: [TRAJ] HOME, each "
+      "joint's HOME, HOME_OFFSET and stroke limits, each axis' reach from home (integrations/linuxcnc/README.md)");
+  add_model_options(*app, opts->model);
+  app->add_option("--units", opts->units, "The machine's length unit (LINEAR_UNITS): mm, inch or m")
+      ->check(CLI::IsMember({"mm", "inch", "m"}))
+      ->capture_default_str();
+  app->add_option("--strategy", opts->strategy,
+                  "Motor commands of the module: compensated, or conventional (the twist ignored, for comparisons)")
+      ->check(CLI::IsMember({"compensated", "conventional"}))
+      ->capture_default_str();
+  app->add_option("--display", opts->display, "[DISPLAY] DISPLAY: the user interface program (axis, or a script)")
+      ->capture_default_str();
+  app->add_option("--out", opts->out, "Write the INI file here instead of to standard output");
+  return {app, [opts, app] {
+            std::string line = "hexatwist linuxcnc";
+            for (const CLI::Option* opt : app->get_options())
+              if (opt->count() > 0 && opt->get_name() != "--out" && opt->get_name() != "--help")
+                line += fmt::format(" {}={}", opt->get_name(), opt->as<std::string>());
+            return run_linuxcnc(*opts, line);
+          }};
+}
+
+}  // namespace hexatwist::cli

@@ -1,0 +1,61 @@
+// Internal: what the C API's files share: the opaque model, conversions between C arrays and the
+// library's types, and the guard that keeps C++ exceptions from crossing into C.
+#pragma once
+
+#include <cstring>
+#include <string>
+
+#include "hexatwist/c/hexatwist.h"
+#include "hexatwist/limits.hpp"
+#include "hexatwist/model.hpp"
+#include "hexatwist/pose.hpp"
+#include "hexatwist/status.hpp"
+
+/// The opaque model of the C API: a validated hexatwist::Model and its name as a C string.
+struct hexatwist_model {
+  hexatwist::Model model;
+  std::string name;
+};
+
+namespace hexatwist::c_api {
+
+/// Pose from {x, y, z, roll, pitch, yaw} [m, rad].
+inline Pose to_pose(const double q[6]) noexcept {
+  Pose p;
+  p.position = Vector3d(q[0], q[1], q[2]);
+  p.rpy = Vector3d(q[3], q[4], q[5]);
+  return p;
+}
+
+/// {x, y, z, roll, pitch, yaw} [m, rad] of a pose.
+inline void from_pose(const Pose& p, double q[6]) noexcept {
+  for (int k = 0; k < 3; ++k) {
+    q[k] = p.position[k];
+    q[3 + k] = p.rpy[k];
+  }
+}
+
+inline Vector6d to_vector(const double v[kLegs]) noexcept { return Eigen::Map<const Vector6d>(v); }
+
+inline void from_vector(const Vector6d& v, double out[kLegs]) noexcept { Eigen::Map<Vector6d>{out} = v; }
+
+inline hexatwist_status to_c(Status s) noexcept { return static_cast<hexatwist_status>(static_cast<int>(s)); }
+
+/// The C limit report: legs counted from 1, 0 for a limit of the whole platform.
+inline void from_limit(const LimitReport& r, hexatwist_limit* out) noexcept {
+  if (out == nullptr) return;
+  out->status = to_c(r.status);
+  out->leg = r.leg + 1;
+  out->value = r.value;
+  out->bound = r.bound;
+}
+
+/// Copies `message` into the caller's buffer, truncated and NUL-terminated (nothing if no buffer).
+inline void write_error(const char* message, char* error, std::size_t size) noexcept {
+  if (error == nullptr || size == 0) return;
+  const std::size_t n = std::min(std::strlen(message), size - 1);
+  std::memcpy(error, message, n);
+  error[n] = '\0';
+}
+
+}  // namespace hexatwist::c_api

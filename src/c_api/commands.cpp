@@ -1,0 +1,62 @@
+// C API: motor commands (paper Eq. 1-12), the full command report and the twist; real-time.
+#include "c_api.hpp"
+#include "hexatwist/compensation.hpp"
+#include "hexatwist/twist.hpp"
+
+using namespace hexatwist;
+
+extern "C" {
+
+hexatwist_status hexatwist_motor_commands(const hexatwist_model* model, const double pose[6],
+                                          hexatwist_strategy strategy, double command[HEXATWIST_LEGS],
+                                          hexatwist_limit* limit) {
+  if (model == nullptr || pose == nullptr || command == nullptr ||
+      (strategy != HEXATWIST_CONVENTIONAL && strategy != HEXATWIST_COMPENSATED))
+    return HEXATWIST_INVALID_ARGUMENT;
+  Vector6d cmd;
+  LimitReport report;
+  const Status s = motor_commands(model->model, c_api::to_pose(pose),
+                                  strategy == HEXATWIST_COMPENSATED ? Strategy::Compensated : Strategy::Conventional,
+                                  cmd, report);
+  c_api::from_limit(report, limit);
+  if (s == Status::Ok) c_api::from_vector(cmd, command);
+  return c_api::to_c(s);
+}
+
+hexatwist_status hexatwist_compute_commands(const hexatwist_model* model, const double pose[6],
+                                            hexatwist_command_report* report) {
+  if (model == nullptr || pose == nullptr || report == nullptr) return HEXATWIST_INVALID_ARGUMENT;
+  CommandReport r;
+  const Status s = compute_commands(model->model, c_api::to_pose(pose), r);
+  c_api::from_vector(r.legs.length, report->length);
+  c_api::from_vector(r.twist, report->twist);
+  c_api::from_vector(r.length_error, report->length_error);
+  c_api::from_vector(r.conventional, report->conventional);
+  c_api::from_vector(r.compensated, report->compensated);
+  c_api::from_limit(r.limit, &report->limit);
+  // The condition number and the nearest limit exist wherever inverse kinematics does.
+  double condition = NAN;
+  LimitReport nearest;
+  double margin = NAN;
+  if (s != Status::NonFiniteInput && r.legs.length.allFinite()) {
+    (void)jacobian_condition(model->model, r.legs, condition);  // PlatformSingularity still gives the number
+    nearest_limit(model->model, r.legs, condition, nearest, margin);
+  }
+  report->condition = condition;
+  c_api::from_limit(nearest, &report->nearest);
+  report->nearest_margin = margin;
+  return c_api::to_c(s);
+}
+
+hexatwist_status hexatwist_twist(const hexatwist_model* model, const double pose[6], double twist_out[HEXATWIST_LEGS]) {
+  if (model == nullptr || pose == nullptr || twist_out == nullptr) return HEXATWIST_INVALID_ARGUMENT;
+  LegState legs;
+  if (const Status s = inverse_kinematics(model->model, c_api::to_pose(pose), legs); s != Status::Ok)
+    return c_api::to_c(s);
+  Vector6d dtheta;
+  const Status s = twist(model->model, legs, dtheta);
+  if (s == Status::Ok) c_api::from_vector(dtheta, twist_out);
+  return c_api::to_c(s);
+}
+
+}  // extern "C"
