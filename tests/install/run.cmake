@@ -8,12 +8,16 @@ function(step)
   endif()
   set(step_output "${out}" PARENT_SCOPE)
 endfunction()
-step(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix")
+# The default component: the library, headers, tool and package files. The LinuxCNC module
+# (component linuxcnc) goes to LinuxCNC's own modules folder, outside any prefix.
+step(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix" --component Unspecified)
 step(${CMAKE_COMMAND} -S "${SOURCE_DIR}" -B "${WORK_DIR}/build" -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=Release
      "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix")
 step(${CMAKE_COMMAND} --build "${WORK_DIR}/build")
 step("${WORK_DIR}/build/consumer")
 message(STATUS "consumer: ${step_output}")
+step("${WORK_DIR}/build/consumer_c")
+message(STATUS "consumer_c: ${step_output}")
 step("${WORK_DIR}/prefix/bin/hexatwist" ik --json)
 if(NOT step_output MATCHES "\"status\": \"ok\"")
   message(FATAL_ERROR "installed hexatwist ik did not report ok:\n${step_output}")

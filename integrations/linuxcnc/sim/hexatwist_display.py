@@ -146,12 +146,14 @@ def demo():
     print("hexatwist LinuxCNC demo: home, then a few moves; each line: commanded pose, joints, pose from FK")
     steps = [{"home": True}, {"mdi": "G0 C20"}, {"mdi": "G0 Z1611 A5 B-5 C-20"}, {"mdi": "G0 X0 Y0 Z1511 A0 B0 C0"}]
     pins = ["hexatwistkins.leg.%d.twist" % i for i in range(1, 7)] + ["hexatwistkins.fk-iterations"]
+    def tidy(v):  # rounding-level values as 0, so that the table shows 0.000000, not -0.000000
+        return 0.0 if abs(v) < 5e-7 else v
     for r in run({"steps": steps, "pins": pins}):
         print("%-28s done=%s %s" % (json.dumps(r["step"]), r["done"], "; ".join(r["errors"])))
-        print("   pose   " + " ".join("%11.6f" % v for v in r["position"]))
-        print("   joints " + " ".join("%11.6f" % v for v in r["joint_position"]))
-        print("   FK     " + " ".join("%11.6f" % v for v in r["actual_position"]))
-        print("   twist [deg] " + " ".join("%8.3f" % r["pins"][p] for p in pins[:6]))
+        print("   pose   " + " ".join("%11.6f" % tidy(v) for v in r["position"]))
+        print("   joints " + " ".join("%11.6f" % tidy(v) for v in r["joint_position"]))
+        print("   FK     " + " ".join("%11.6f" % tidy(v) for v in r["actual_position"]))
+        print("   twist [deg] " + " ".join("%8.3f" % tidy(r["pins"][p]) for p in pins[:6]))
 
 
 def main():

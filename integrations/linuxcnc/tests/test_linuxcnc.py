@@ -316,3 +316,15 @@ def test_genhexkins_side_by_side_with_hexatwistkins():
     big = [i for i, yaw in enumerate(yaws) if yaw >= 20]
     assert min(worst["genhexkins +lead"][i] for i in big) > 0.1
     assert min(worst["genhexkins -lead"][i] for i in big) > 0.1
+
+
+def test_sample_configuration_runs_headless():
+    """sim/run.sh, as the README tells a new user to run it: homes and makes its moves."""
+    r = subprocess.run(["bash", os.path.join(os.path.dirname(HERE), "sim", "run.sh")], capture_output=True, text=True,
+                       timeout=120)
+    try:
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+        assert r.stdout.count("done=True") == 4, r.stdout[-3000:]
+        assert "twist [deg]" in r.stdout
+    finally:
+        harness.clean_stale()

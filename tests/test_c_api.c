@@ -1,0 +1,234 @@
+/* The C API (include/hexatwist/c/hexatwist.h), compiled as C99: models, commands against the
+ * report, forward kinematics round trips and tracking, limits, errors, and no allocation in the
+ * real-time calls (malloc interposed: every heap allocation of the process is counted). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hexatwist/c/hexatwist.h"
+
+static int passed = 0, failed = 0;
+
+#define CHECK(cond, ...)                                   \
+  do {                                                     \
+    if (cond) {                                            \
+      ++passed;                                            \
+    } else {                                               \
+      ++failed;                                            \
+      fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond); \
+      fprintf(stderr, __VA_ARGS__);                        \
+      fputc('\n', stderr);                                 \
+    }                                                      \
+  } while (0)
+
+#ifndef HEXATWIST_NO_MALLOC_PROBE
+/* glibc's allocator under its own names; the definitions below replace malloc for the whole
+ * process, the C++ runtime's operator new included. */
+extern void* __libc_malloc(size_t);
+extern void* __libc_calloc(size_t, size_t);
+extern void* __libc_realloc(void*, size_t);
+extern void __libc_free(void*);
+static volatile long allocations = 0;
+void* malloc(size_t n) { ++allocations; return __libc_malloc(n); }
+void* calloc(size_t n, size_t m) { ++allocations; return __libc_calloc(n, m); }
+void* realloc(void* p, size_t n) { ++allocations; return __libc_realloc(p, n); }
+void free(void* p) { __libc_free(p); }
+#define PROBE 1
+#else
+static long allocations = 0;
+#define PROBE 0
+#endif
+
+static double max_abs_diff(const double* a, const double* b, int n) {
+  double worst = 0.0;
+  for (int i = 0; i < n; ++i) worst = fmax(worst, fabs(a[i] - b[i]));
+  return worst;
+}
+
+static const double kDeg = 3.14159265358979323846 / 180.0;
+
+/* A seeded pseudo-random pose inside the seed's test range: +-0.3 m, +-20 deg. */
+static unsigned long long rng_state = 12345;
+static double uniform(double lo, double hi) {
+  rng_state = rng_state * 6364136223846793005ULL + 1442695040888963407ULL;
+  return lo + (hi - lo) * (double)(rng_state >> 11) / 9007199254740992.0;
+}
+static void random_pose(double pose[6]) {
+  for (int k = 0; k < 3; ++k) pose[k] = uniform(-0.3, 0.3);
+  for (int k = 3; k < 6; ++k) pose[k] = uniform(-20, 20) * kDeg;
+}
+
+static void test_models(void) {
+  char error[256];
+  hexatwist_model* m = hexatwist_model_default(error, sizeof error);
+  CHECK(m != NULL, "default model: %s", error);
+  CHECK(strstr(hexatwist_model_name(m), "seed platform") != NULL, "name '%s'", hexatwist_model_name(m));
+  CHECK(fabs(hexatwist_model_home_height(m) - 1.511) < 1e-15, "home height %g", hexatwist_model_home_height(m));
+  double geometric[6], motor[6], lo, hi;
+  hexatwist_model_home_lengths(m, geometric, motor);
+  hexatwist_model_stroke(m, &lo, &hi);
+  CHECK(lo == 1.4 && hi == 2.45, "stroke %g..%g", lo, hi);
+  for (int i = 0; i < 6; ++i) CHECK(geometric[i] > lo && geometric[i] < hi && motor[i] == geometric[i], "leg %d", i + 1);
+  hexatwist_model_free(m);
+  hexatwist_model_free(NULL);
+
+  /* Errors: one line naming the file, line and field, or the path. */
+  m = hexatwist_model_from_yaml("symmetric:\n  Ra: abc\n", "bad.yaml", error, sizeof error);
+  CHECK(m == NULL && strstr(error, "bad.yaml:1:1: field 'screw'") == error && !strchr(error, '\n'), "message '%s'", error);
+  m = hexatwist_model_from_file("/nonexistent/platform.yaml", error, sizeof error);
+  CHECK(m == NULL && strstr(error, "/nonexistent/platform.yaml") && strstr(error, "cannot read"), "message '%s'", error);
+  m = hexatwist_model_from_file(NULL, error, sizeof error);
+  CHECK(m == NULL && strstr(error, "NULL"), "message '%s'", error);
+  char tiny[8];
+  m = hexatwist_model_from_yaml("name: [", "x.yaml", tiny, sizeof tiny);
+  CHECK(m == NULL && strlen(tiny) == sizeof tiny - 1, "truncated to the buffer: '%s'", tiny);
+  m = hexatwist_model_from_yaml("name: x\n", "x.yaml", NULL, 0); /* no buffer: still NULL, no crash */
+  CHECK(m == NULL, "no buffer");
+
+  /* The seed file itself, from disk. */
+  m = hexatwist_model_from_file(HEXATWIST_SOURCE_DIR "/configs/seed.yaml", error, sizeof error);
+  CHECK(m != NULL, "configs/seed.yaml: %s", error);
+  hexatwist_model_free(m);
+}
+
+static void test_commands_and_fk(const hexatwist_model* m) {
+  double worst_round_trip = 0.0;
+  for (int n = 0; n < 500; ++n) {
+    double pose[6], comp[6], conv[6];
+    random_pose(pose);
+    hexatwist_command_report report;
+    hexatwist_limit limit;
+    const hexatwist_status s = hexatwist_compute_commands(m, pose, &report);
+    if (s != HEXATWIST_OK) {
+      CHECK(hexatwist_status_is_limit(s), "pose %d: %s", n, hexatwist_status_name(s));
+      continue;
+    }
+    CHECK(hexatwist_motor_commands(m, pose, HEXATWIST_COMPENSATED, comp, &limit) == HEXATWIST_OK, "pose %d", n);
+    CHECK(hexatwist_motor_commands(m, pose, HEXATWIST_CONVENTIONAL, conv, &limit) == HEXATWIST_OK, "pose %d", n);
+    CHECK(max_abs_diff(comp, report.compensated, 6) < 1e-15, "real-time and full path agree");
+    CHECK(max_abs_diff(conv, report.length, 6) < 1e-15, "conventional = length (zero offsets)");
+    double twist[6];
+    CHECK(hexatwist_twist(m, pose, twist) == HEXATWIST_OK && max_abs_diff(twist, report.twist, 6) == 0.0, "twist");
+    for (int i = 0; i < 6; ++i) {
+      /* Eq. (10)-(12): the length error is lead * twist / 2 pi, and the command subtracts it. */
+      CHECK(fabs(report.length_error[i] - 0.010 * report.twist[i] / (2 * 3.14159265358979323846)) < 1e-15, "Eq. 10");
+      CHECK(fabs(report.length[i] - report.length_error[i] - report.compensated[i]) < 1e-15, "Eq. 12");
+    }
+    CHECK(report.condition >= 1 && report.condition < 50, "condition %g", report.condition);
+    CHECK(report.nearest_margin > 0 && report.nearest_margin <= 1, "margin %g", report.nearest_margin);
+
+    hexatwist_fk_result fk;
+    CHECK(hexatwist_forward_kinematics(m, comp, HEXATWIST_MOTOR, NULL, NULL, &fk) == HEXATWIST_OK, "fk %d", n);
+    worst_round_trip = fmax(worst_round_trip, max_abs_diff(fk.pose, pose, 6));
+    CHECK(fk.residual <= 1e-12 && fk.iterations > 0, "residual %g", fk.residual);
+    CHECK(hexatwist_forward_kinematics(m, report.length, HEXATWIST_GEOMETRIC, pose, NULL, &fk) == HEXATWIST_OK &&
+              max_abs_diff(fk.pose, pose, 6) < 1e-11, "geometric fk from the pose itself");
+  }
+  CHECK(worst_round_trip < 1e-11, "worst round trip %g", worst_round_trip);
+  printf("C API: worst FK round trip %.2g (m, rad)\n", worst_round_trip);
+}
+
+static void test_limits(const hexatwist_model* m) {
+  const double outside[6] = {0, 0, 0.8, 0, 0, 0}; /* legs past their maximum */
+  double command[6] = {-1, -1, -1, -1, -1, -1};
+  hexatwist_limit limit;
+  const hexatwist_status s = hexatwist_motor_commands(m, outside, HEXATWIST_COMPENSATED, command, &limit);
+  CHECK(s == HEXATWIST_STROKE_ABOVE_MAX && limit.status == s && limit.leg >= 1 && limit.leg <= 6, "%s leg %d",
+        hexatwist_status_name(s), limit.leg);
+  CHECK(limit.value > limit.bound && limit.bound == 2.45, "value %g bound %g", limit.value, limit.bound);
+  CHECK(command[0] == -1 && command[5] == -1, "no command written outside a limit");
+  const double nan_pose[6] = {NAN, 0, 0, 0, 0, 0};
+  CHECK(hexatwist_motor_commands(m, nan_pose, HEXATWIST_COMPENSATED, command, NULL) == HEXATWIST_NON_FINITE_INPUT, "NaN");
+  CHECK(hexatwist_motor_commands(NULL, outside, HEXATWIST_COMPENSATED, command, NULL) == HEXATWIST_INVALID_ARGUMENT, "NULL");
+  CHECK(hexatwist_motor_commands(m, outside, (hexatwist_strategy)7, command, NULL) == HEXATWIST_INVALID_ARGUMENT, "enum");
+  CHECK(strcmp(hexatwist_status_name(HEXATWIST_OK), "ok") == 0, "name");
+  CHECK(strcmp(hexatwist_status_name(HEXATWIST_PLATFORM_SINGULARITY), "platform_singularity") == 0, "name");
+  CHECK(strcmp(hexatwist_status_name(HEXATWIST_INVALID_ARGUMENT), "invalid_argument") == 0, "name");
+  CHECK(hexatwist_status_is_limit(HEXATWIST_PLATFORM_SINGULARITY) && !hexatwist_status_is_limit(HEXATWIST_NO_CONVERGENCE),
+        "is_limit");
+  CHECK(strlen(hexatwist_status_describe(HEXATWIST_BEND_BASE)) > 10, "describe");
+}
+
+/* A 1 kHz yaw sweep with the tracker: every step solved on home's assembly mode, and the
+ * tracker reset or set from a pose behaves as documented. */
+static void test_tracking(const hexatwist_model* m) {
+  hexatwist_fk_tracker tracker;
+  memset(&tracker, 0, sizeof tracker);
+  hexatwist_fk_result fk;
+  int ok = 0, steps = 0;
+  double worst = 0.0;
+  for (double yaw = 0; yaw <= 30.0; yaw += 0.015, ++steps) {
+    const double pose[6] = {0.1 * sin(yaw * kDeg), 0, 0.05, 0, 0, yaw * kDeg};
+    double command[6];
+    if (hexatwist_motor_commands(m, pose, HEXATWIST_COMPENSATED, command, NULL) != HEXATWIST_OK) continue;
+    ok += hexatwist_forward_kinematics_tracked(m, command, HEXATWIST_MOTOR, &tracker, NULL, &fk) == HEXATWIST_OK;
+    worst = fmax(worst, max_abs_diff(fk.pose, pose, 6));
+  }
+  CHECK(ok == steps && tracker.valid && worst < 1e-11, "%d of %d tracked, worst %g", ok, steps, worst);
+  hexatwist_fk_tracker_reset(&tracker);
+  CHECK(!tracker.valid, "reset");
+  const double at[6] = {0, 0, 0.05, 0, 0, 10 * kDeg};
+  CHECK(hexatwist_fk_tracker_set(m, &tracker, at, HEXATWIST_MOTOR) == HEXATWIST_OK && tracker.valid &&
+            (tracker.det_sign == 1.0 || tracker.det_sign == -1.0), "set");
+  hexatwist_fk_options options = hexatwist_fk_default_options();
+  CHECK(options.max_iterations > 0 && options.tolerance > 0 && options.max_step_translation > 0, "options");
+  options.max_iterations = 0; /* no iteration allowed: the far solve must fail, and say so */
+  double command[6];
+  const double far[6] = {0.2, -0.2, 0.1, 0.1, 0.1, 0.3};
+  CHECK(hexatwist_motor_commands(m, far, HEXATWIST_COMPENSATED, command, NULL) == HEXATWIST_OK, "far pose");
+  const hexatwist_fk_tracker before = tracker;
+  CHECK(hexatwist_forward_kinematics_tracked(m, command, HEXATWIST_MOTOR, &tracker, &options, &fk) ==
+            HEXATWIST_NO_CONVERGENCE && memcmp(&before, &tracker, sizeof tracker) == 0,
+        "a failed tracked solve leaves the tracker as it was");
+}
+
+static void test_no_allocation(const hexatwist_model* m) {
+  if (!PROBE) return;
+  char error[64];
+  const long probe_before = allocations;
+  hexatwist_model* other = hexatwist_model_default(error, sizeof error);
+  CHECK(allocations > probe_before, "the probe sees the model's allocations");
+  hexatwist_model_free(other);
+
+  hexatwist_fk_tracker tracker;
+  memset(&tracker, 0, sizeof tracker);
+  const long before = allocations;
+  int calls = 0;
+  for (int n = 0; n < 200; ++n) {
+    double pose[6], command[6], twist[6];
+    random_pose(pose);
+    if (n % 4 == 0) pose[2] = 1.0; /* outside a limit */
+    hexatwist_command_report report;
+    hexatwist_fk_result fk;
+    hexatwist_limit limit;
+    (void)hexatwist_compute_commands(m, pose, &report);
+    (void)hexatwist_twist(m, pose, twist);
+    if (hexatwist_motor_commands(m, pose, HEXATWIST_COMPENSATED, command, &limit) == HEXATWIST_OK) {
+      (void)hexatwist_forward_kinematics(m, command, HEXATWIST_MOTOR, NULL, NULL, &fk);
+      (void)hexatwist_forward_kinematics_tracked(m, command, HEXATWIST_MOTOR, &tracker, NULL, &fk);
+      (void)hexatwist_fk_tracker_set(m, &tracker, pose, HEXATWIST_MOTOR);
+      ++calls;
+    }
+    (void)hexatwist_status_name(hexatwist_status_is_limit(limit.status) ? limit.status : HEXATWIST_OK);
+  }
+  CHECK(allocations == before, "%ld allocations in the real-time calls", allocations - before);
+  CHECK(calls > 60, "the success path was exercised (%d)", calls);
+}
+
+int main(void) {
+  char error[256];
+  test_models();
+  hexatwist_model* m = hexatwist_model_default(error, sizeof error);
+  if (!m) {
+    fprintf(stderr, "no default model: %s\n", error);
+    return 1;
+  }
+  test_commands_and_fk(m);
+  test_limits(m);
+  test_tracking(m);
+  test_no_allocation(m);
+  hexatwist_model_free(m);
+  printf("%d passed, %d failed\n", passed, failed);
+  return failed == 0 ? 0 : 1;
+}
