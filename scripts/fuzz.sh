@@ -22,7 +22,7 @@ if [ ${#targets[@]} -eq 0 ]; then
   done
 fi
 
-cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang++ -DHEXATWIST_FUZZ=ON \
+cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DHEXATWIST_FUZZ=ON \
   -DHEXATWIST_BUILD_APPS=OFF -DHEXATWIST_BUILD_TESTS=OFF -DHEXATWIST_BUILD_BENCHMARKS=OFF \
   -DHEXATWIST_BUILD_EXAMPLES=OFF >/dev/null
 cmake --build build-fuzz -- -j2

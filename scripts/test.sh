@@ -26,7 +26,7 @@ if [ ! -f build-asan/build.ninja ]; then
 fi
 # Without AVX-512, so that this build runs the leg kernels in their two-packet form (src/lanes.hpp)
 # where the Release build, on a CPU with AVX-512, runs the one-packet form.
-cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang++ -DHEXATWIST_SANITIZE=ON \
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DHEXATWIST_SANITIZE=ON \
   -DHEXATWIST_BUILD_BENCHMARKS=OFF -DCMAKE_CXX_FLAGS=-mno-avx512f >/dev/null
 env "${sanitizer_env[@]}" cmake --build build-asan -- -j2
 env "${sanitizer_env[@]}" ctest --test-dir build-asan --output-on-failure -j2
