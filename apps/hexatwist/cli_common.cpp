@@ -162,6 +162,9 @@ std::string describe_limit(const LimitReport& r) {
     case Status::TorqueAboveMax:
       return fmt::format("{}holding the load takes {:.2f} N m, above the motor's limit {:.2f} N m (servo.torque_limit)",
                          leg, r.value, r.bound);
+    case Status::PlatformSingularity:
+      return fmt::format("the platform is near a singularity: the Jacobian's condition number {:.4g} is above the limit "
+                         "{:.4g} (limits.jacobian_condition_max)", r.value, r.bound);
     default:
       return leg + std::string(describe(r.status));
   }
@@ -173,7 +176,8 @@ void write_limit_json(JsonWriter& json, const LimitReport& r) {
     return;
   }
   json.begin_object().field("status", to_string(r.status));
-  if (r.leg >= 0) json.field("leg", r.leg + 1).field("value", r.value).field("bound", r.bound);
+  if (r.leg >= 0) json.field("leg", r.leg + 1);
+  if (r.leg >= 0 || r.status == Status::PlatformSingularity) json.field("value", r.value).field("bound", r.bound);
   json.field("message", describe_limit(r)).end_object();
 }
 

@@ -62,7 +62,8 @@ int run_config(const ConfigOptions& o) {
     j.key("pivot").vector(spec.pivot_P);
     j.key("observation_point").vector(spec.observation_P);
     j.key("limits").begin_object().field("length_min", lim.length_min).field("length_max", lim.length_max);
-    j.field("bend_max", lim.bend_max).field("singularity_margin", lim.singularity_margin).end_object();
+    j.field("bend_max", lim.bend_max).field("singularity_margin", lim.singularity_margin);
+    j.field("jacobian_condition_max", lim.jacobian_condition_max).end_object();
     j.key("legs").begin_array(true);
     for (int i = 0; i < kLegs; ++i) {
       const Leg& l = model.leg(i);
@@ -107,8 +108,10 @@ int run_config(const ConfigOptions& o) {
   std::string out = fmt::format("platform: {}\nsource: {}\n", spec.name, model_source(o.model));
   out += fmt::format("home height: {:.6f} m; pivot {} m [P]; observation point {} m [P]\n", spec.home_height,
                      v3(spec.pivot_P), v3(spec.observation_P));
-  out += fmt::format("limits: length {:.4f} .. {:.4f} m, U-joint bend <= {:.2f} deg, singularity margin {:.2f} deg\n",
-                     lim.length_min, lim.length_max, rad2deg(lim.bend_max), rad2deg(lim.singularity_margin));
+  out += fmt::format("limits: length {:.4f} .. {:.4f} m, U-joint bend <= {:.2f} deg, singularity margin {:.2f} deg, "
+                     "Jacobian condition <= {:.4g}\n",
+                     lim.length_min, lim.length_max, rad2deg(lim.bend_max), rad2deg(lim.singularity_margin),
+                     lim.jacobian_condition_max);
   for (int i = 0; i < kLegs; ++i) {
     const Leg& l = model.leg(i);
     out += fmt::format("leg {}:\n  base joint      {} m [B]\n  platform joint  {} m [P]\n", i + 1, v3(l.base_B),
