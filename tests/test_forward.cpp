@@ -434,3 +434,42 @@ TEST(Forward, HomeLengthsGiveHomeWithoutIterating) {
 
 }  // namespace
 }  // namespace hexatwist::test
+
+namespace hexatwist::test {
+namespace {
+
+// A tracker set at a pose starts the next tracked solve there, on that pose's assembly mode.
+TEST(Forward, ATrackerSetAtAPoseTracksFromThere) {
+  const Model& model = seed_model();
+  std::mt19937_64 rng(kSeed + 80);
+  for (int n = 0; n < 200; ++n) {
+    const Pose p = random_valid_pose(model, rng, 0.4, deg2rad(25));
+    FkTracker tracker;
+    ASSERT_EQ(fk_tracker_set(model, placement_from_pose(p), LengthKind::Motor, tracker), Status::Ok);
+    ASSERT_TRUE(tracker.valid);
+    // Its mode is the one forward kinematics finds at that pose.
+    FkResult at;
+    ASSERT_EQ(forward_kinematics(model, lengths_for(model, placement_from_pose(p), LengthKind::Motor), LengthKind::Motor,
+                                 placement_from_pose(p), at),
+              Status::Ok);
+    EXPECT_EQ(tracker.det_sign, at.det_sign);
+    // A pose 1 ms of fast motion away is found from there in few iterations.
+    Pose q = p;
+    q.position.x() += 5e-4;
+    q.rpy.z() += 1e-3;
+    FkResult r;
+    ASSERT_EQ(forward_kinematics_tracked(model, lengths_for(model, placement_from_pose(q), LengthKind::Motor),
+                                         LengthKind::Motor, tracker, r),
+              Status::Ok);
+    EXPECT_LE(r.iterations, 3);
+    EXPECT_LT(pose_error(r.placement, placement_from_pose(q)).position, kRoundTripTol);
+  }
+  FkTracker untouched;
+  Pose bad;
+  bad.position.x() = NAN;
+  EXPECT_EQ(fk_tracker_set(model, placement_from_pose(bad), LengthKind::Motor, untouched), Status::NonFiniteInput);
+  EXPECT_FALSE(untouched.valid);
+}
+
+}  // namespace
+}  // namespace hexatwist::test

@@ -232,3 +232,66 @@ TEST(Limits, ModelRefusesAHomeBeyondTheConditionLimit) {
 
 }  // namespace
 }  // namespace hexatwist::test
+
+namespace hexatwist::test {
+namespace {
+
+// nearest_limit's margin says the same as check_limits: positive inside every limit, not positive
+// outside one (poses on both sides, across the seed's workspace and past it).
+TEST(Limits, NearestLimitMarginIsPositiveExactlyWhenThePoseIsInsideEveryLimit) {
+  const Model& model = seed_model();
+  std::mt19937_64 rng(kSeed + 70);
+  int inside = 0, outside = 0;
+  for (int n = 0; n < 20000; ++n) {
+    const Pose p = n % 2 ? random_pose(rng, 0.3, deg2rad(20)) : random_pose(rng, 0.7, deg2rad(45));
+    LegState st;
+    ASSERT_EQ(inverse_kinematics(model, p, st), Status::Ok);
+    double condition;
+    (void)jacobian_condition(model, st, condition);
+    LimitReport nearest, check;
+    double margin;
+    nearest_limit(model, st, condition, nearest, margin);
+    if (std::abs(margin) < 1e-9) continue;  // on a limit to rounding: either answer is right
+    const bool ok = check_limits(model, st, check) == Status::Ok;
+    ASSERT_EQ(margin > 0, ok) << str(p) << " margin " << margin << " nearest " << to_string(nearest.status);
+    ASSERT_TRUE(is_limit(nearest.status)) << str(p);
+    ASSERT_LE(margin, 1.0);
+    (ok ? inside : outside) += 1;
+  }
+  EXPECT_GT(inside, 1000);
+  EXPECT_GT(outside, 1000);
+}
+
+TEST(Limits, NearestLimitOnTheEdgeOfTheReachIsTheLimitMetThereWithMarginZero) {
+  const Model& model = seed_model();
+  for (int k = 0; k < 6; ++k) {
+    AxisRange range;
+    ASSERT_EQ(axis_range(model, k, Strategy::Compensated, range), Status::Ok);
+    Vector6d q = Vector6d::Zero();
+    q[k] = range.upper;
+    LegState st;
+    ASSERT_EQ(inverse_kinematics(model, Pose::from_vector(q), st), Status::Ok);
+    double condition, margin;
+    LimitReport nearest;
+    (void)jacobian_condition(model, st, condition);
+    nearest_limit(model, st, condition, nearest, margin);
+    // The reach ends on a limit of the motor-side command or of the pose; the stroke of the
+    // command differs from the pose's by the twist term, so allow its size in the margin.
+    EXPECT_NEAR(margin, 0.0, 0.01) << "coordinate " << k;
+    if (range.upper_limit.status != Status::StrokeAboveMax && range.upper_limit.status != Status::StrokeBelowMin) {
+      EXPECT_EQ(nearest.status, range.upper_limit.status) << k;
+      EXPECT_EQ(nearest.leg, range.upper_limit.leg) << k;
+    }
+  }
+  // Home is far from every limit.
+  LegState home;
+  ASSERT_EQ(inverse_kinematics(model, Placement{}, home), Status::Ok);
+  double condition, margin;
+  LimitReport nearest;
+  ASSERT_EQ(jacobian_condition(model, home, condition), Status::Ok);
+  nearest_limit(model, home, condition, nearest, margin);
+  EXPECT_GT(margin, 0.3);
+}
+
+}  // namespace
+}  // namespace hexatwist::test
