@@ -101,7 +101,11 @@ def module_installed():
     so = os.environ.get("HEXATWISTKINS_SO")
     if not so:
         pytest.fail("HEXATWISTKINS_SO is not set: run these tests through ctest")
-    harness.install_module(so)
+    try:
+        harness.install_module(so)
+    except PermissionError as e:
+        pytest.fail("copying the module where LinuxCNC loads it needs root (%s): run the tests as root, or install "
+                    "this build first: sudo cmake --install build --component linuxcnc" % e)
     os.makedirs(OUT, exist_ok=True)
 
 
