@@ -80,9 +80,23 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
     out.residual = f.cwiseAbs().maxCoeff();
     if (out.residual <= options.tolerance) {
       out.pose = pose_from_placement(x);
-      // The assembly mode at the solution, against the guess's (theory §5).
-      if (const Status s = length_jacobian(model, *legs, kind, J); s != Status::Ok) return finish(s);
-      out.condition = detail::scaled_condition(J, model.condition_length(), out.det_sign);
+      // The assembly mode and condition at the solution (theory §5), taken from the factors of the
+      // last Newton step's Jacobian: that iterate lies one step (|J^-1 f|, f the residual before
+      // the step) from the solution, so the condition differs from the solution's by a relative
+      // O(condition * step / condition_length) -- about 1e-8 from a warm start -- and the sign of
+      // det J cannot differ unless J is singular within that step, which a condition below half the
+      // limit rules out. Nearer the limit, or with no step taken, the Jacobian is formed at the
+      // solution, so that which poses pass the limit is decided exactly as before.
+      const double bound = model.spec().limits.jacobian_condition_max;
+      if (out.iterations > 0) {
+        out.det_sign = detail::lu6_det_sign(lu);
+        out.condition = detail::lu6_scaled_condition(lu, J.cwiseAbs().colwise().sum().transpose(),
+                                                     1.0 / model.condition_length());
+      }
+      if (out.iterations == 0 || !(out.condition <= 0.5 * bound)) {
+        if (const Status s = length_jacobian(model, *legs, kind, J); s != Status::Ok) return finish(s);
+        out.condition = detail::scaled_condition(J, model.condition_length(), out.det_sign);
+      }
       if (det_sign_guess == 0.0) det_sign_guess = out.det_sign;  // no step taken: the guess is the solution
       return finish(out.det_sign == det_sign_guess ? Status::Ok : Status::AssemblyModeChanged);
     }

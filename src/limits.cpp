@@ -37,6 +37,20 @@ Status jacobian_condition(const Model& model, const LegState& state, double& con
   return condition <= model.spec().limits.jacobian_condition_max ? Status::Ok : Status::PlatformSingularity;
 }
 
+namespace detail {
+
+bool condition_proven_within(const Model& model, const LegState& state) noexcept {
+  Matrix6d J;
+  if (model.has_twist()) {
+    if (motor_length_jacobian(model, state, J) != Status::Ok) return false;
+  } else {
+    length_jacobian(state, J);
+  }
+  return scaled_condition_below(J, model.condition_length(), model.spec().limits.jacobian_condition_max);
+}
+
+}  // namespace detail
+
 void bend_angles(const Model& model, const LegState& state, Vector6d& bend_base, Vector6d& bend_platform) noexcept {
   for (int i = 0; i < kLegs; ++i) {
     const Vector3d s = state.s_B.row(i).transpose();
@@ -66,6 +80,8 @@ Status check_limits(const Model& model, const LegState& state, LimitReport& r) n
     ok &= detail::within_limits(model, terms[k]);
   }
   if (detail::all_lanes(ok)) {
+    // Most poses are far inside the condition limit: prove that cheaply, else compute it exactly.
+    if (detail::condition_proven_within(model, state)) return Status::Ok;
     double condition;
     if (const Status st = jacobian_condition(model, state, condition); st != Status::Ok)
       return report_violation(r, st, -1, condition, lim.jacobian_condition_max);

@@ -9,6 +9,7 @@
 
 #include <bit>
 #include <cstdint>
+#include <cstdio>
 #include <random>
 
 namespace hexatwist::detail {
@@ -139,6 +140,36 @@ TEST(LinearSolve, ReportsSingularAndNearSingularMatrices) {
   const Vector6d c = (Vector6d() << -3, 0, 2, 7, 1, 1).finished();
   lu6_solve(lu, c, x);
   EXPECT_LT((P * x - c).norm(), 1e-14);
+}
+
+TEST(LinearSolve, CheapConditionProofNeverAcceptsAboveTheExactCondition) {
+  // scaled_condition_below may only say yes where scaled_condition is within the bound: never
+  // just below the exact number, and almost always at twice it (its slack is tiny), over
+  // matrices from well to badly conditioned (1 to 1e8), singular ones included.
+  std::mt19937_64 rng(12345);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), scale(-8.0, 0.0), len(0.3, 3.0);
+  int proven = 0, total = 0;
+  for (int n = 0; n < 20000; ++n) {
+    Matrix6d J;
+    for (int i = 0; i < 36; ++i) J(i) = u(rng);
+    // Shrink one direction to set the condition; every 100th matrix exactly singular.
+    const Vector6d v = Vector6d::NullaryExpr([&] { return u(rng); }).normalized();
+    J -= (1.0 - (n % 100 == 0 ? 0.0 : std::pow(10.0, scale(rng)))) * (J * v) * v.transpose();
+    const double length = len(rng);
+    double sign;
+    const double exact = scaled_condition(J, length, sign);
+    if (!std::isfinite(exact)) {
+      EXPECT_FALSE(scaled_condition_below(J, length, 1e300)) << J;
+      continue;
+    }
+    EXPECT_FALSE(scaled_condition_below(J, length, exact * (1.0 - 1e-9))) << exact << "\n" << J;
+    if (exact < 1e6) {
+      ++total;
+      proven += scaled_condition_below(J, length, 2.0 * exact);
+    }
+  }
+  std::printf("  proven within twice the exact condition: %d of %d\n", proven, total);
+  EXPECT_GE(proven, total * 99 / 100);
 }
 
 }  // namespace
