@@ -10,9 +10,9 @@ py::dict commands_batch(const Model& model, const py::object& poses_in, const st
   const Rows6 poses = rows6(poses_in, "poses");
   const std::size_t n = poses.rows;
   auto commands = new_rows(n, 6, poses.single);
-  auto status = new_column<std::int8_t>(n);
-  auto leg = new_column<std::int8_t>(n);
-  auto value = new_column<double>(n), bound = new_column<double>(n);
+  auto status = new_column<std::int8_t>(n, poses.single);
+  auto leg = new_column<std::int8_t>(n, poses.single);
+  auto value = new_column<double>(n, poses.single), bound = new_column<double>(n, poses.single);
   double *pc = commands.mutable_data(), *pv = value.mutable_data(), *pb = bound.mutable_data();
   std::int8_t *ps = status.mutable_data(), *pg = leg.mutable_data();
   const double* q = poses.data;

@@ -39,9 +39,10 @@ Rows6 rows6(const py::handle& obj, const char* name, bool allow_single = true);
 
 /// A new C-contiguous float64 array of shape (n, cols), or (cols,) when `single` (n must be 1).
 py::array_t<double> new_rows(std::size_t n, std::size_t cols, bool single);
-/// A new 1-D array of n elements, or a 0-d array when `single`.
+/// A new 1-D array of n elements, or a 0-d array when `single` (one pose given as (6,)).
 template <class T>
-py::array_t<T> new_column(std::size_t n) {
+py::array_t<T> new_column(std::size_t n, bool single) {
+  if (single) return py::array_t<T>(std::vector<py::ssize_t>{});
   return py::array_t<T>(static_cast<py::ssize_t>(n));
 }
 

@@ -54,7 +54,7 @@ Rows6 rows6(const py::handle& obj, const char* name, bool allow_single) {
   } else {
     r.array = py::reinterpret_borrow<py::array>(obj);
   }
-  if (!r.array.dtype().is(py::dtype::of<double>()))
+  if (!py::isinstance<py::array_t<double>>(r.array))
     raise_dtype(std::string(name) + ": expected dtype float64, got " + std::string(py::str(r.array.dtype())));
   const bool one = r.array.ndim() == 1 && r.array.shape(0) == 6;
   if (!(r.array.ndim() == 2 && r.array.shape(1) == 6) && !(allow_single && one))

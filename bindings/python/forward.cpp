@@ -27,9 +27,9 @@ py::dict fk_batch(const Model& model, const py::object& lengths_in, const std::s
   options.max_iterations = max_iterations;
   options.tolerance = tolerance;
   auto poses = new_rows(n, 6, lengths.single);
-  auto status = new_column<std::int8_t>(n);
-  auto iterations = new_column<std::int32_t>(n);
-  auto residual = new_column<double>(n);
+  auto status = new_column<std::int8_t>(n, lengths.single);
+  auto iterations = new_column<std::int32_t>(n, lengths.single);
+  auto residual = new_column<double>(n, lengths.single);
   double *pq = poses.mutable_data(), *pr = residual.mutable_data();
   std::int8_t* ps = status.mutable_data();
   std::int32_t* pi = iterations.mutable_data();

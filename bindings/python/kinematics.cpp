@@ -12,7 +12,7 @@ py::dict ik_batch(const Model& model, const py::object& poses_in) {
   py::array_t<double> axes = poses.single ? py::array_t<double>({6, 3})
                                           : py::array_t<double>({static_cast<py::ssize_t>(n), py::ssize_t{6}, py::ssize_t{3}});
   auto bend_base = new_rows(n, 6, poses.single), bend_platform = new_rows(n, 6, poses.single);
-  auto status = new_column<std::int8_t>(n);
+  auto status = new_column<std::int8_t>(n, poses.single);
   double *pl = lengths.mutable_data(), *pa = axes.mutable_data(), *pb = bend_base.mutable_data(),
          *pp = bend_platform.mutable_data();
   std::int8_t* ps = status.mutable_data();
@@ -51,7 +51,7 @@ py::dict twist_batch(const Model& model, const py::object& poses_in) {
   const Rows6 poses = rows6(poses_in, "poses");
   const std::size_t n = poses.rows;
   auto tw = new_rows(n, 6, poses.single), err = new_rows(n, 6, poses.single);
-  auto status = new_column<std::int8_t>(n);
+  auto status = new_column<std::int8_t>(n, poses.single);
   double *pt = tw.mutable_data(), *pe = err.mutable_data();
   std::int8_t* ps = status.mutable_data();
   const double* q = poses.data;

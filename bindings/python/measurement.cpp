@@ -20,7 +20,7 @@ py::array_t<double> vec(const double* x, std::size_t n) { return py::array_t<dou
 
 // (K, C) float64 array, C-contiguous (a copy otherwise, counted).
 const double* rows_of(const py::array& a, std::size_t cols, const char* name, std::size_t& n) {
-  if (!a.dtype().is(py::dtype::of<double>())) raise_input(std::string(name) + ": expected dtype float64");
+  if (!py::isinstance<py::array_t<double>>(a)) raise_input(std::string(name) + ": expected dtype float64");
   if (a.ndim() != 2 || a.shape(1) != static_cast<py::ssize_t>(cols))
     raise_input(std::string(name) + ": expected shape (K, " + std::to_string(cols) + ")");
   if (!(a.flags() & py::array::c_style)) raise_input(std::string(name) + ": expected a C-contiguous array");
@@ -45,7 +45,7 @@ py::dict point_log(const py::object& src, const std::string& time_column, double
 
 TimedPoses timed(const py::array& t, const py::array& poses) {
   std::size_t nt = 0, np = 0;
-  if (!t.dtype().is(py::dtype::of<double>()) || t.ndim() != 1) raise_input("t: expected a 1-D float64 array [s]");
+  if (!py::isinstance<py::array_t<double>>(t) || t.ndim() != 1) raise_input("t: expected a 1-D float64 array [s]");
   const Rows6 q = rows6(poses, "poses", false);
   nt = static_cast<std::size_t>(t.shape(0));
   np = q.rows;
@@ -85,7 +85,7 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
   const TimedPoses tp = timed(t, poses);
   PointLog log;
   std::size_t ns = 0, np = 0;
-  if (!stamps.dtype().is(py::dtype::of<double>()) || stamps.ndim() != 1) raise_input("stamps: expected a 1-D float64 array [s]");
+  if (!py::isinstance<py::array_t<double>>(stamps) || stamps.ndim() != 1) raise_input("stamps: expected a 1-D float64 array [s]");
   const double* p = rows_of(points, 3, "points", np);
   ns = static_cast<std::size_t>(stamps.shape(0));
   if (ns != np) raise_input("stamps and points: expected as many stamps as points");
