@@ -12,6 +12,11 @@ std::atomic<std::uint64_t>& input_copies() noexcept {
   return count;
 }
 
+std::atomic<unsigned>& thread_setting() noexcept {
+  static std::atomic<unsigned> n{0};
+  return n;
+}
+
 Errors& errors() {
   static Errors e;
   return e;
@@ -134,6 +139,14 @@ void expose_errors(py::module_& m) {
     if (s < 0 || s > static_cast<int>(Status::AssemblyModeChanged)) raise_input("status: no status " + std::to_string(s));
     return std::string(describe(static_cast<Status>(s)));
   }, py::arg("status"), "One-sentence description of a status code.");
+  m.def("set_num_threads", [](int n) {
+    if (n < 0) raise_input("set_num_threads: expected a count >= 0 (0 = every core)");
+    thread_setting() = static_cast<unsigned>(n);
+  }, py::arg("n"), "Threads of the batch functions (0, the default: every core). Results do not depend on it.");
+  m.def("get_num_threads", [] {
+    const unsigned s = thread_setting().load();
+    return s ? s : std::max(1u, std::thread::hardware_concurrency());
+  }, "Threads the batch functions use.");
   m.def("_input_copies", [] { return input_copies().load(); },
         "Debug counter: inputs the bindings had to copy (never a C-contiguous float64 array).");
 }

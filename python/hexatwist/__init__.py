@@ -28,6 +28,8 @@ from ._hexatwist import (  # noqa: F401  (re-exported)
     control_period,
     default_model,
     describe_status,
+    get_num_threads,
+    set_num_threads,
     load_model,
     motor_command,
     seed_config_yaml,
@@ -41,7 +43,7 @@ __all__ = [
     "Model", "Stream", "default_model", "load_model", "seed_config_yaml", "control_period", "study_trajectory",
     "inverse_kinematics", "twist", "length_error", "commands", "motor_command", "forward",
     "simulate", "study", "read_point_log", "measured_test", "observations_at_rest", "identify",
-    "map_batch", "map_simulations", "describe_status",
+    "map_batch", "map_simulations", "describe_status", "set_num_threads", "get_num_threads",
 ]
 
 Status = enum.IntEnum("Status", [(name.upper(), code) for code, name in enumerate(STATUS_NAMES)])
