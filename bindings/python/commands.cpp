@@ -46,25 +46,23 @@ py::dict commands_batch(const Model& model, const py::object& poses_in, const st
 py::array_t<double> motor_command(const Model& model, const py::object& pose_in, const std::string& strategy_name) {
   const Strategy strategy = strategy_from(strategy_name);
   Pose pose;
-  if (py::isinstance<py::array>(pose_in)) {
-    const Rows6 r = rows6(pose_in, "pose");
-    if (!r.single) raise_input("pose: expected shape (6,) for one pose; use commands() for (N, 6)");
-    pose = pose_row(r.data, 0);
-  } else {
-    py::sequence seq;
-    if (!py::isinstance<py::sequence>(pose_in) || py::len(pose_in) != 6)
+  if (PyList_Check(pose_in.ptr()) || PyTuple_Check(pose_in.ptr())) {
+    // Lists and tuples of six numbers read directly: the cheapest path from Python.
+    if (PySequence_Fast_GET_SIZE(pose_in.ptr()) != 6)
       raise_input("pose: expected 6 numbers x, y, z [m], roll, pitch, yaw [rad]");
-    seq = py::reinterpret_borrow<py::sequence>(pose_in);
     double q[6];
     for (int k = 0; k < 6; ++k) {
-      PyObject* item = PySequence_Fast_GET_ITEM(seq.ptr(), k);
-      q[k] = PyFloat_AsDouble(item);
+      q[k] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(pose_in.ptr(), k));
       if (q[k] == -1.0 && PyErr_Occurred()) {
         PyErr_Clear();
         raise_input("pose: field " + std::to_string(k) + " is not a number");
       }
     }
     pose = pose_row(q, 0);
+  } else {
+    const Rows6 r = rows6(pose_in, "pose");
+    if (!r.single) raise_input("pose: expected 6 numbers x, y, z [m], roll, pitch, yaw [rad]; use commands() for (N, 6)");
+    pose = pose_row(r.data, 0);
   }
   Vector6d c;
   LimitReport r;

@@ -23,10 +23,10 @@ py::array_t<double> rows3(const PerLeg<LegSpec>& legs, Vector3d LegSpec::*field)
   return a;
 }
 
-py::array_t<double> vec(const Eigen::VectorXd& x) {
-  py::array_t<double> a(x.size());
-  for (Eigen::Index i = 0; i < x.size(); ++i) a.mutable_data()[i] = x[i];
-  return a;
+// A copy of a fixed-size vector (no conversion to a dynamic one: GCC 12 then flags Eigen's AVX-512 loads).
+template <class V>
+py::array_t<double> vec(const V& x) {
+  return py::array_t<double>(static_cast<py::ssize_t>(x.size()), x.data());
 }
 
 // A (6, 3) float64 array argument (copied: a model is built once).

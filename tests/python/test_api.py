@@ -86,6 +86,8 @@ BAD = [
     ("status", lambda m: hexatwist.motor_command(m, [0, 0, 2.0, 0, 0, 0]), hexatwist.StatusError, "stroke_above_max"),
     ("single nan", lambda m: hexatwist.motor_command(m, [0, 0, np.nan, 0, 0, 0]), ValueError, "NaN"),
     ("single short", lambda m: hexatwist.motor_command(m, [0, 0, 0]), ValueError, "6 numbers"),
+    ("single 2-d", lambda m: hexatwist.motor_command(m, np.zeros((2, 6))), ValueError, "commands()"),
+    ("single text", lambda m: hexatwist.motor_command(m, (0, 0, "z", 0, 0, 0)), ValueError, "field 2"),
     ("stream", lambda m: hexatwist.Stream(m, max_velocity=-1), ValueError, "max_velocity"),
     ("map_batch", lambda m: hexatwist.map_batch("nope", m, np.zeros((2, 6))), ValueError, "unknown function"),
 ]
