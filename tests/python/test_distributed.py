@@ -38,11 +38,12 @@ def client(tmp_path_factory):
                                       start_new_session=True, cwd=log))
 
     try:
-        start(["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+        start(["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard",
+               "--idle-timeout", "120s"],  # and should pytest itself be killed, the cluster still ends
               "scheduler")
         for i in range(2):
             start(["distributed.cli.dask_worker", address, "--host", "127.0.0.1", "--nthreads", "1",
-                   "--no-dashboard", "--memory-limit", "0", "--name", f"w{i}"], f"worker{i}")
+                   "--no-dashboard", "--memory-limit", "0", "--name", f"w{i}", "--death-timeout", "30"], f"worker{i}")
         c = distributed.Client(address, timeout=60)
         c.wait_for_workers(2, timeout=60)
         yield c
