@@ -12,7 +12,9 @@ packages=(
   gnuplot-nox                                       # figures
   clang libclang-rt-dev                             # fuzzing and sanitizer builds (libFuzzer, ASan, UBSan)
   linuxcnc-uspace linuxcnc-uspace-dev               # the LinuxCNC kinematics module and its tests (LinuxCNC 2.9)
-  python3-pytest                                    # the tests that drive LinuxCNC (Debian's python3)
+  python3-pytest                                    # the tests that drive LinuxCNC and the Python package (Debian's python3)
+  pybind11-dev python3-pybind11 python3-dev python3-numpy  # the Python package (bindings/python)
+  python3-matplotlib python3-dask python3-distributed     # its examples and the Dask helper
 )
 
 missing=()

@@ -1,0 +1,89 @@
+// Motor-side commands (Eq. 11-12) over (N, 6) poses with a per-pose status and limit report, and
+// the one-pose real-time call.
+#include "common.hpp"
+
+namespace hexatwist::python {
+namespace {
+
+py::dict commands_batch(const Model& model, const py::object& poses_in, const std::string& strategy_name) {
+  const Strategy strategy = strategy_from(strategy_name);
+  const Rows6 poses = rows6(poses_in, "poses");
+  const std::size_t n = poses.rows;
+  auto commands = new_rows(n, 6, poses.single);
+  auto status = new_column<std::int8_t>(n, poses.single);
+  auto leg = new_column<std::int8_t>(n, poses.single);
+  auto value = new_column<double>(n, poses.single), bound = new_column<double>(n, poses.single);
+  double *pc = commands.mutable_data(), *pv = value.mutable_data(), *pb = bound.mutable_data();
+  std::int8_t *ps = status.mutable_data(), *pg = leg.mutable_data();
+  const double* q = poses.data;
+  parallel_blocks(n, [&](std::size_t begin, std::size_t end) {
+    Vector6d c;
+    LimitReport r;
+    for (std::size_t i = begin; i < end; ++i) {
+      const Status s = motor_commands(model, pose_row(q, i), strategy, c, r);
+      ps[i] = static_cast<std::int8_t>(s);
+      pg[i] = static_cast<std::int8_t>(r.leg);
+      pv[i] = r.value;
+      pb[i] = r.bound;
+      if (s == Status::Ok) {
+        for (int k = 0; k < 6; ++k) pc[6 * i + k] = c[k];
+      } else {
+        for (int k = 0; k < 6; ++k) pc[6 * i + k] = NAN;
+      }
+    }
+  });
+  raise_non_finite(ps, n, "poses");
+  py::dict d;
+  d["commands"] = commands;
+  d["status"] = status;
+  d["limit_leg"] = leg;
+  d["limit_value"] = value;
+  d["limit_bound"] = bound;
+  return d;
+}
+
+// One pose, the real-time function called as directly as Python allows.
+py::array_t<double> motor_command(const Model& model, const py::object& pose_in, const std::string& strategy_name) {
+  const Strategy strategy = strategy_from(strategy_name);
+  Pose pose;
+  if (PyList_Check(pose_in.ptr()) || PyTuple_Check(pose_in.ptr())) {
+    // Lists and tuples of six numbers read directly: the cheapest path from Python.
+    if (PySequence_Fast_GET_SIZE(pose_in.ptr()) != 6)
+      raise_input("pose: expected 6 numbers x, y, z [m], roll, pitch, yaw [rad]");
+    double q[6];
+    for (int k = 0; k < 6; ++k) {
+      q[k] = PyFloat_AsDouble(PySequence_Fast_GET_ITEM(pose_in.ptr(), k));
+      if (q[k] == -1.0 && PyErr_Occurred()) {
+        PyErr_Clear();
+        raise_input("pose: field " + std::to_string(k) + " is not a number");
+      }
+    }
+    pose = pose_row(q, 0);
+  } else {
+    const Rows6 r = rows6(pose_in, "pose");
+    if (!r.single) raise_input("pose: expected 6 numbers x, y, z [m], roll, pitch, yaw [rad]; use commands() for (N, 6)");
+    pose = pose_row(r.data, 0);
+  }
+  Vector6d c;
+  LimitReport r;
+  const Status s = motor_commands(model, pose, strategy, c, r);
+  if (s == Status::NonFiniteInput) raise_input("pose: holds NaN or inf");
+  if (s != Status::Ok)
+    raise_status(s, "pose outside a limit (leg " + std::to_string(r.leg + 1) + ", value " + std::to_string(r.value) +
+                        ", bound " + std::to_string(r.bound) + ")");
+  py::array_t<double> out(6);
+  std::copy(c.data(), c.data() + 6, out.mutable_data());
+  return out;
+}
+
+}  // namespace
+
+void expose_commands(py::module_& m) {
+  m.def("_commands", &commands_batch, py::arg("model"), py::arg("poses"), py::arg("strategy") = "compensated");
+  m.def("motor_command", &motor_command, py::arg("model"), py::arg("pose"), py::arg("strategy") = "compensated",
+        "Motor-side commands (6,) [m] for one pose [x, y, z m, roll, pitch, yaw rad] relative to home: the "
+        "library's real-time motor_commands (Eq. 11-12, limits checked). Raises StatusError outside a limit, "
+        "InputError for NaN or a malformed pose.");
+}
+
+}  // namespace hexatwist::python

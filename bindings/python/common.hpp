@@ -1,0 +1,112 @@
+// Shared helpers of the Python bindings: checked views of numpy arrays (no copy of a contiguous
+// float64 input), output arrays, the status names, and the std::thread chunking of batch work.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "hexatwist/hexatwist.hpp"
+
+namespace hexatwist::python {
+
+namespace py = pybind11;
+
+/// Copies the bindings made of inputs that were not C-contiguous float64 (a debug counter for the
+/// tests: a contiguous float64 input is never copied).
+std::atomic<std::uint64_t>& input_copies() noexcept;
+
+/// Poses of a batch per deterministic block: work is split on these boundaries whatever the number
+/// of threads, so warm-started forward kinematics gives the same numbers on 1 or 64 threads.
+inline constexpr std::size_t kBlock = 4096;
+
+/// A checked read-only view of an (N, 6) float64 array (or (6,) seen as N = 1). Throws
+/// ValueError / TypeError with one line naming the argument. Holds the array (or its copy).
+struct Rows6 {
+  py::array array;     ///< the array read (the input itself when it was C-contiguous float64)
+  const double* data = nullptr;
+  std::size_t rows = 0;
+  bool single = false; ///< the input was one row of shape (6,)
+};
+Rows6 rows6(const py::handle& obj, const char* name, bool allow_single = true);
+
+/// A new C-contiguous float64 array of shape (n, cols), or (cols,) when `single` (n must be 1).
+py::array_t<double> new_rows(std::size_t n, std::size_t cols, bool single);
+/// A new 1-D array of n elements, or a 0-d array when `single` (one pose given as (6,)).
+template <class T>
+py::array_t<T> new_column(std::size_t n, bool single) {
+  if (single) return py::array_t<T>(std::vector<py::ssize_t>{});
+  return py::array_t<T>(static_cast<py::ssize_t>(n));
+}
+
+/// Status from its snake_case name; throws ValueError naming the argument.
+Strategy strategy_from(const std::string& name);
+LengthKind length_kind_from(const std::string& name);
+
+/// Threads a batch call uses (0 = every core).
+std::atomic<unsigned>& thread_setting() noexcept;
+
+/// Runs body(begin, end) over [0, n) in blocks of kBlock poses spread over the cores, with the GIL
+/// released. Small batches run on the calling thread.
+template <class F>
+void parallel_blocks(std::size_t n, F&& body) {
+  py::gil_scoped_release release;
+  const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  const unsigned setting = thread_setting().load();
+  const std::size_t hw = setting ? setting : std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t workers = std::min(hw, blocks);
+  if (workers <= 1) {
+    for (std::size_t b = 0; b < blocks; ++b) body(b * kBlock, std::min(n, (b + 1) * kBlock));
+    return;
+  }
+  std::atomic<std::size_t> next{0};
+  auto run = [&] {
+    for (std::size_t b = next++; b < blocks; b = next++) body(b * kBlock, std::min(n, (b + 1) * kBlock));
+  };
+  std::vector<std::thread> threads;
+  threads.reserve(workers - 1);
+  for (std::size_t w = 1; w < workers; ++w) threads.emplace_back(run);
+  run();
+  for (auto& t : threads) t.join();
+}
+
+/// The pose of row `i` of an (N, 6) row-major array.
+inline Pose pose_row(const double* data, std::size_t i) noexcept {
+  const double* q = data + 6 * i;
+  Pose p;
+  p.position = Vector3d(q[0], q[1], q[2]);
+  p.rpy = Vector3d(q[3], q[4], q[5]);
+  return p;
+}
+
+/// Throws ValueError "name row i holds NaN or inf" if any status is NonFiniteInput.
+void raise_non_finite(const std::int8_t* status, std::size_t n, const char* name);
+
+/// The Python exception types (hexatwist.Error and its subclasses), set by expose_errors.
+struct Errors {
+  py::object error, config_error, input_error, dtype_error, status_error;
+};
+Errors& errors();
+/// Raises hexatwist.StatusError for a status where a value was needed.
+[[noreturn]] void raise_status(Status s, const std::string& what);
+/// Raises hexatwist.InputError (a ValueError) with a one-line message.
+[[noreturn]] void raise_input(const std::string& what);
+
+// One function per binding file.
+void expose_errors(py::module_& m);
+void expose_model(py::module_& m);
+void expose_kinematics(py::module_& m);
+void expose_commands(py::module_& m);
+void expose_forward(py::module_& m);
+void expose_simulation(py::module_& m);
+void expose_measurement(py::module_& m);
+void expose_stream(py::module_& m);
+
+}  // namespace hexatwist::python

@@ -1,0 +1,91 @@
+// Batch inverse kinematics and twist over (N, 6) poses: leg lengths, unit axes, U-joint bends,
+// twist relative to home and the length error it causes (Eq. 1-10).
+#include "common.hpp"
+
+namespace hexatwist::python {
+namespace {
+
+py::dict ik_batch(const Model& model, const py::object& poses_in) {
+  const Rows6 poses = rows6(poses_in, "poses");
+  const std::size_t n = poses.rows;
+  auto lengths = new_rows(n, 6, poses.single);
+  py::array_t<double> axes = poses.single ? py::array_t<double>({6, 3})
+                                          : py::array_t<double>({static_cast<py::ssize_t>(n), py::ssize_t{6}, py::ssize_t{3}});
+  auto bend_base = new_rows(n, 6, poses.single), bend_platform = new_rows(n, 6, poses.single);
+  auto status = new_column<std::int8_t>(n, poses.single);
+  double *pl = lengths.mutable_data(), *pa = axes.mutable_data(), *pb = bend_base.mutable_data(),
+         *pp = bend_platform.mutable_data();
+  std::int8_t* ps = status.mutable_data();
+  const double* q = poses.data;
+  parallel_blocks(n, [&](std::size_t begin, std::size_t end) {
+    LegState legs;
+    Vector6d bb, bp;
+    for (std::size_t i = begin; i < end; ++i) {
+      const Status s = inverse_kinematics(model, pose_row(q, i), legs);
+      ps[i] = static_cast<std::int8_t>(s);
+      if (s == Status::NonFiniteInput) {
+        for (int k = 0; k < 6; ++k) pl[6 * i + k] = pb[6 * i + k] = pp[6 * i + k] = NAN;
+        for (int k = 0; k < 18; ++k) pa[18 * i + k] = NAN;
+        continue;
+      }
+      bend_angles(model, legs, bb, bp);
+      for (int k = 0; k < 6; ++k) {
+        pl[6 * i + k] = legs.length[k];
+        pb[6 * i + k] = bb[k];
+        pp[6 * i + k] = bp[k];
+        for (int c = 0; c < 3; ++c) pa[18 * i + 3 * k + c] = legs.s_B(k, c);
+      }
+    }
+  });
+  raise_non_finite(ps, n, "poses");
+  py::dict d;
+  d["lengths"] = lengths;
+  d["axes"] = axes;
+  d["bend_base"] = bend_base;
+  d["bend_platform"] = bend_platform;
+  d["status"] = status;
+  return d;
+}
+
+py::dict twist_batch(const Model& model, const py::object& poses_in) {
+  const Rows6 poses = rows6(poses_in, "poses");
+  const std::size_t n = poses.rows;
+  auto tw = new_rows(n, 6, poses.single), err = new_rows(n, 6, poses.single);
+  auto status = new_column<std::int8_t>(n, poses.single);
+  double *pt = tw.mutable_data(), *pe = err.mutable_data();
+  std::int8_t* ps = status.mutable_data();
+  const double* q = poses.data;
+  parallel_blocks(n, [&](std::size_t begin, std::size_t end) {
+    LegState legs;
+    Vector6d dtheta, e;
+    for (std::size_t i = begin; i < end; ++i) {
+      Status s = inverse_kinematics(model, pose_row(q, i), legs);
+      if (s == Status::Ok) s = twist(model, legs, dtheta);
+      ps[i] = static_cast<std::int8_t>(s);
+      if (s != Status::Ok) {
+        for (int k = 0; k < 6; ++k) pt[6 * i + k] = pe[6 * i + k] = NAN;
+        continue;
+      }
+      length_error(model, dtheta, e);
+      for (int k = 0; k < 6; ++k) {
+        pt[6 * i + k] = dtheta[k];
+        pe[6 * i + k] = e[k];
+      }
+    }
+  });
+  raise_non_finite(ps, n, "poses");
+  py::dict d;
+  d["twist"] = tw;
+  d["length_error"] = err;
+  d["status"] = status;
+  return d;
+}
+
+}  // namespace
+
+void expose_kinematics(py::module_& m) {
+  m.def("_ik", &ik_batch, py::arg("model"), py::arg("poses"));
+  m.def("_twist", &twist_batch, py::arg("model"), py::arg("poses"));
+}
+
+}  // namespace hexatwist::python

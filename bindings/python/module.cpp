@@ -1,0 +1,16 @@
+// The hexatwist Python extension module (_hexatwist): one layer over the library, one file per
+// concept. The public API and its docstrings are in python/hexatwist/__init__.py.
+#include "common.hpp"
+
+PYBIND11_MODULE(_hexatwist, m) {
+  using namespace hexatwist::python;
+  m.doc() = "hexatwist: twist-aware kinematics of lead-screw Stewart platforms (compiled core)";
+  expose_errors(m);
+  expose_model(m);
+  expose_kinematics(m);
+  expose_commands(m);
+  expose_forward(m);
+  expose_simulation(m);
+  expose_measurement(m);
+  expose_stream(m);
+}

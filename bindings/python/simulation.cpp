@@ -1,0 +1,166 @@
+// Closed-loop simulation and the paper's study: time series as (T,) and (T, 6) arrays, the
+// summary as a dict. Configurations as YAML text or a path (None: the embedded seed); they travel
+// to worker processes as text.
+#include <pybind11/stl.h>
+
+#include "common.hpp"
+
+namespace hexatwist::python {
+
+std::pair<std::string, std::string> read_yaml_source(const py::object& path_or_text);
+
+namespace {
+
+Config config_of(const py::object& src) {
+  if (src.is_none()) return default_config();
+  auto [text, source] = read_yaml_source(src);
+  return load_config(text, source);
+}
+
+py::dict samples_dict(const std::vector<SimulationSample>& s) {
+  const std::size_t n = s.size();
+  py::array_t<double> time(static_cast<py::ssize_t>(n)), error(static_cast<py::ssize_t>(n)),
+      error_twist(static_cast<py::ssize_t>(n));
+  auto mk = [&] { return py::array_t<double>({static_cast<py::ssize_t>(n), py::ssize_t{6}}); };
+  py::array_t<double> desired = mk(), actual = mk(), command = mk(), encoder = mk(), motor = mk(), length = mk(),
+                      tw = mk(), torque = mk();
+  for (std::size_t k = 0; k < n; ++k) {
+    time.mutable_data()[k] = s[k].time;
+    error.mutable_data()[k] = s[k].error;
+    error_twist.mutable_data()[k] = s[k].error_twist_only;
+    auto put = [&](py::array_t<double>& a, const Vector6d& v) { std::copy(v.data(), v.data() + 6, a.mutable_data() + 6 * k); };
+    put(desired, s[k].desired);
+    put(actual, s[k].actual);
+    put(command, s[k].command);
+    put(encoder, s[k].encoder);
+    put(motor, s[k].motor);
+    put(length, s[k].length);
+    put(tw, s[k].twist);
+    put(torque, s[k].torque);
+  }
+  py::dict d;
+  d["time"] = time;
+  d["desired"] = desired;
+  d["actual"] = actual;
+  d["command"] = command;
+  d["encoder"] = encoder;
+  d["motor"] = motor;
+  d["length"] = length;
+  d["twist"] = tw;
+  d["torque"] = torque;
+  d["error"] = error;
+  d["error_twist_only"] = error_twist;
+  return d;
+}
+
+py::dict issue_dict(Status s, const SimulationIssue& issue) {
+  py::dict d;
+  d["status"] = std::string(to_string(s));
+  d["index"] = issue.index;
+  d["time"] = issue.time;
+  d["leg"] = issue.limit.leg;
+  d["value"] = issue.limit.value;
+  d["bound"] = issue.limit.bound;
+  return d;
+}
+
+Trajectory trajectory_of(const Config& config, const std::string& test, const py::object& poses_in) {
+  const double dt = config.rig.control_period();
+  if (!poses_in.is_none()) {
+    const Rows6 rows = rows6(poses_in, "poses", false);
+    Trajectory tr;
+    tr.dt = dt;
+    tr.poses.resize(rows.rows);
+    for (std::size_t i = 0; i < rows.rows; ++i) tr.poses[i] = pose_row(rows.data, i);
+    if (tr.poses.empty()) raise_input("poses: expected at least one pose");
+    return tr;
+  }
+  for (const StudyTest& t : seed_tests(config.study))
+    if (t.name == test) return test_trajectory(config.study, t, dt);
+  raise_input("test: unknown test '" + test + "'; expected Lz, Lx, Rz or Ry");
+}
+
+py::dict simulate_py(const py::object& config_src, const std::string& test, const py::object& poses,
+                     const std::string& strategy, bool twist_in_plant) {
+  const Config config = config_of(config_src);
+  const Trajectory tr = trajectory_of(config, test, poses);
+  SimulationOptions options;
+  options.strategy = strategy_from(strategy);
+  options.twist_in_plant = twist_in_plant;
+  std::vector<SimulationSample> samples;
+  SimulationIssue issue;
+  Status s;
+  {
+    py::gil_scoped_release release;
+    s = simulate(config.rig, tr, options, samples, issue);
+  }
+  py::dict d = samples_dict(samples);
+  std::vector<double> err(samples.size());
+  for (std::size_t k = 0; k < samples.size(); ++k) err[k] = samples[k].error;
+  const ErrorStats st = error_stats(err);
+  py::dict summary = issue_dict(s, issue);
+  summary["error_max"] = st.max;
+  summary["error_rms"] = st.rms;
+  summary["ticks"] = samples.size();
+  d["summary"] = summary;
+  return d;
+}
+
+py::dict stats(const ErrorStats& e) {
+  py::dict d;
+  d["max"] = e.max;
+  d["rms"] = e.rms;
+  return d;
+}
+
+py::dict study_py(const py::object& config_src, const std::string& test, const py::object& poses) {
+  const Config config = config_of(config_src);
+  const Trajectory tr = trajectory_of(config, test, poses);
+  TestRun run;
+  SimulationIssue issue;
+  Status s;
+  {
+    py::gil_scoped_release release;
+    s = run_test(config.rig, tr, run, issue);
+  }
+  py::dict d;
+  py::dict summary = issue_dict(s, issue);
+  summary["test"] = poses.is_none() ? test : std::string("poses");
+  for (auto [name, r] : {std::pair<const char*, const StrategyRun*>{"conventional", &run.conventional},
+                         std::pair<const char*, const StrategyRun*>{"compensated", &run.compensated}}) {
+    d[name] = samples_dict(r->samples);
+    py::dict sd;
+    sd["total"] = stats(r->total);
+    sd["twist_only"] = stats(r->twist_only);
+    sd["tracking_only"] = stats(r->tracking_only);
+    summary[name] = sd;
+  }
+  d["tracking_only"] = py::array_t<double>(static_cast<py::ssize_t>(run.tracking_only.size()), run.tracking_only.data());
+  d["summary"] = summary;
+  return d;
+}
+
+}  // namespace
+
+Config python_config(const py::object& src) { return config_of(src); }
+
+void expose_simulation(py::module_& m) {
+  m.def("_simulate", &simulate_py, py::arg("config") = py::none(), py::arg("test") = "Rz",
+        py::arg("poses") = py::none(), py::arg("strategy") = "compensated", py::arg("twist_in_plant") = true);
+  m.def("_study", &study_py, py::arg("config") = py::none(), py::arg("test") = "Rz", py::arg("poses") = py::none());
+  m.def("control_period", [](const py::object& c) { return config_of(c).rig.control_period(); },
+        py::arg("config") = py::none(), "The configuration's control period [s] (poses of simulate are this far apart).");
+  m.def("study_trajectory", [](const py::object& c, const std::string& test) {
+    const Config config = config_of(c);
+    const Trajectory tr = trajectory_of(config, test, py::none());
+    py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
+    for (std::size_t k = 0; k < tr.poses.size(); ++k) {
+      const Vector6d v = tr.poses[k].to_vector();
+      std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
+    }
+    return q;
+  }, py::arg("config") = py::none(), py::arg("test") = "Rz",
+     "Poses (T, 6) [m, rad] of one of the paper's tests (Lz, Lx, Rz, Ry), one per control period.");
+}
+
+}  // namespace hexatwist::python

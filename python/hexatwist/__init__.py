@@ -1,0 +1,192 @@
+"""hexatwist: twist-aware kinematics of lead-screw (U-P-U) Stewart platforms, from numpy.
+
+Poses are rows ``[x, y, z, roll, pitch, yaw]`` relative to home: x, y, z [m] in the base frame B,
+roll, pitch, yaw [rad] with R = Rz(yaw) Ry(pitch) Rx(roll) (paper Eq. 3). Batch functions take an
+(N, 6) float64 array (or one (6,) pose), never copy a C-contiguous float64 input, release the GIL
+and spread the work over all cores. Per-pose outcomes are int8 status codes (``STATUS_NAMES[code]``,
+0 = ok); bad arguments raise :class:`InputError` (a ValueError) with a one-line message, a bad
+configuration :class:`ConfigError`.
+"""
+from __future__ import annotations
+
+import enum
+import os
+
+import numpy as np
+
+from ._hexatwist import (  # noqa: F401  (re-exported)
+    BLOCK,
+    STATUS_NAMES,
+    ConfigError,
+    DTypeError,
+    Error,
+    InputError,
+    Model,
+    StatusError,
+    Stream,
+    _input_copies,
+    control_period,
+    default_model,
+    describe_status,
+    get_num_threads,
+    set_num_threads,
+    load_model,
+    motor_command,
+    seed_config_yaml,
+    study_trajectory,
+)
+from . import _hexatwist as _core
+from .distributed import map_batch, map_simulations  # noqa: F401
+
+__all__ = [
+    "BLOCK", "STATUS_NAMES", "Status", "Result", "Error", "ConfigError", "InputError", "DTypeError", "StatusError",
+    "Model", "Stream", "default_model", "load_model", "seed_config_yaml", "control_period", "study_trajectory",
+    "inverse_kinematics", "twist", "length_error", "commands", "motor_command", "forward",
+    "simulate", "study", "read_point_log", "measured_test", "observations_at_rest", "identify",
+    "map_batch", "map_simulations", "describe_status", "set_num_threads", "get_num_threads",
+]
+
+Status = enum.IntEnum("Status", [(name.upper(), code) for code, name in enumerate(STATUS_NAMES)])
+Status.__doc__ = "Status codes of the per-pose ``status`` arrays (the library's hexatwist::Status)."
+
+
+class Result(dict):
+    """The arrays of a batch call: a dict whose keys are also attributes (``r.commands``)."""
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def __dir__(self):
+        return list(self.keys()) + list(super().__dir__())
+
+    def __reduce__(self):
+        return (Result, (dict(self),))
+
+    @property
+    def ok(self):
+        """Boolean mask of the poses whose status is ok."""
+        return self["status"] == 0
+
+
+def inverse_kinematics(model: Model, poses) -> Result:
+    """Inverse kinematics, paper Eq. (1)-(4), of (N, 6) poses [m, rad].
+
+    Returns ``lengths`` (N, 6) joint-to-joint leg lengths [m], ``axes`` (N, 6, 3) unit leg axes base to
+    platform [-, B], ``bend_base`` and ``bend_platform`` (N, 6) U-joint bends from home [rad], and
+    ``status`` (N,) int8 (ok, or stroke_below_min for a zero-length leg; limits are not checked here).
+    """
+    return Result(_core._ik(model, poses))
+
+
+def twist(model: Model, poses) -> Result:
+    """Twist (passive rotation of each rod relative to its housing about the leg axis) relative to home.
+
+    Returns ``twist`` (N, 6) [rad] (signed, atan2 form; docs/theory.md §3), ``length_error`` (N, 6)
+    real minus motor-side length it causes, Eq. (10) [m], and ``status`` (N,) int8 (singular_base /
+    singular_platform where a leg is parallel to a fixed U-joint axis: NaN rows).
+    """
+    return Result(_core._twist(model, poses))
+
+
+def length_error(model: Model, poses) -> np.ndarray:
+    """Length error of each leg from its twist, Eq. (10): (N, 6) real minus motor-side length [m]
+    (NaN where the twist is undefined; see :func:`twist` for the statuses)."""
+    return _core._twist(model, poses)["length_error"]
+
+
+def commands(model: Model, poses, strategy: str = "compensated") -> Result:
+    """Motor-side commands for (N, 6) poses [m, rad], limits checked (the library's motor_commands).
+
+    ``strategy``: "compensated" (Eq. 12: IK length - offset - twist_gain * twist) or "conventional"
+    (twist ignored). Returns ``commands`` (N, 6) [m] (NaN rows where the status is not ok: never send
+    those), ``status`` (N,) int8, and the first limit crossed: ``limit_leg`` (N,) int8 0-based (-1:
+    none or the platform Jacobian), ``limit_value`` and ``limit_bound`` (N,) [m, rad or -].
+    """
+    return Result(_core._commands(model, poses, strategy))
+
+
+def forward(model: Model, lengths, kind: str = "motor", guess=None, max_iterations: int = 30,
+            tolerance: float = 1e-12) -> Result:
+    """Forward kinematics (Newton on R^3 x SO(3)) of (N, 6) leg lengths [m].
+
+    ``kind``: "motor" (motor-side lengths, twist included: solves IK - offset - twist_gain * twist = m)
+    or "geometric" (joint-to-joint lengths). ``guess``: None warm-starts along the batch (each block of
+    ``BLOCK`` rows starts at home, then from the previous solution: the same numbers on any number of
+    threads or Dask chunks that are multiples of BLOCK); a (6,) pose starts every row there, an (N, 6)
+    array each row at its own. Returns ``poses`` (N, 6) [m, rad] (NaN unless ok), ``status`` (N,) int8
+    (ok, no_convergence, singular_jacobian, assembly_mode_changed, ...), ``iterations`` (N,) int32 and
+    ``residual`` (N,) largest |length residual| [m].
+    """
+    return Result(_core._forward(model, lengths, kind, guess, max_iterations, tolerance))
+
+
+def simulate(config=None, test: str = "Rz", poses=None, strategy: str = "compensated",
+             twist_in_plant: bool = True) -> Result:
+    """Closed-loop simulation under the six servo loops (simulation.hpp).
+
+    ``config``: YAML text, a path, or None for the embedded seed configuration. The trajectory is one
+    of the paper's tests (``test``: Lz, Lx, Rz, Ry) or ``poses`` (T, 6) [m, rad] one per control period.
+    Returns time series ``time`` (T,) [s]; ``desired``, ``actual`` poses (T, 6) [m, rad]; ``command``,
+    ``encoder``, ``motor`` motor-side and ``length`` real lengths (T, 6) [m]; ``twist`` (T, 6) [rad];
+    ``torque`` (T, 6) [N m]; observation errors ``error``, ``error_twist_only`` (T,) [m]; and
+    ``summary`` (dict: status, issue index/time/leg/value/bound, error_max, error_rms [m], ticks).
+    """
+    r = Result(_core._simulate(config, test, poses, strategy, twist_in_plant))
+    for k, v in list(r.items()):
+        if isinstance(v, dict) and k != "summary":
+            r[k] = Result(v)
+    return r
+
+
+def study(config=None, test: str = "Rz", poses=None) -> Result:
+    """One test of the paper's study (§4, Table 1): the twist-free, conventional and compensated runs.
+
+    Returns ``conventional`` and ``compensated`` (each a Result of time series as :func:`simulate`),
+    ``tracking_only`` (T,) observation error of the twist-free run [m], and ``summary``: status, and per
+    strategy the max / rms of the total, twist-only and tracking-only errors [m].
+    """
+    r = Result(_core._study(config, test, poses))
+    r["conventional"] = Result(r["conventional"])
+    r["compensated"] = Result(r["compensated"])
+    return r
+
+
+def read_point_log(path_or_text, time_column: str = "t", length_unit: float = 0.0, indexed: bool = False) -> Result:
+    """A laser tracker's point log (CSV with a header; measurement.hpp): ``stamps`` (K,) [s] (or sample
+    indices), ``points`` (K, 3) [m, tracker frame T], ``lines`` (K,) source lines. Units come from the
+    column suffixes (``x_mm``, ``t_s``) or ``length_unit`` [m per unit]. Raises ConfigError with the
+    library's "source:line:column: ..." message."""
+    return Result(_core._read_point_log(path_or_text, time_column, length_unit, indexed))
+
+
+def measured_test(config=None, test: str = "Rz") -> Result:
+    """The commanded run of a measured test: calibration moves then the study test. ``t`` (T,) [s],
+    ``poses`` (T, 6) [m, rad], ``calibration_end`` [s]."""
+    return Result(_core._measured_test(config, test))
+
+
+def observations_at_rest(model: Model, t, poses, stamps, points, time_offset: float = 0.0,
+                         strategy: str = "compensated", settle: float = 0.25) -> Result:
+    """The log points taken while the commanded pose had been still for ``settle`` [s], each with the
+    motor-side lengths the model commands there: ``motor`` (K, 6) [m], ``points`` (K, 3) [m, T],
+    ``index`` (log rows), ``poses`` (distinct poses). ``time_offset``: log time at trajectory t = 0 [s]."""
+    return Result(_core._observations_at_rest(model, np.asarray(t, dtype=np.float64), poses,
+                                              np.asarray(stamps, dtype=np.float64), points, time_offset,
+                                              strategy, settle))
+
+
+def identify(model: Model, motor, points, lead_effect: str = "twist") -> Result:
+    """Identifies lead, twist sign, length offsets, observation point and the tracker placement X_BT
+    (identification.hpp) from observations ``motor`` (K, 6) [m] and ``points`` (K, 3) [m, T].
+
+    Returns ``status`` (name) and ``reason``; ``estimate`` (dict: lead [m], twist_sign, length_offsets
+    (6,) [m], observation_point (3,) [m, P], R_BT (3, 3), t_BT (3,) [m, B]); ``sd`` (16,) standard
+    deviations in the order of ``parameter_names`` [m; rad for the rotation]; ``covariance`` (16, 16);
+    ``sigma``, ``rms_before``, ``rms_after``, ``max_after`` [m]; ``residuals`` (K, 3) [m, B];
+    ``corrected_model`` (a Model, when ok).
+    """
+    return Result(_core._identify(model, np.ascontiguousarray(motor, dtype=np.float64),
+                                  np.ascontiguousarray(points, dtype=np.float64), lead_effect))

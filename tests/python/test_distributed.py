@@ -1,0 +1,93 @@
+"""The Dask helper on a real (local) cluster: a scheduler and two workers on 127.0.0.1, started as
+processes and always stopped; results identical, bit for bit, to the local run."""
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import hexatwist
+from conftest import random_poses
+
+distributed = pytest.importorskip("distributed")
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def client(tmp_path_factory):
+    port = free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in [os.path.dirname(os.path.dirname(hexatwist.__file__)),
+                                                    os.path.dirname(__file__), env.get("PYTHONPATH", "")] if p)
+    log = tmp_path_factory.mktemp("dask")
+    procs = []
+
+    def start(args, name):
+        out = open(log / f"{name}.log", "w")
+        procs.append(subprocess.Popen([sys.executable, "-m", *args], env=env, stdout=out, stderr=subprocess.STDOUT,
+                                      start_new_session=True, cwd=log))
+
+    try:
+        start(["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard",
+               "--idle-timeout", "120s"],  # and should pytest itself be killed, the cluster still ends
+              "scheduler")
+        for i in range(2):
+            start(["distributed.cli.dask_worker", address, "--host", "127.0.0.1", "--nthreads", "1",
+                   "--no-dashboard", "--memory-limit", "0", "--name", f"w{i}", "--death-timeout", "30"], f"worker{i}")
+        c = distributed.Client(address, timeout=60)
+        c.wait_for_workers(2, timeout=60)
+        yield c
+        c.close()
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                os.killpg(p.pid, signal.SIGTERM)
+        deadline = time.monotonic() + 10
+        for p in procs:
+            try:
+                p.wait(timeout=max(0.1, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
+
+
+def test_a_million_pose_map_equals_the_local_run(client, model):
+    q = random_poses(1_000_000, seed=5)
+    local = hexatwist.commands(model, q)
+    remote = hexatwist.map_batch("commands", model, q, client=client, chunk=100_000)
+    assert len(client.scheduler_info()["workers"]) == 2
+    for key in local:
+        assert np.array_equal(local[key], remote[key], equal_nan=True), key
+    # Forward kinematics, warm-started along the batch: the same on the cluster's chunks.
+    m = local.commands[local.ok][:50_000]
+    fl = hexatwist.forward(model, m)
+    fr = hexatwist.map_batch("forward", model, m, client=client, chunk=10_000)
+    for key in fl:
+        assert np.array_equal(fl[key], fr[key], equal_nan=True), key
+
+
+def test_sixteen_simulations_equal_the_local_run(client):
+    dt = hexatwist.control_period()
+    t = np.arange(600) * dt
+    runs = []
+    for i in range(16):
+        q = np.zeros((600, 6))
+        q[:, i % 6] = 0.01 * np.sin(np.pi * t / t[-1]) ** 2 * (1 + i // 6)
+        runs.append(dict(poses=q, strategy="compensated" if i % 2 else "conventional"))
+    local = hexatwist.map_simulations(runs)
+    remote = hexatwist.map_simulations(runs, client=client)
+    assert len(remote) == 16
+    for a, b in zip(local, remote):
+        assert a.summary == b.summary
+        for key in ("time", "actual", "command", "motor", "error", "twist"):
+            assert np.array_equal(a[key], b[key]), key

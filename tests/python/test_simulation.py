@@ -1,0 +1,123 @@
+"""Simulation, the study, the stream and identification through the bindings."""
+import os
+
+import numpy as np
+import pytest
+
+import hexatwist
+
+
+def test_simulate_returns_time_series_and_summary():
+    dt = hexatwist.control_period()
+    t = np.arange(1500) * dt
+    q = np.zeros((1500, 6))
+    q[:, 5] = 0.02 * np.sin(np.pi * t / t[-1]) ** 2
+    r = hexatwist.simulate(poses=q, strategy="compensated")
+    assert r.summary["status"] == "ok", r.summary
+    assert r.summary["ticks"] == 1500
+    assert r.time.shape == (1500,) and r.actual.shape == (1500, 6) and r.torque.shape == (1500, 6)
+    np.testing.assert_allclose(r.time, t, atol=1e-12)
+    assert r.summary["error_max"] == pytest.approx(np.max(r.error))
+    conv = hexatwist.simulate(poses=q, strategy="conventional")
+    # Uncompensated twist: the conventional run misses the commanded point by more.
+    assert conv.summary["error_max"] > r.summary["error_max"]
+
+
+def test_simulate_reports_a_limit_as_status():
+    q = np.zeros((10, 6))
+    q[5:, 2] = 2.0
+    r = hexatwist.simulate(poses=q)
+    assert r.summary["status"] != "ok" and r.summary["index"] == 5
+
+
+def test_study_summary_matches_its_series():
+    q = hexatwist.study_trajectory(test="Rz")[:1500]
+    s = hexatwist.study(poses=q)
+    assert s.summary["status"] == "ok"
+    for name in ("conventional", "compensated"):
+        assert s.summary[name]["total"]["max"] == pytest.approx(np.max(s[name].error))
+    assert s.summary["compensated"]["twist_only"]["max"] < s.summary["conventional"]["twist_only"]["max"]
+
+
+def test_stream_answers_one_pose_at_a_time(model):
+    st = hexatwist.Stream(model)
+    st.start(np.zeros(6))
+    a = st.pose([0, 0, 0.01, 0, 0, 0])
+    assert a["status"] == "ok" and a["action"] == "new"
+    np.testing.assert_array_equal(a["command"], hexatwist.motor_command(model, [0, 0, 0.01, 0, 0, 0]))
+    b = st.pose([0, 0, 3.0, 0, 0, 0])
+    assert b["status"] == "stroke_above_max" and b["action"] == "held"
+    np.testing.assert_array_equal(b["command"], a["command"])
+
+
+def test_identify_on_the_shipped_rz_log_reports_what_it_cannot_determine(model):
+    log_path = os.path.join(os.environ.get("HEXATWIST_SOURCE_DIR", ""), "examples", "tracker_Rz.csv")
+    if not os.path.exists(log_path):
+        pytest.skip("HEXATWIST_SOURCE_DIR not set")
+    log = hexatwist.read_point_log(log_path)
+    assert log.points.shape == (2398, 3)
+    run = hexatwist.measured_test(test="Rz")
+    obs = hexatwist.observations_at_rest(model, run.t, run.poses, log.stamps, log.points)
+    assert obs.motor.shape[0] == obs.points.shape[0] > 16
+    r = hexatwist.identify(model, obs.motor, obs.points)
+    # A rotation about z cannot separate A's height from the tracker's: a status, not an exception.
+    assert r.status == "not_identifiable" and "A z" in r.reason and "\n" not in r.reason
+
+
+def test_identify_recovers_offsets_from_stations(model):
+    true = synthetic_truth(model)
+    motor, points = synthetic_observations(model, true, count=40, seed=2)
+    r = hexatwist.identify(model, motor, points)
+    assert r.status == "ok", r.reason
+    est, sd = r.estimate, r.sd
+    assert r.parameter_names[0] == "lead" and sd.shape == (16,)
+    assert abs(est["lead"] - 0.010) < 4 * sd[0] + 1e-9
+    assert np.all(np.abs(est["length_offsets"] - true["offsets"]) < 4 * sd[1:7] + 1e-9)
+    assert r.rms_after < 3e-6 < r.rms_before
+    assert isinstance(r.corrected_model, hexatwist.Model)
+
+
+def synthetic_truth(model):
+    return dict(offsets=np.array([3e-4, -4e-5, 1e-4, 0.0, 3e-4, -5e-5]))
+
+
+def synthetic_observations(model, true, count, seed, noise=1e-6):
+    """Tracker points for random stations: the real platform (offsets) under the nominal commands."""
+    real = hexatwist.Model.from_arrays(model.base, model.platform, model.base_axes, model.platform_axes,
+                                       model.home_height, lead=model.lead, length_offsets=true["offsets"],
+                                       observation_point=model.observation_point, name="real",
+                                       **{k: model.limits[k] for k in ("length_min", "length_max", "bend_max",
+                                                                      "singularity_margin")})
+    rng = np.random.default_rng(seed)
+    poses = rng.uniform(-1, 1, (count * 3, 6)) * [0.2, 0.2, 0.2, 0.2, 0.2, 0.2]
+    c = hexatwist.commands(model, poses)
+    motor = c.commands[c.ok][:count]
+    fk = hexatwist.forward(real, motor, guess=poses[c.ok][:count])
+    assert (fk.status == 0).all()
+    a_B = observation_points(real, fk.poses)
+    # Tracker frame: rotated 30 deg about z and shifted; p_T = R^T (p_B - t).
+    ang = np.deg2rad(30)
+    R = np.array([[np.cos(ang), -np.sin(ang), 0], [np.sin(ang), np.cos(ang), 0], [0, 0, 1]])
+    t = np.array([2.0, -1.0, 0.5])
+    p_T = (a_B - t) @ R + rng.normal(0, noise, a_B.shape)
+    return np.ascontiguousarray(motor), np.ascontiguousarray(p_T)
+
+
+def rotation(rpy):
+    r, p, y = rpy
+    Rx = np.array([[1, 0, 0], [0, np.cos(r), -np.sin(r)], [0, np.sin(r), np.cos(r)]])
+    Ry = np.array([[np.cos(p), 0, np.sin(p)], [0, 1, 0], [-np.sin(p), 0, np.cos(p)]])
+    Rz = np.array([[np.cos(y), -np.sin(y), 0], [np.sin(y), np.cos(y), 0], [0, 0, 1]])
+    return Rz @ Ry @ Rx
+
+
+def observation_points(model, poses):
+    """Observation point A in the base frame for each pose: pivot_home + t + R (A_P - pivot_P) [m, B]."""
+    pivot_home = np.array([0, 0, model.home_height]) + model.pivot
+    return np.array([pivot_home + q[:3] + rotation(q[3:]) @ (model.observation_point - model.pivot) for q in poses])
+
+
+def test_point_log_errors_are_one_line():
+    with pytest.raises(hexatwist.ConfigError) as e:
+        hexatwist.read_point_log("t_s,x_mm,y_mm\n0,1,2\n")
+    assert "\n" not in str(e.value)
