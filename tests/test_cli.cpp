@@ -1131,3 +1131,39 @@ TEST(CliLinuxcnc, UnitsStrategyAndOutputs) {
 }
 
 }  // namespace
+
+// ----- no silent failures (#12): every run means what it says or says why not -----
+namespace {
+
+// Runs the tool with standard output on /dev/full; the exit code and stderr.
+Outcome run_to_full_disk(const std::vector<std::string>& args) {
+  Outcome r;
+  const std::filesystem::path err_path = temp_dir() / "stderr-full.txt";
+  r.command = shell_quote(HEXATWIST_CLI);
+  for (const std::string& a : args) r.command += " " + shell_quote(a);
+  const int status = std::system((r.command + " >/dev/full 2>" + shell_quote(err_path.string())).c_str());
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.err = read_file(err_path);
+  return r;
+}
+
+}  // namespace
+
+TEST(CliOutputs, EveryCommandWritingToAFullStandardOutputExitsFour) {
+  const std::vector<std::vector<std::string>> commands = {
+      {"ik", "--pose=0,0,0.1,0,0,30"},
+      {"ik", "--pose=0,0,0.1,0,0,30", "--json"},
+      {"fk", "--lengths=1.700685245,2.377495057,1.700685245,2.377495057,1.700685245,2.377495057", "--motor"},
+      {"fk", "--lengths=1.700685245,2.377495057,1.700685245,2.377495057,1.700685245,2.377495057", "--json"},
+      {"config"},
+      {"config", "--json"},
+      {"config", "--yaml"},
+      {"linuxcnc"},
+      {"--help"},
+      {"ik", "--help"},
+      {"--version"}};
+  for (const auto& args : commands) {
+    const Outcome r = run_to_full_disk(args);
+    expect_error(r, 4, {"standard output"});
+  }
+}

@@ -49,7 +49,7 @@ int run_config(const ConfigOptions& o) {
   if (o.yaml) {
     if (!o.model.config.empty())
       throw ExitError(kExitBadInput, "--yaml prints the embedded seed config; drop --config");
-    std::fputs(std::string(seed_config_yaml()).c_str(), stdout);
+    write_stdout(seed_config_yaml());
     return kExitOk;
   }
   const Model model = load_model_from(o.model);
@@ -102,7 +102,7 @@ int run_config(const ConfigOptions& o) {
       j.null();
     }
     j.end_object();
-    std::fputs(j.str().c_str(), stdout);
+    write_stdout(j.str());
     return kExitOk;
   }
   std::string out = fmt::format("platform: {}\nsource: {}\n", spec.name, model_source(o.model));
@@ -148,7 +148,7 @@ int run_config(const ConfigOptions& o) {
   } else {
     out += fmt::format("servo (study, simulate): not usable: {}\n", sv.why_not);
   }
-  std::fputs(out.c_str(), stdout);
+  write_stdout(out);
   return kExitOk;
 }
 

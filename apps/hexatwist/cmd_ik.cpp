@@ -57,7 +57,7 @@ int run_ik(const IkOptions& o) {
       j.field("bend_base", bend_base[i]).field("bend_platform", bend_platform[i]).end_object();
     }
     j.end_array().end_object();
-    std::fputs(j.str().c_str(), stdout);
+    write_stdout(j.str());
   } else {
     std::string out = fmt::format("hexatwist ik on {}: {}\n", model_source(o.model), model.spec().name);
     out += fmt::format("pose: x={:.6g} y={:.6g} z={:.6g} m, roll={:.6g} pitch={:.6g} yaw={:.6g} deg\n",
@@ -78,7 +78,7 @@ int run_ik(const IkOptions& o) {
     }
     out +=
         fmt::format("status: {}\n", ok ? "ok" : std::string(to_string(status)) + ": " + describe_limit(report->limit));
-    std::fputs(out.c_str(), stdout);
+    write_stdout(out);
   }
   if (!ok) {
     std::fprintf(stderr, "hexatwist: pose outside a limit: %s\n", describe_limit(report->limit).c_str());

@@ -241,7 +241,7 @@ int run_synth(const SynthOptions& o) {
                             : fmt::format("wrote {}, {} and the run {}", out, truth, o.run_out);
   if (std::isfinite(run.calibration_end))
     text += fmt::format("; measure registers on the calibration moves, t <= {:.3f} s", run.calibration_end);
-  std::puts(text.c_str());
+  write_stdout(text + "\n");
   return kExitOk;
 }
 
@@ -385,7 +385,7 @@ int run_measure(const MeasureOptions& o) {
     t.measured = std::move(measured);
     return s;
   };
-  std::fputs(simulate_and_report(rig, ro, tests, start, compare).c_str(), stdout);
+  write_stdout(simulate_and_report(rig, ro, tests, start, compare));
   return kExitOk;
 }
 
@@ -483,7 +483,7 @@ int run_identify(const IdentifyOptions& o) {
   io.lead_effect = o.lead_effect == "twist" ? LeadEffect::TwistOnly : LeadEffect::TwistAndTravel;
   Identification id;
   const Status status = identify(model, set.observations, id, io);
-  if (o.json) std::puts(identify_json(model, o, set, log, id, status).c_str());
+  if (o.json) write_stdout(identify_json(model, o, set, log, id, status) + "\n");
   if (status != Status::Ok) {
     const char* what = status == Status::NotIdentifiable       ? "not identifiable"
                        : status == Status::SolverNoConvergence ? "no convergence"
@@ -545,7 +545,7 @@ int run_identify(const IdentifyOptions& o) {
                       id.estimate.X_BT.t.x(), id.estimate.X_BT.t.y(), id.estimate.X_BT.t.z(),
                       rad2deg(turn.angle()), turn.axis().x(), turn.axis().y(), turn.axis().z());
   text += fmt::format("wrote {}: the corrected configuration", o.out);
-  std::puts(text.c_str());
+  write_stdout(text + "\n");
   return kExitOk;
 }
 
