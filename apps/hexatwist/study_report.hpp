@@ -75,9 +75,11 @@ std::string report_notes(const Rig& rig, const std::vector<ReportedTest>& tests)
 /// the tests with a measurement.
 std::string summary_table(const std::vector<ReportedTest>& tests);
 
-/// Writes summary.json, summary.md, the CSVs and (optionally) the figures into out_dir; returns
-/// the files written. Every file is written whole to a temporary name and renamed; on failure
-/// throws ExitError(kExitOutputFailed) naming the file (files already complete stay).
+/// Writes summary.json, summary.md, the CSVs and (optionally) the figures into out_dir as one set
+/// (OutputSet): on failure ExitError(kExitOutputFailed) names the file and none of the set nor any
+/// temporary is left. The summaries list the files written. In a folder that was not empty, the
+/// files an earlier summary listed and this run did not write are removed, and a note on stderr
+/// says what was replaced, removed and left. Returns the files written.
 std::vector<std::string> write_report(const Rig& rig, const ReportOptions& options,
                                       const std::vector<ReportedTest>& tests);
 
