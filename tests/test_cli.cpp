@@ -1310,3 +1310,16 @@ TEST(CliOptions, AFiniteButHugePoseIsNotCalledNonFinite) {
   EXPECT_NE(r.code, 0);
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1);
 }
+
+TEST(CliOptions, OptionsWithoutEffectInTheChosenModeAreRefused) {
+  const std::string none;
+  expect_error(run({"config", "--yaml", "--json"}), 2, {"--json", "--yaml"});
+  expect_error(run({"stream", "--rate", "50"}, &none), 2, {"--rate", "--max-velocity"});
+}
+
+TEST(CliOptions, SynthErrorsNameTheOptionNotTheRoutine) {
+  const std::string out = (temp_dir() / "named.csv").string();
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--rate", "33"}), 2, {"--rate 33: 33 Hz does not divide"});
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--offsets-mm", "-1"}), 2, {"--offsets-mm -1", ">= 0 [mm]"});
+  EXPECT_FALSE(std::filesystem::exists(out));
+}

@@ -49,6 +49,7 @@ int run_config(const ConfigOptions& o) {
   if (o.yaml) {
     if (!o.model.config.empty())
       throw ExitError(kExitBadInput, "--yaml prints the embedded seed config; drop --config");
+    if (o.json) throw ExitError(kExitBadInput, "--json: not with --yaml (which prints the seed configuration as YAML)");
     write_stdout(seed_config_yaml());
     return kExitOk;
   }
@@ -159,7 +160,7 @@ Command make_config_command(CLI::App& root) {
   CLI::App* app = root.add_subcommand("config", "Show the resolved platform model (every leg's vectors, SI units)");
   add_model_options(*app, opts->model);
   app->add_flag("--json", opts->json, "Machine-readable output (SI units: m, rad)");
-  app->add_flag("--yaml", opts->yaml, "Print the embedded seed configuration as YAML (a starting point for your own)");
+  app->add_flag("--yaml", opts->yaml, "Print the embedded seed configuration as YAML (a starting point for your own); not with --config or --json");
   return {app, [opts] { return run_config(*opts); }};
 }
 

@@ -197,10 +197,11 @@ int run_synth(const SynthOptions& o) {
   so.seed = o.seed;
   so.errors.lead_error = o.lead_error_pct / 100.0;
   so.errors.flip_twist_sign = o.flip_sign;
-  if (o.offsets_mm.find(',') == std::string::npos)
-    so.errors.zero_offset = random_zero_offsets(
-        parse_numbers(o.offsets_mm, 1, "--offsets-mm", "a bound [mm], or six offsets [mm]")[0] / 1e3, o.seed);
-  else
+  if (o.offsets_mm.find(',') == std::string::npos) {
+    const double bound = parse_numbers(o.offsets_mm, 1, "--offsets-mm", "a bound [mm], or six offsets [mm]")[0];
+    check_option(bound >= 0.0, "--offsets-mm", bound, "a bound >= 0 [mm], or six offsets [mm]");
+    so.errors.zero_offset = random_zero_offsets(bound / 1e3, o.seed);
+  } else
     for (int i = 0;
          const double v : parse_numbers(o.offsets_mm, 6, "--offsets-mm", "a bound [mm], or six offsets [mm]"))
       so.errors.zero_offset[i++] = v / 1e3;
@@ -213,7 +214,16 @@ int run_synth(const SynthOptions& o) {
                     fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
                                 is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
   SyntheticLog log;
-  if (const Status s = synthesize(rig, run.test.trajectory, so, log, issue); s != Status::Ok)
+  Status synthesized = Status::Ok;
+  try {
+    synthesized = synthesize(rig, run.test.trajectory, so, log, issue);
+  } catch (const Error& e) {
+    // The options were checked above but the rate's divisibility: name the option, not the routine.
+    std::string what = e.what();
+    if (what.starts_with("rate: ")) what = fmt::format("--rate {}: {}", o.rate, what.substr(6));
+    throw ExitError(kExitBadInput, what);
+  }
+  if (const Status s = synthesized; s != Status::Ok)
     throw ExitError(kExitOutOfLimit,
                     fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
                                 is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));

@@ -351,7 +351,7 @@ Command make_stream_command(CLI::App& root) {
       ->capture_default_str();
   app->add_option("--max-velocity", o->max_velocity, "rate limit of each leg's command [m/s] (0: none)");
   app->add_option("--max-acceleration", o->max_acceleration, "acceleration limit of each leg's command [m/s^2] (0: none)");
-  app->add_option("--rate", o->rate, "input rate the limits assume [Hz]: one input every 1/rate s")->capture_default_str();
+  app->add_option("--rate", o->rate, "input rate the limits assume [Hz]: one input every 1/rate s; only with --max-velocity or --max-acceleration")->capture_default_str();
   app->add_option("--start", o->start,
                   "pose the platform stands at when the stream starts (x,y,z [m],roll,pitch,yaw [deg]), home or none; "
                   "default: home with rate limits, none without");
@@ -374,6 +374,9 @@ Command make_stream_command(CLI::App& root) {
               for (const char* udp_only : {"--idle-timeout", "--receive-buffer", "--busy-poll"})
                 if (app->count(udp_only) > 0)
                   throw ExitError(kExitBadInput, fmt::format("{}: only with --input udp://HOST:PORT", udp_only));
+            if (app->count("--rate") > 0 && o->max_velocity == 0 && o->max_acceleration == 0)
+              throw ExitError(kExitBadInput, "--rate: only with --max-velocity or --max-acceleration (the input rate "
+                                             "their limits assume)");
             if (!(o->rate > 0) || !std::isfinite(o->rate))
               throw ExitError(kExitBadInput, "--rate: expected a positive rate [Hz]");
             if (o->max_velocity < 0 || o->max_acceleration < 0 || !std::isfinite(o->max_velocity) ||
