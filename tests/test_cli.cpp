@@ -1323,3 +1323,16 @@ TEST(CliOptions, SynthErrorsNameTheOptionNotTheRoutine) {
   expect_error(run({"synth", "--test", "Lz", "--out", out, "--offsets-mm", "-1"}), 2, {"--offsets-mm -1", ">= 0 [mm]"});
   EXPECT_FALSE(std::filesystem::exists(out));
 }
+
+TEST(CliOutputs, AReportWhoseStandardOutputFailsLeavesNoFiles) {
+  const std::string csv = write_file("fullout.csv", heave_csv());
+  const std::filesystem::path out = temp_dir() / "fullout-out";
+  std::filesystem::remove_all(out);
+  expect_error(run_to_full_disk({"simulate", "--trajectory", csv, "--out", out.string(), "--no-figures"}), 4,
+               {"standard output"});
+  EXPECT_TRUE(folder_entries(out).empty());
+  const std::string log = (temp_dir() / "fullout-log.csv").string();
+  expect_error(run_to_full_disk({"synth", "--test", "Lz", "--out", log}), 4, {"standard output"});
+  EXPECT_FALSE(std::filesystem::exists(log));
+  EXPECT_FALSE(std::filesystem::exists(temp_dir() / "fullout-log.truth.json"));
+}

@@ -146,6 +146,16 @@ void write_stdout(std::string_view text) {
                                                    errno != 0 ? std::strerror(errno) : "write error"));
 }
 
+void write_stdout_or_withdraw(std::string_view text, const std::vector<std::string>& files) {
+  try {
+    write_stdout(text);
+  } catch (const ExitError&) {
+    std::error_code ignored;
+    for (const std::string& f : files) std::filesystem::remove(f, ignored);
+    throw;
+  }
+}
+
 Model load_model_from(const ModelOptions& opts) {
   try {
     if (opts.config.empty()) return default_model();

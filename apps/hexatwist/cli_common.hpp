@@ -100,6 +100,10 @@ class OutputSet {
 /// (a full disk, a closed pipe).
 void write_stdout(std::string_view text);
 
+/// Writes `text` to standard output (write_stdout); if that fails, first removes `files`, the
+/// outputs the run has just written, so that a failed run leaves none of them behind.
+void write_stdout_or_withdraw(std::string_view text, const std::vector<std::string>& files);
+
 /// Name of the platform source for messages.
 std::string model_source(const ModelOptions& opts);
 

@@ -258,7 +258,7 @@ int run_synth(const SynthOptions& o) {
                             : fmt::format("wrote {}, {} and the run {}", out, truth, o.run_out);
   if (std::isfinite(run.calibration_end))
     text += fmt::format("; measure registers on the calibration moves, t <= {:.3f} s", run.calibration_end);
-  write_stdout(text + "\n");
+  write_stdout_or_withdraw(text + "\n", files.paths());
   return kExitOk;
 }
 
@@ -437,7 +437,7 @@ int run_measure(const MeasureOptions& o) {
     t.measured = std::move(measured);
     return s;
   };
-  write_stdout(simulate_and_report(rig, ro, tests, start, compare));
+  simulate_and_report(rig, ro, tests, start, compare);
   return kExitOk;
 }
 
@@ -610,7 +610,7 @@ int run_identify(const IdentifyOptions& o) {
     fail(e, status);
   }
   if (o.json) {
-    write_stdout(identify_json(model, o, set, log, id, status, std::string()) + "\n");
+    write_stdout_or_withdraw(identify_json(model, o, set, log, id, status, std::string()) + "\n", {o.out});
     return kExitOk;
   }
 
@@ -646,7 +646,7 @@ int run_identify(const IdentifyOptions& o) {
                       id.estimate.X_BT.t.x(), id.estimate.X_BT.t.y(), id.estimate.X_BT.t.z(),
                       rad2deg(turn.angle()), turn.axis().x(), turn.axis().y(), turn.axis().z());
   text += fmt::format("wrote {}: the corrected configuration", o.out);
-  write_stdout(text + "\n");
+  write_stdout_or_withdraw(text + "\n", {o.out});
   return kExitOk;
 }
 

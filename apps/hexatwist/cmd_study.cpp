@@ -24,7 +24,7 @@ struct StudyOptions {
 int finish(const Rig& rig, const StudyOptions& o, const std::string& command, std::vector<ReportedTest>& tests,
            std::chrono::steady_clock::time_point start) {
   const ReportOptions ro{o.out, command, model_source(o.model), !o.no_figures, !o.no_csv};
-  write_stdout(simulate_and_report(rig, ro, tests, start));
+  simulate_and_report(rig, ro, tests, start);
   return kExitOk;
 }
 

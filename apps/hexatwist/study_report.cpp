@@ -475,7 +475,7 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std:
   bar.finish();
 }
 
-std::string simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<ReportedTest>& tests,
+void simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<ReportedTest>& tests,
                                 std::chrono::steady_clock::time_point start,
                                 const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation) {
   simulate_tests(rig, tests, o.out_dir);
@@ -494,7 +494,7 @@ std::string simulate_and_report(const Rig& rig, const ReportOptions& o, std::vec
   out += report_notes(rig, tests);
   out += fmt::format("\n{:.1f} s simulated ({} runs) in {:.1f} s; {} files written to {} in {:.1f} s in all\n",
                      simulated, 3 * tests.size(), sim_wall, files.size(), o.out_dir, wall);
-  return out;
+  write_stdout_or_withdraw(out, files);
 }
 
 std::string summary_table(const std::vector<ReportedTest>& tests) {

@@ -62,9 +62,10 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std:
 
 /// What study, simulate and measure do once their tests are set up: simulate_tests, then
 /// `after_simulation` (may be empty; returns lines to print before the table, e.g. the
-/// measurement's registration), then write_report. Returns the text for the terminal: the platform,
-/// those lines, the table, the notes, and the time taken since `start`.
-std::string simulate_and_report(const Rig& rig, const ReportOptions& options, std::vector<ReportedTest>& tests,
+/// measurement's registration), then write_report, then prints the text for the terminal: the
+/// platform, those lines, the table, the notes, and the time taken since `start`. If standard
+/// output cannot be written, the report's files are removed (ExitError(4)): all or nothing.
+void simulate_and_report(const Rig& rig, const ReportOptions& options, std::vector<ReportedTest>& tests,
                                 std::chrono::steady_clock::time_point start,
                                 const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation = {});
 
