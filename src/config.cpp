@@ -338,6 +338,8 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
       leg.thread = screw.thread;
       leg.driven = screw.driven;
     }
+    // A leg's lead is the screw block's: its errors point at screw.lead.
+    for (int i = 0; i < kLegs; ++i) locs[fmt::format("leg {}: lead", i + 1)] = screw.lead_at;
     // The legs are derived from the whole block: their errors point at it.
     locs["legs"] = Loc{"symmetric", sym.key};
     locs["home_height"] = loc(Reader::child(sym, "H"));

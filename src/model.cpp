@@ -77,6 +77,10 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
     require_finite(ls.platform_P, who + ": platform");
     require_finite(ls.lead, who + ": lead");
     if (ls.lead < 0.0) fail(fmt::format("{}: lead: expected >= 0 m, got {}", who, ls.lead));
+    // A screw turns at least once over its stroke: a longer lead (1e30 m) is a typing error.
+    if (!(ls.lead <= lim.length_max - lim.length_min))
+      fail(fmt::format("{}: lead: expected at most the stroke ({} m), got {} m", who, lim.length_max - lim.length_min,
+                       ls.lead));
 
     leg.base_B = ls.base_B;
     leg.platform_P = ls.platform_P;
@@ -95,6 +99,10 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
       fail(fmt::format("{}: length_offset: expected less than the stroke ({} m) in magnitude, got {} m", who,
                        lim.length_max - lim.length_min, ls.length_offset));
     leg.length_offset = ls.length_offset;
+    // The motor must reach home: its command there, real length minus offset, inside the stroke.
+    if (const double command = leg.length_home - ls.length_offset; command < lim.length_min || command > lim.length_max)
+      fail(fmt::format("{}: length_offset: {} m puts the home command {:.6f} m outside the stroke [{}, {}] m", who,
+                       ls.length_offset, command, lim.length_min, lim.length_max));
 
     leg.lead = ls.lead;
     leg.thread = ls.thread;

@@ -425,7 +425,9 @@ Trajectory resample(const TimedPoses& samples, double dt) {
   const Pchip curve(samples, "resample");
   const std::vector<double>& t = samples.t;
   const double span = t.back() - t.front();
-  const double steps = std::floor(span / dt + 1e-9);
+  // The grid covers the whole span: a last time between two ticks is reached on the next tick
+  // (which holds the last pose) instead of being dropped.
+  const double steps = std::ceil(span / dt - 1e-9);
   if (!(steps + 1.0 <= kMaxSamples))
     throw Error(fmt::format("resample: {} s at dt = {} s is more than {:.0f} samples", span, dt, kMaxSamples));
   const auto n = static_cast<std::size_t>(steps);

@@ -1131,3 +1131,208 @@ TEST(CliLinuxcnc, UnitsStrategyAndOutputs) {
 }
 
 }  // namespace
+
+// ----- no silent failures (#12): every run means what it says or says why not -----
+namespace {
+
+// Runs the tool with standard output on /dev/full; the exit code and stderr.
+Outcome run_to_full_disk(const std::vector<std::string>& args) {
+  Outcome r;
+  const std::filesystem::path err_path = temp_dir() / "stderr-full.txt";
+  r.command = shell_quote(HEXATWIST_CLI);
+  for (const std::string& a : args) r.command += " " + shell_quote(a);
+  const int status = std::system((r.command + " >/dev/full 2>" + shell_quote(err_path.string())).c_str());
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.err = read_file(err_path);
+  return r;
+}
+
+std::vector<std::string> folder_entries(const std::filesystem::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace
+
+TEST(CliOutputs, EveryCommandWritingToAFullStandardOutputExitsFour) {
+  const std::vector<std::vector<std::string>> commands = {
+      {"ik", "--pose=0,0,0.1,0,0,30"},
+      {"ik", "--pose=0,0,0.1,0,0,30", "--json"},
+      {"fk", "--lengths=1.700685245,2.377495057,1.700685245,2.377495057,1.700685245,2.377495057", "--motor"},
+      {"fk", "--lengths=1.700685245,2.377495057,1.700685245,2.377495057,1.700685245,2.377495057", "--json"},
+      {"config"},
+      {"config", "--json"},
+      {"config", "--yaml"},
+      {"linuxcnc"},
+      {"--help"},
+      {"ik", "--help"},
+      {"--version"}};
+  for (const auto& args : commands) {
+    const Outcome r = run_to_full_disk(args);
+    expect_error(r, 4, {"standard output"});
+  }
+}
+
+TEST(CliOutputs, SynthOutputsThatNameTheSameFileAreRefusedBeforeAnythingIsWritten) {
+  const std::filesystem::path c = temp_dir() / "same.csv";
+  std::filesystem::remove(c);
+  expect_error(run({"synth", "--test", "Lz", "--out", c.string(), "--run-out", c.string()}), 2,
+               {"--out", "--run-out", "same.csv", "nothing was written"});
+  EXPECT_FALSE(std::filesystem::exists(c));
+  const std::string truth = (temp_dir() / "same.truth.json").string();
+  expect_error(run({"synth", "--test", "Lz", "--out", c.string(), "--run-out", truth}), 2, {"--run-out", "truth"});
+  EXPECT_FALSE(std::filesystem::exists(truth));
+}
+
+TEST(CliOutputs, AReportThatCannotBeWrittenWholeLeavesNoFileAndNoTemporary) {
+  const std::string csv = write_file("blocked.csv", heave_csv());
+  const std::filesystem::path out = temp_dir() / "blocked-out";
+  std::filesystem::remove_all(out);
+  std::filesystem::create_directories(out / "summary.json");  // a folder where the summary goes
+  expect_error(run({"simulate", "--trajectory", csv, "--out", out.string()}), 4, {"summary.json"});
+  EXPECT_EQ(folder_entries(out), std::vector<std::string>{"summary.json"});
+}
+
+TEST(CliOutputs, AReusedFolderSaysSoAndItsSummaryListsOnlyThisRunsFiles) {
+  const std::string csv = write_file("reused.csv", heave_csv());
+  const std::filesystem::path out = temp_dir() / "reused-out";
+  std::filesystem::remove_all(out);
+  const Outcome first = run({"simulate", "--trajectory", csv, "--out", out.string(), "--no-figures"});
+  ASSERT_EQ(first.code, 0) << first.err;
+  EXPECT_EQ(first.err, "");
+  EXPECT_TRUE(std::filesystem::exists(out / "reused_compensated.csv"));
+  write_file("reused-out/notes.txt", "mine\n");
+  const Outcome second =
+      run({"simulate", "--trajectory", csv, "--out", out.string(), "--no-figures", "--no-csv"});
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_NE(second.err.find("was not empty: 2 files replaced, 2 of an earlier run removed; 1 other files left"),
+            std::string::npos)
+      << second.err;
+  EXPECT_NE(second.err.find("notes.txt"), std::string::npos);
+  EXPECT_EQ(folder_entries(out), (std::vector<std::string>{"notes.txt", "summary.json", "summary.md"}));
+  const YAML::Node s = YAML::LoadFile((out / "summary.json").string());
+  EXPECT_EQ(s["files"].size(), 0u);
+  EXPECT_EQ(read_file(out / "summary.md").find("_compensated.csv"), std::string::npos);
+}
+
+TEST(CliIdentify, JsonStatusAgreesWithTheExitCodeWhenTheConfigurationCannotBeWritten) {
+  const std::string log = (temp_dir() / "stations.csv").string();
+  if (!std::filesystem::exists(log)) {
+    ASSERT_EQ(run({"synth", "--stations", "40", "--station-seed", "3", "--out", log}).code, 0);
+  }
+  const Outcome r = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--json", "--out",
+                         "/proc/hexatwist-x.yaml"});
+  expect_error(r, 4, {"hexatwist-x.yaml"});
+  const YAML::Node j = json(r);
+  EXPECT_EQ(j["status"].as<std::string>(), "failed");
+  EXPECT_NE(j["reason"].as<std::string>().find("hexatwist-x.yaml"), std::string::npos);
+  EXPECT_TRUE(j["corrected_config"].IsNull());
+  EXPECT_TRUE(j["estimate"].IsMap());  // the identification itself succeeded
+}
+
+TEST(CliIdentify, JsonOfDataThatCannotDetermineTheParametersHasNullsNotZeros) {
+  const std::string log = (temp_dir() / "lz-json.csv").string();
+  ASSERT_EQ(run({"synth", "--test", "Lz", "--out", log}).code, 0);
+  const Outcome r = run({"identify", "--points", log, "--test", "Lz", "--json", "--out",
+                         (temp_dir() / "lz-json.yaml").string()});
+  expect_error(r, 5, {"not identifiable"});
+  const YAML::Node j = json(r);
+  EXPECT_EQ(j["status"].as<std::string>(), "failed");
+  for (const char* key : {"estimate", "rms_after", "max_after", "max_after_line", "sigma", "corrected_config"})
+    EXPECT_TRUE(j[key].IsNull()) << key;
+}
+
+TEST(CliOptions, UdpOnlyOptionsOnStandardInputAreRefused) {
+  const std::string input = "0,0,0.1,0,0,0\n";
+  for (const std::vector<std::string>& extra :
+       {std::vector<std::string>{"--idle-timeout", "1"}, {"--receive-buffer", "65536"}, {"--busy-poll"}}) {
+    std::vector<std::string> args{"stream"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    expect_error(run(args, &input), 2, {extra[0], "only with --input udp://"});
+  }
+}
+
+TEST(CliOptions, SynthOptionsOutOfTheirRangeAreRefused) {
+  const std::string out = (temp_dir() / "range.csv").string();
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--lead-error-pct", "-100"}), 2,
+               {"--lead-error-pct -100", "zero lead"});
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--noise-um", "-1"}), 2, {"--noise-um -1", ">= 0"});
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--rate", "0"}), 2, {"--rate 0", "> 0"});
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--noise-um", "inf"}), 2, {"--noise-um"});
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(CliMeasure, TwoColumnNamesForTheSameColumnAreRefused) {
+  const std::string traj = write_file("calibrated.csv", calibrated_csv());
+  const std::string log = synth_log(traj, "twocols");
+  expect_error(run({"measure", "--points", log, "--trajectory", traj, "--register-until", "8", "--columns",
+                    "t_s,x_mm,x_mm,z_mm", "--out", (temp_dir() / "twocols-out").string()}),
+               2, {"--columns", "same column"});
+  expect_error(run({"measure", "--points", log, "--trajectory", traj, "--register-until", "8", "--columns",
+                    "t_s,x,X_mm,z_mm", "--out", (temp_dir() / "twocols-out").string()}),
+               2, {"--columns", "same column"});
+}
+
+TEST(CliMeasure, AnAbsurdPointAfterTheWindowIsRefusedNamingItsLine) {
+  const std::string traj = write_file("calibrated.csv", calibrated_csv());
+  std::vector<std::string> rows = lines_of(read_file(synth_log(traj, "absurd")));
+  rows[1000] = "9.990000,1e300,0,0";
+  const std::string bad = write_file("absurd-bad.csv", joined(rows));
+  const std::filesystem::path out = temp_dir() / "absurd-out";
+  expect_error(run({"measure", "--points", bad, "--trajectory", traj, "--register-until", "8", "--out", out.string()}),
+               2, {"--points", "line 1001", "not a point of this run"});
+  EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
+}
+
+TEST(CliSimulate, ATrajectoryShorterThanOneControlPeriodIsRefused) {
+  const std::string csv = write_file("blink.csv", "t,x,y,z,roll,pitch,yaw\n0,0,0,0,0,0,0\n0.0005,0,0,0.001,0,0,0\n");
+  expect_error(run({"simulate", "--trajectory", csv, "--no-figures", "--out", (temp_dir() / "blink").string()}), 2,
+               {"--trajectory", "blink.csv", "less than one control period"});
+}
+
+TEST(CliConfig, ALeadLongerThanTheStrokeIsRefusedAtLoad) {
+  const std::string bad = write_file("lead1e30.yaml", replace_line(kSymmetric, 9, "  lead: 1e30"));
+  expect_error(run({"config", "--config", bad}), 2, {"lead1e30.yaml:9:", "lead", "stroke"});
+}
+
+TEST(CliConfig, LengthOffsetsThatPutHomeOutsideTheStrokeAreRefusedAtLoad) {
+  const std::string bad =
+      write_file("offset-home.yaml", kSymmetric + "length_offsets: [-0.9, 0, 0, 0, 0, 0]\n");
+  expect_error(run({"config", "--config", bad}), 2, {"offset-home.yaml:17:", "length_offset", "outside the stroke"});
+}
+
+TEST(CliOptions, AFiniteButHugePoseIsNotCalledNonFinite) {
+  const Outcome r = run({"ik", "--pose=1e300,0,0,0,0,0"});
+  SCOPED_TRACE(r.err);
+  EXPECT_EQ(r.err.find("non-finite"), std::string::npos);
+  EXPECT_NE(r.code, 0);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1);
+}
+
+TEST(CliOptions, OptionsWithoutEffectInTheChosenModeAreRefused) {
+  const std::string none;
+  expect_error(run({"config", "--yaml", "--json"}), 2, {"--json", "--yaml"});
+  expect_error(run({"stream", "--rate", "50"}, &none), 2, {"--rate", "--max-velocity"});
+}
+
+TEST(CliOptions, SynthErrorsNameTheOptionNotTheRoutine) {
+  const std::string out = (temp_dir() / "named.csv").string();
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--rate", "33"}), 2, {"--rate 33: 33 Hz does not divide"});
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--offsets-mm", "-1"}), 2, {"--offsets-mm -1", ">= 0 [mm]"});
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(CliOutputs, AReportWhoseStandardOutputFailsLeavesNoFiles) {
+  const std::string csv = write_file("fullout.csv", heave_csv());
+  const std::filesystem::path out = temp_dir() / "fullout-out";
+  std::filesystem::remove_all(out);
+  expect_error(run_to_full_disk({"simulate", "--trajectory", csv, "--out", out.string(), "--no-figures"}), 4,
+               {"standard output"});
+  EXPECT_TRUE(folder_entries(out).empty());
+  const std::string log = (temp_dir() / "fullout-log.csv").string();
+  expect_error(run_to_full_disk({"synth", "--test", "Lz", "--out", log}), 4, {"standard output"});
+  EXPECT_FALSE(std::filesystem::exists(log));
+  EXPECT_FALSE(std::filesystem::exists(temp_dir() / "fullout-log.truth.json"));
+}

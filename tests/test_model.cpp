@@ -140,12 +140,33 @@ TEST(Model, RejectsNonFiniteLengthOffsetOrOneAsLongAsTheStroke) {
     expect_rejected(spec, {"leg 5", "length_offset", "stroke"});
   }
   ModelSpec spec = seed_spec();
-  spec.legs[4].length_offset = -1.04;
+  spec.legs[4].length_offset = -0.5;
   spec.legs[5].length_offset = 1e-3;
   const Model m(spec);
-  EXPECT_EQ(m.leg(4).length_offset, -1.04);
+  EXPECT_EQ(m.leg(4).length_offset, -0.5);
   EXPECT_EQ(m.geometry().length_offset[5], 1e-3);
   EXPECT_EQ(m.geometry().length_offset[0], 0.0);
+}
+
+TEST(Model, RejectsLengthOffsetsThatPutTheHomeCommandOutsideTheStroke) {
+  // The seed's legs are 1.910247 m at home and its stroke [1.40, 2.45] m: the motor's command
+  // there, length minus offset, is inside for offsets in [-0.54, 0.51] m.
+  for (const double v : {-0.55, 0.52, -1.04}) {
+    ModelSpec spec = seed_spec();
+    spec.legs[4].length_offset = v;
+    expect_rejected(spec, {"leg 5", "length_offset", "home command", "outside the stroke"});
+  }
+}
+
+TEST(Model, RejectsALeadLongerThanTheStroke) {
+  for (const double v : {1.06, 1e30}) {
+    ModelSpec spec = seed_spec();
+    spec.legs[3].lead = v;
+    expect_rejected(spec, {"leg 4", "lead", "at most the stroke"});
+  }
+  ModelSpec spec = seed_spec();
+  spec.legs[3].lead = 1.05;  // one turn over the whole stroke: a screw still
+  EXPECT_NO_THROW((void)Model(spec));
 }
 
 TEST(Model, RejectsNonFiniteOrNonPositiveHomeHeight) {

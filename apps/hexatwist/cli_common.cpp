@@ -51,22 +51,91 @@ std::string read_text_file(const std::string& path, const std::string& option, c
 }
 
 void write_output_file(const std::string& file, std::string_view content) {
+  OutputSet set;
+  set.add(file, std::string(content));
+  set.commit();
+}
+
+void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
   namespace fs = std::filesystem;
-  const fs::path path(file);
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(content.data(), static_cast<std::streamsize>(content.size()));
+  for (std::size_t a = 0; a < outputs.size(); ++a)
+    for (std::size_t b = a + 1; b < outputs.size(); ++b) {
+      if (outputs[a].second.empty() || outputs[b].second.empty()) continue;
+      std::error_code ea, eb;
+      const fs::path pa = fs::weakly_canonical(outputs[a].second, ea);
+      const fs::path pb = fs::weakly_canonical(outputs[b].second, eb);
+      if ((!ea && !eb) ? pa == pb : outputs[a].second == outputs[b].second)
+        throw ExitError(kExitBadInput, fmt::format("{} and {} both name '{}': one run's outputs never overwrite each "
+                                                   "other; nothing was written",
+                                                   outputs[a].first, outputs[b].first, printable(outputs[b].second)));
+    }
+}
+
+OutputSet::~OutputSet() {
+  if (!committed_) roll_back();
+}
+
+void OutputSet::add(const std::string& path, std::string content) {
+  pending_.push_back({path, path + ".tmp", std::move(content)});
+  paths_.push_back(path);
+}
+
+void OutputSet::adopt(const std::string& path) {
+  adopted_.push_back(path);
+  paths_.push_back(path);
+}
+
+void OutputSet::roll_back() noexcept {
+  std::error_code ec;
+  for (const Pending& p : pending_)
+    if (p.staged) std::filesystem::remove(p.tmp, ec);
+  for (const std::string& a : adopted_) std::filesystem::remove(a, ec);
+}
+
+void OutputSet::stage() {
+  namespace fs = std::filesystem;
+  for (Pending& p : pending_) {
+    if (p.staged) continue;
+    std::error_code ec;
+    if (fs::is_directory(p.path, ec)) {
+      roll_back();
+      throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}': it is a directory; nothing was written",
+                                                     printable(p.path)));
+    }
+    errno = 0;
+    std::ofstream out(p.tmp, std::ios::binary | std::ios::trunc);
+    p.staged = static_cast<bool>(out);  // from here on, the temporary is ours to remove
+    out.write(p.content.data(), static_cast<std::streamsize>(p.content.size()));
     out.close();
     if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}'", path.string()));
+      const int err = errno;
+      roll_back();
+      throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}': {}; nothing was written", printable(p.path),
+                                                     err != 0 ? std::strerror(err) : "write error"));
     }
+    p.content.clear();
+    p.content.shrink_to_fit();
   }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}': {}", path.string(), ec.message()));
+}
+
+void OutputSet::commit() {
+  namespace fs = std::filesystem;
+  stage();
+  for (std::size_t k = 0; k < pending_.size(); ++k) {
+    std::error_code ec;
+    fs::rename(pending_[k].tmp, pending_[k].path, ec);
+    if (ec) {
+      // The files already renamed are this run's: remove them with the rest, so no partial set is left.
+      std::error_code ignore;
+      for (std::size_t r = 0; r < k; ++r) fs::remove(pending_[r].path, ignore);
+      roll_back();
+      committed_ = true;
+      throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}': {}; nothing was written",
+                                                     printable(pending_[k].path), ec.message()));
+    }
+    pending_[k].staged = false;
+  }
+  committed_ = true;
 }
 
 void write_stdout(std::string_view text) {
@@ -75,6 +144,16 @@ void write_stdout(std::string_view text) {
   if (std::fflush(stdout) != 0 || !written || std::ferror(stdout))
     throw ExitError(kExitOutputFailed, fmt::format("cannot write to standard output: {}",
                                                    errno != 0 ? std::strerror(errno) : "write error"));
+}
+
+void write_stdout_or_withdraw(std::string_view text, const std::vector<std::string>& files) {
+  try {
+    write_stdout(text);
+  } catch (const ExitError&) {
+    std::error_code ignored;
+    for (const std::string& f : files) std::filesystem::remove(f, ignored);
+    throw;
+  }
 }
 
 Model load_model_from(const ModelOptions& opts) {
@@ -128,6 +207,11 @@ std::vector<double> parse_numbers(const std::string& text, std::size_t count, co
     throw ExitError(kExitBadInput, fmt::format("{}: expected {} comma-separated numbers ({}), got {}", option, count,
                                                what, values.size()));
   return values;
+}
+
+void check_option(bool ok, std::string_view option, double value, std::string_view expected) {
+  if (ok && std::isfinite(value)) return;
+  throw ExitError(kExitBadInput, fmt::format("{} {}: expected {}", option, value, expected));
 }
 
 Pose parse_pose_m_deg(const std::string& text, const std::string& option) {

@@ -8,6 +8,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hexatwist/hexatwist.hpp"
@@ -54,12 +55,54 @@ Config load_config_from(const ModelOptions& opts);
 std::string read_text_file(const std::string& path, const std::string& option, const std::string& what);
 
 /// Writes `content` to the file whole: to a temporary name first, then renamed; ExitError(4)
-/// naming the file if it cannot be written.
+/// naming the file if it cannot be written (no temporary is left).
 void write_output_file(const std::string& path, std::string_view content);
+
+/// ExitError(2) if two of the (option, path) pairs name the same file (`synth --out c.csv
+/// --run-out c.csv`): one command's outputs never overwrite each other. Empty paths are skipped.
+void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs);
+
+/// The files one run writes, put in place as a set: stage() writes each whole to a temporary
+/// name beside it, commit() renames them all. If anything fails before commit() ends, no file of
+/// the set and no temporary is left (files adopted with adopt(), already in place, are removed
+/// too) and ExitError(4) names the file.
+class OutputSet {
+ public:
+  OutputSet() = default;
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+  ~OutputSet();
+
+  /// Adds a file to write.
+  void add(const std::string& path, std::string content);
+  /// A file already put in place by someone else (a figure) that belongs to the set.
+  void adopt(const std::string& path);
+  /// Writes every added file to its temporary name.
+  void stage();
+  /// Stages what is not staged yet, then renames every temporary to its file.
+  void commit();
+  /// Every file of the set, in the order added (adopted ones included).
+  const std::vector<std::string>& paths() const { return paths_; }
+
+ private:
+  struct Pending {
+    std::string path, tmp, content;
+    bool staged = false;
+  };
+  void roll_back() noexcept;
+  std::vector<Pending> pending_;
+  std::vector<std::string> adopted_;
+  std::vector<std::string> paths_;
+  bool committed_ = false;
+};
 
 /// Writes `text` to standard output and flushes it; ExitError(4) if it could not be written whole
 /// (a full disk, a closed pipe).
 void write_stdout(std::string_view text);
+
+/// Writes `text` to standard output (write_stdout); if that fails, first removes `files`, the
+/// outputs the run has just written, so that a failed run leaves none of them behind.
+void write_stdout_or_withdraw(std::string_view text, const std::vector<std::string>& files);
 
 /// Name of the platform source for messages.
 std::string model_source(const ModelOptions& opts);
@@ -68,6 +111,10 @@ std::string model_source(const ModelOptions& opts);
 /// describes them for the error message.
 std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option,
                                   const std::string& what);
+
+/// ExitError(2) "OPTION VALUE: expected EXPECTED" unless `ok`: the check of a number option's
+/// range, sign and finiteness (NaN and infinities never pass: `ok` must be false for them).
+void check_option(bool ok, std::string_view option, double value, std::string_view expected);
 
 /// Parses "x,y,z,roll,pitch,yaw" in m and degrees into a pose [m, rad].
 Pose parse_pose_m_deg(const std::string& text, const std::string& option);

@@ -49,7 +49,8 @@ int run_config(const ConfigOptions& o) {
   if (o.yaml) {
     if (!o.model.config.empty())
       throw ExitError(kExitBadInput, "--yaml prints the embedded seed config; drop --config");
-    std::fputs(std::string(seed_config_yaml()).c_str(), stdout);
+    if (o.json) throw ExitError(kExitBadInput, "--json: not with --yaml (which prints the seed configuration as YAML)");
+    write_stdout(seed_config_yaml());
     return kExitOk;
   }
   const Model model = load_model_from(o.model);
@@ -102,7 +103,7 @@ int run_config(const ConfigOptions& o) {
       j.null();
     }
     j.end_object();
-    std::fputs(j.str().c_str(), stdout);
+    write_stdout(j.str());
     return kExitOk;
   }
   std::string out = fmt::format("platform: {}\nsource: {}\n", spec.name, model_source(o.model));
@@ -148,7 +149,7 @@ int run_config(const ConfigOptions& o) {
   } else {
     out += fmt::format("servo (study, simulate): not usable: {}\n", sv.why_not);
   }
-  std::fputs(out.c_str(), stdout);
+  write_stdout(out);
   return kExitOk;
 }
 
@@ -159,7 +160,7 @@ Command make_config_command(CLI::App& root) {
   CLI::App* app = root.add_subcommand("config", "Show the resolved platform model (every leg's vectors, SI units)");
   add_model_options(*app, opts->model);
   app->add_flag("--json", opts->json, "Machine-readable output (SI units: m, rad)");
-  app->add_flag("--yaml", opts->yaml, "Print the embedded seed configuration as YAML (a starting point for your own)");
+  app->add_flag("--yaml", opts->yaml, "Print the embedded seed configuration as YAML (a starting point for your own); not with --config or --json");
   return {app, [opts] { return run_config(*opts); }};
 }
 

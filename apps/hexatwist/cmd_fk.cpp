@@ -50,7 +50,7 @@ int run_fk(const FkOptionsCli& o) {
     j.key("limit");
     write_limit_json(j, limit);
     j.end_object();
-    std::fputs(j.str().c_str(), stdout);
+    write_stdout(j.str());
   } else {
     std::string out = fmt::format("hexatwist fk on {} ({} lengths{})\n", model_source(o.model), kind_name,
                                   o.motor ? ", twist included" : "");
@@ -60,7 +60,7 @@ int run_fk(const FkOptionsCli& o) {
     out += fmt::format("iterations: {}, residual: {:.3g} m\n", result->iterations, result->residual);
     out += fmt::format("status: {}\n",
                        final_status == Status::Ok ? std::string("ok") : std::string(to_string(final_status)));
-    std::fputs(out.c_str(), stdout);
+    write_stdout(out);
   }
   if (status != Status::Ok) {
     std::fprintf(stderr,

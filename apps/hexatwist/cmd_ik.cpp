@@ -22,7 +22,10 @@ int run_ik(const IkOptions& o) {
   const Pose pose = parse_pose_m_deg(o.pose, "--pose");
   auto report = std::make_unique<CommandReport>();
   const Status status = compute_commands(model, pose, *report);
-  if (status == Status::NonFiniteInput) throw ExitError(kExitBadInput, "--pose: non-finite value");
+  // The numbers were finite when parsed (parse_pose_m_deg): so they are too large to compute with.
+  if (status == Status::NonFiniteInput)
+    throw ExitError(kExitBadInput, fmt::format("--pose {}: too large to compute with (the leg lengths overflow); "
+                                               "expected a pose within reach of the platform", printable(o.pose)));
   const bool ok = status == Status::Ok;
   // The twist (and the length error) exist wherever no U-joint is singular, also outside the
   // other limits; compute_commands leaves them unspecified otherwise.
@@ -57,7 +60,7 @@ int run_ik(const IkOptions& o) {
       j.field("bend_base", bend_base[i]).field("bend_platform", bend_platform[i]).end_object();
     }
     j.end_array().end_object();
-    std::fputs(j.str().c_str(), stdout);
+    write_stdout(j.str());
   } else {
     std::string out = fmt::format("hexatwist ik on {}: {}\n", model_source(o.model), model.spec().name);
     out += fmt::format("pose: x={:.6g} y={:.6g} z={:.6g} m, roll={:.6g} pitch={:.6g} yaw={:.6g} deg\n",
@@ -78,7 +81,7 @@ int run_ik(const IkOptions& o) {
     }
     out +=
         fmt::format("status: {}\n", ok ? "ok" : std::string(to_string(status)) + ": " + describe_limit(report->limit));
-    std::fputs(out.c_str(), stdout);
+    write_stdout(out);
   }
   if (!ok) {
     std::fprintf(stderr, "hexatwist: pose outside a limit: %s\n", describe_limit(report->limit).c_str());

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -181,6 +182,14 @@ int run_synth(const SynthOptions& o) {
   const Config config = load_config_from(o.run.model);
   const Rig& rig = config.rig;
   const Run run = build_run(config, o.run);
+  const std::string out = o.out.empty() ? fmt::format("tracker_{}.csv", run.test.name) : o.out;
+  const std::filesystem::path csv(out);
+  const std::string truth = (csv.parent_path() / (csv.stem().string() + ".truth.json")).string();
+  check_distinct_outputs({{"--out", out}, {"the truth beside --out", truth}, {"--run-out", o.run_out}});
+  check_option(o.noise_um >= 0.0, "--noise-um", o.noise_um, "a standard deviation >= 0 [um]");
+  check_option(o.rate > 0.0, "--rate", o.rate, "a sample rate > 0 [Hz]");
+  check_option(o.lead_error_pct > -100.0 && o.lead_error_pct < 1e4, "--lead-error-pct", o.lead_error_pct,
+               "a lead error above -100 % (-100 % is a zero lead) and below 1e4 %");
   SynthesisOptions so;
   so.strategy = strategy_of(o.run);
   so.noise = o.noise_um / 1e6;
@@ -188,10 +197,11 @@ int run_synth(const SynthOptions& o) {
   so.seed = o.seed;
   so.errors.lead_error = o.lead_error_pct / 100.0;
   so.errors.flip_twist_sign = o.flip_sign;
-  if (o.offsets_mm.find(',') == std::string::npos)
-    so.errors.zero_offset = random_zero_offsets(
-        parse_numbers(o.offsets_mm, 1, "--offsets-mm", "a bound [mm], or six offsets [mm]")[0] / 1e3, o.seed);
-  else
+  if (o.offsets_mm.find(',') == std::string::npos) {
+    const double bound = parse_numbers(o.offsets_mm, 1, "--offsets-mm", "a bound [mm], or six offsets [mm]")[0];
+    check_option(bound >= 0.0, "--offsets-mm", bound, "a bound >= 0 [mm], or six offsets [mm]");
+    so.errors.zero_offset = random_zero_offsets(bound / 1e3, o.seed);
+  } else
     for (int i = 0;
          const double v : parse_numbers(o.offsets_mm, 6, "--offsets-mm", "a bound [mm], or six offsets [mm]"))
       so.errors.zero_offset[i++] = v / 1e3;
@@ -204,7 +214,16 @@ int run_synth(const SynthOptions& o) {
                     fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
                                 is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
   SyntheticLog log;
-  if (const Status s = synthesize(rig, run.test.trajectory, so, log, issue); s != Status::Ok)
+  Status synthesized = Status::Ok;
+  try {
+    synthesized = synthesize(rig, run.test.trajectory, so, log, issue);
+  } catch (const Error& e) {
+    // The options were checked above but the rate's divisibility: name the option, not the routine.
+    std::string what = e.what();
+    if (what.starts_with("rate: ")) what = fmt::format("--rate {}: {}", o.rate, what.substr(6));
+    throw ExitError(kExitBadInput, what);
+  }
+  if (const Status s = synthesized; s != Status::Ok)
     throw ExitError(kExitOutOfLimit,
                     fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
                                 is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
@@ -216,15 +235,13 @@ int run_synth(const SynthOptions& o) {
     const Vector3d p = 1e3 * log.log.points_T[k];
     fmt::format_to(std::back_inserter(b), "{:.6f},{:.6f},{:.6f},{:.6f}\n", log.log.stamps[k], p.x(), p.y(), p.z());
   }
-  const std::string out = o.out.empty() ? fmt::format("tracker_{}.csv", run.test.name) : o.out;
-  const std::filesystem::path csv(out);
-  const std::string truth = (csv.parent_path() / (csv.stem().string() + ".truth.json")).string();
-  write_output_file(out, fmt::to_string(b));
-  write_output_file(truth, truth_json(config, o, run, so, log));
+  OutputSet files;
+  files.add(out, fmt::to_string(b));
+  files.add(truth, truth_json(config, o, run, so, log));
   if (!o.run_out.empty())
-    write_output_file(o.run_out,
-                      trajectory_csv(run.test.trajectory,
-                                     static_cast<std::size_t>(std::llround(rig.simulation().control_rate / so.rate))));
+    files.add(o.run_out, trajectory_csv(run.test.trajectory, static_cast<std::size_t>(std::llround(
+                                                                 rig.simulation().control_rate / so.rate))));
+  files.commit();
 
   const Vector3d& origin = log.X_BT.t;
   std::string text = fmt::format("hexatwist synth on {}: {}\n", model_source(o.run.model), rig.model().spec().name);
@@ -241,7 +258,7 @@ int run_synth(const SynthOptions& o) {
                             : fmt::format("wrote {}, {} and the run {}", out, truth, o.run_out);
   if (std::isfinite(run.calibration_end))
     text += fmt::format("; measure registers on the calibration moves, t <= {:.3f} s", run.calibration_end);
-  std::puts(text.c_str());
+  write_stdout_or_withdraw(text + "\n", files.paths());
   return kExitOk;
 }
 
@@ -285,6 +302,7 @@ struct MeasureOptions {
 // The log's format, its time alignment and the log itself; bad options or a bad file become
 // ExitError(2) with one line.
 PointLogFormat log_format(const LogOptions& o) {
+  check_option(true, "--time-offset", o.time_offset, "a time [s]");
   PointLogFormat f;
   std::vector<std::string> names;
   std::size_t begin = 0;
@@ -298,13 +316,30 @@ PointLogFormat log_format(const LogOptions& o) {
     throw ExitError(
         kExitBadInput,
         fmt::format("--columns: expected four column names (time or index, x, y, z), got '{}'", printable(o.columns)));
+  // Two names for one column would read it twice (x as y): every column once. Case and unit
+  // suffix are ignored when matching, so compare the bare names.
+  const auto bare = [](std::string n) {
+    std::transform(n.begin(), n.end(), n.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    for (const char* suffix : {"_ms", "_mm", "_s", "_m"})
+      if (n.size() > std::string_view(suffix).size() && n.ends_with(suffix)) {
+        n.resize(n.size() - std::string_view(suffix).size());
+        break;
+      }
+    return n;
+  };
+  for (std::size_t a = 0; a < names.size(); ++a)
+    for (std::size_t b = a + 1; b < names.size(); ++b)
+      if (bare(names[a]) == bare(names[b]))
+        throw ExitError(kExitBadInput, fmt::format("--columns: '{}' and '{}' name the same column; expected four "
+                                                   "different columns (time or index, x, y, z)",
+                                                   printable(names[a]), printable(names[b])));
   f.time_column = names[0];
   f.x_column = names[1];
   f.y_column = names[2];
   f.z_column = names[3];
   if (!o.units.empty()) f.length_unit = o.units == "mm" ? 1e-3 : 1.0;
   f.indexed = o.index;
-  if (o.index && !(o.rate > 0.0))
+  if (o.index && !(o.rate > 0.0 && std::isfinite(o.rate)))
     throw ExitError(kExitBadInput, "--index: give the tracker's sample rate with --rate HZ");
   if (!o.index && o.rate != 0.0) throw ExitError(kExitBadInput, "--rate: only with --index (a log of sample indices)");
   return f;
@@ -326,6 +361,9 @@ int run_measure(const MeasureOptions& o) {
   const PointLogFormat format = log_format(o.log);
   Run run = build_run(config, o.run);
 
+  check_option(o.settle >= 0.0, "--settle", o.settle, "a time >= 0 [s]");
+  if (!std::isnan(o.register_until))
+    check_option(true, "--register-until", o.register_until, "a time [s]");
   MeasurementOptions mo;
   mo.strategy = strategy_of(o.run);
   mo.time = {o.log.time_offset, o.log.rate};
@@ -351,6 +389,20 @@ int run_measure(const MeasureOptions& o) {
     measured.measurement = measure_points(rig.model(), run.commanded, log, mo);
   } catch (const Error& e) {
     throw ExitError(kExitBadInput, e.what());
+  }
+  // A point farther from the commanded position than a whole leg is long is not a point of this
+  // run (a typing or export error): its error would be meaningless and swamp the statistics.
+  {
+    const Measurement& mm = measured.measurement;
+    const double absurd = rig.model().spec().limits.length_max;
+    for (std::size_t k = mm.window; k < mm.points.size(); ++k) {
+      const double e = mm.points[k].error_B.norm();
+      if (!(e <= absurd))
+        throw ExitError(kExitBadInput,
+                        fmt::format("--points: {}: line {}: the point is {:.4g} m from where the run puts it, more "
+                                    "than a leg's maximum length ({} m): not a point of this run",
+                                    printable(o.log.points), mm.points[k].line, e, absurd));
+    }
   }
   measured.source = o.log.points;
   measured.strategy = mo.strategy;
@@ -385,7 +437,7 @@ int run_measure(const MeasureOptions& o) {
     t.measured = std::move(measured);
     return s;
   };
-  std::fputs(simulate_and_report(rig, ro, tests, start, compare).c_str(), stdout);
+  simulate_and_report(rig, ro, tests, start, compare);
   return kExitOk;
 }
 
@@ -424,44 +476,64 @@ std::vector<ParameterRow> parameter_rows(const Model& nominal, const Identificat
   return rows;
 }
 
+// The JSON of identify. `failure` empty: the run succeeded and wrote `o.out`. Otherwise its
+// one-line reason; the estimate and what follows from it are null unless the identification
+// itself succeeded (`status` Ok, e.g. only the output failed).
 std::string identify_json(const Model& nominal, const IdentifyOptions& o, const ObservationSet& set,
-                          const PointLog& log, const Identification& id, Status status) {
+                          const PointLog& log, const Identification& id, Status status, const std::string& failure) {
+  const bool solved = status == Status::Ok;
+  const auto number = [](JsonWriter& w, std::string_view key, double v, bool known) {
+    w.key(key);
+    known && std::isfinite(v) ? w.value(v) : w.null();
+  };
   JsonWriter j;
-  j.begin_object().field("command", "identify").field("status", status == Status::Ok ? "ok" : "failed");
-  if (status != Status::Ok) j.field("reason", id.reason);
+  j.begin_object().field("command", "identify").field("status", failure.empty() ? "ok" : "failed");
+  if (!failure.empty()) j.field("reason", failure);
   j.field("model", nominal.spec().name).field("config", model_source(o.run.model)).field("points", o.log.points);
   j.field("log_points", static_cast<int>(log.points_T.size())).field("observations", id.count);
   j.field("poses", static_cast<int>(set.poses)).field("settle", set.settle).field("strategy", o.run.strategy).field("lead_effect", o.lead_effect);
-  j.field("rms_before", id.rms_before).field("rms_after", id.rms_after).field("max_after", id.max_after);
+  number(j, "rms_before", id.rms_before, true);
+  number(j, "rms_after", id.rms_after, solved);
+  number(j, "max_after", id.max_after, solved);
   j.key("max_after_line");
-  id.max_after_index >= 0 ? j.value(log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]]) : j.null();
-  j.field("sigma", id.sigma).field("condition", id.condition).field("cost_ratio", id.cost_ratio);
+  solved && id.max_after_index >= 0 ? j.value(log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]])
+                                    : j.null();
+  number(j, "sigma", id.sigma, solved);
+  number(j, "condition", id.condition, true);
+  number(j, "cost_ratio", id.cost_ratio, solved);
   j.key("fits").begin_array(true);
   for (const SignFit& f : id.fits) {
-    j.begin_object().field("twist_sign", f.twist_sign).field("status", describe(f.status)).field("cost", f.cost);
-    j.field("iterations", f.iterations).field("lead_at_bound", f.lead_at_bound).field("lead", f.estimate.lead);
+    j.begin_object().field("twist_sign", f.twist_sign).field("status", describe(f.status));
+    number(j, "cost", f.cost, f.status == Status::Ok);
+    j.field("iterations", f.iterations).field("lead_at_bound", f.lead_at_bound);
+    number(j, "lead", f.estimate.lead, f.status == Status::Ok);
     j.end_object();
   }
   j.end_array();
   const PlatformParameters& e = id.estimate;
-  j.key("estimate").begin_object();
-  j.field("lead", e.lead).field("lead_sd", id.sd[kLeadIndex]).field("lead_nominal", nominal.leg(0).lead);
-  j.field("twist_sign", e.twist_sign).field("twist_sign_nominal", nominal.leg(0).twist_sign);
-  j.field("thread", e.twist_sign > 0.0 ? "right" : "left");
-  j.key("length_offsets").vector(e.length_offset);
-  j.key("length_offsets_sd").vector(id.sd.segment<kLegs>(kOffsetIndex));
-  j.key("observation_point").vector(e.observation_P);
-  j.key("observation_point_sd").vector(id.sd.segment<3>(kObservationIndex));
-  j.key("X_BT").begin_object();
-  j.key("R").begin_array();
-  for (int i = 0; i < 3; ++i) j.vector(e.X_BT.R.row(i));
-  j.end_array();
-  j.key("t").vector(e.X_BT.t);
-  j.key("rotation_sd").vector(id.sd.segment<3>(kRotationIndex));
-  j.key("t_sd").vector(id.sd.segment<3>(kTranslationIndex));
-  j.end_object().end_object();
+  j.key("estimate");
+  if (!solved) {
+    j.null();
+  } else {
+    j.begin_object();
+    j.field("lead", e.lead).field("lead_sd", id.sd[kLeadIndex]).field("lead_nominal", nominal.leg(0).lead);
+    j.field("twist_sign", e.twist_sign).field("twist_sign_nominal", nominal.leg(0).twist_sign);
+    j.field("thread", e.twist_sign > 0.0 ? "right" : "left");
+    j.key("length_offsets").vector(e.length_offset);
+    j.key("length_offsets_sd").vector(id.sd.segment<kLegs>(kOffsetIndex));
+    j.key("observation_point").vector(e.observation_P);
+    j.key("observation_point_sd").vector(id.sd.segment<3>(kObservationIndex));
+    j.key("X_BT").begin_object();
+    j.key("R").begin_array();
+    for (int i = 0; i < 3; ++i) j.vector(e.X_BT.R.row(i));
+    j.end_array();
+    j.key("t").vector(e.X_BT.t);
+    j.key("rotation_sd").vector(id.sd.segment<3>(kRotationIndex));
+    j.key("t_sd").vector(id.sd.segment<3>(kTranslationIndex));
+    j.end_object().end_object();
+  }
   j.key("corrected_config");
-  status == Status::Ok ? j.value(o.out) : j.null();
+  failure.empty() ? j.value(o.out) : j.null();
   j.end_object();
   return j.str();
 }
@@ -470,6 +542,7 @@ int run_identify(const IdentifyOptions& o) {
   const Config config = load_config_from(o.run.model);
   const Model& model = config.rig.model();
   const PointLogFormat format = log_format(o.log);
+  check_option(o.settle >= 0.0, "--settle", o.settle, "a time >= 0 [s]");
   const Run run = build_run(config, o.run);
   const PointLog log = read_point_log(o.log, format);
   ObservationSet set;
@@ -483,17 +556,37 @@ int run_identify(const IdentifyOptions& o) {
   io.lead_effect = o.lead_effect == "twist" ? LeadEffect::TwistOnly : LeadEffect::TwistAndTravel;
   Identification id;
   const Status status = identify(model, set.observations, id, io);
-  if (o.json) std::puts(identify_json(model, o, set, log, id, status).c_str());
+  // A failure still prints the JSON (with the reason, and null where there is no value) when asked.
+  const auto fail = [&](const ExitError& e, Status solved) {
+    if (o.json) write_stdout(identify_json(model, o, set, log, id, solved, e.what()) + "\n");
+    throw e;
+  };
   if (status != Status::Ok) {
     const char* what = status == Status::NotIdentifiable       ? "not identifiable"
                        : status == Status::SolverNoConvergence ? "no convergence"
                                                                : "failed";
-    throw ExitError(kExitNotIdentified,
-                    fmt::format("{}: {} points at rest at {} pose{}: {}: {}; nothing was written",
-                                printable(o.log.points), set.observations.size(), set.poses,
-                                set.poses == 1 ? "" : "s", what, id.reason));
+    fail(ExitError(kExitNotIdentified,
+                   fmt::format("{}: {} points at rest at {} pose{}: {}: {}; nothing was written",
+                               printable(o.log.points), set.observations.size(), set.poses,
+                               set.poses == 1 ? "" : "s", what, id.reason)),
+         status);
   }
 
+  // The thread hand is decided only if the other sign fits worse by more than the noise explains:
+  // twice the cost difference over sigma^2 is a chi-square of one degree of freedom; ask 25 (5 sd).
+  {
+    const bool plus = id.estimate.twist_sign > 0.0;
+    const SignFit& rejected = id.fits[plus ? 1 : 0];
+    const SignFit& chosen = id.fits[plus ? 0 : 1];
+    const double separation = 2.0 * (rejected.cost - chosen.cost) / (id.sigma * id.sigma);
+    if (rejected.status == Status::Ok && !rejected.lead_at_bound && !(separation >= 25.0))
+      fail(ExitError(kExitNotIdentified,
+                     fmt::format("{}: the two thread hands fit the data equally well (cost ratio {:.4g}, difference "
+                                 "{:.3g} noise variances, 25 needed): the twist sign and lead are not decided; record "
+                                 "a run with rotations (--stations); nothing was written",
+                                 printable(o.log.points), id.cost_ratio, separation)),
+           Status::NotIdentifiable);
+  }
   const std::string source_text =
       o.run.model.config.empty() ? std::string(seed_config_yaml()) : read_text_file(o.run.model.config, "--config", "config file");
   ModelSpec corrected = corrected_spec(model.spec(), id.estimate);
@@ -507,11 +600,19 @@ int run_identify(const IdentifyOptions& o) {
     yaml = corrected_config_yaml(source_text, model_source(o.run.model), corrected, header);
     (void)load_config(yaml, o.out);  // what is written must load
   } catch (const Error& e) {
-    throw ExitError(kExitNotIdentified, fmt::format("{}: the corrected configuration does not load: {}; nothing was "
-                                                    "written", printable(o.out), e.what()));
+    fail(ExitError(kExitNotIdentified, fmt::format("{}: the corrected configuration does not load: {}; nothing was "
+                                                   "written", printable(o.out), e.what())),
+         Status::NotIdentifiable);
   }
-  write_output_file(o.out, yaml);
-  if (o.json) return kExitOk;
+  try {
+    write_output_file(o.out, yaml);
+  } catch (const ExitError& e) {
+    fail(e, status);
+  }
+  if (o.json) {
+    write_stdout_or_withdraw(identify_json(model, o, set, log, id, status, std::string()) + "\n", {o.out});
+    return kExitOk;
+  }
 
   std::string text = fmt::format("hexatwist identify on {}: {}\n", model_source(o.run.model), model.spec().name);
   text += fmt::format(
@@ -545,7 +646,7 @@ int run_identify(const IdentifyOptions& o) {
                       id.estimate.X_BT.t.x(), id.estimate.X_BT.t.y(), id.estimate.X_BT.t.z(),
                       rad2deg(turn.angle()), turn.axis().x(), turn.axis().y(), turn.axis().z());
   text += fmt::format("wrote {}: the corrected configuration", o.out);
-  std::puts(text.c_str());
+  write_stdout_or_withdraw(text + "\n", {o.out});
   return kExitOk;
 }
 
@@ -558,14 +659,15 @@ Command make_synth_command(CLI::App& root) {
       "A tracker-like point log made from the closed-loop simulation: the real platform differs from the model by "
       "known errors (lead, twist sign, zero offsets, observation point), the points are in a random tracker frame "
       "with Gaussian noise. Writes FILE.csv (t_s,x_mm,y_mm,z_mm) and FILE.truth.json (SI: the tracker frame X_BT, the "
-      "errors, the noise) beside it. Input for measure.");
+      "errors, the noise) beside it, all files or none; outputs naming the same file are refused (exit 2). Input for "
+      "measure.");
   add_run_options(*app, o->run);
-  app->add_option("--noise-um", o->noise_um, "Tracker noise, standard deviation per axis [um]")->capture_default_str();
-  app->add_option("--rate", o->rate, "Tracker samples per second [Hz]; must divide the control rate")
+  app->add_option("--noise-um", o->noise_um, "Tracker noise, standard deviation per axis [um], >= 0")->capture_default_str();
+  app->add_option("--rate", o->rate, "Tracker samples per second [Hz], > 0; must divide the control rate")
       ->capture_default_str();
   app->add_option("--seed", o->seed, "Seed of the tracker's placement, the noise and random offsets")
       ->capture_default_str();
-  app->add_option("--lead-error-pct", o->lead_error_pct, "Real lead minus nominal, in % of the nominal")
+  app->add_option("--lead-error-pct", o->lead_error_pct, "Real lead minus nominal, in % of the nominal; above -100 (a zero lead)")
       ->capture_default_str();
   app->add_flag("--flip-sign", o->flip_sign, "The real twist term has the opposite sign (other thread hand)");
   app->add_option("--offsets-mm", o->offsets_mm,
@@ -589,7 +691,8 @@ Command make_measure_command(CLI::App& root) {
       "A laser tracker's point log of the observation point, processed as the paper's experiment: aligned in time "
       "with the commanded trajectory, the tracker frame registered (Kabsch/Umeyama) on the points at rest in a window "
       "(the calibration moves with --test), the observation-point errors of the points after it, beside the "
-      "simulation of the same run: the study's table, summary.json/.md, CSVs and figures.");
+      "simulation of the same run: the study's table, summary.json/.md, CSVs and figures, written as a set (all or none, "
+      "exit 4). Two --columns names for one column, or a point farther from the run than a leg is long, is exit 2.");
   add_log_options(*app, o->log);
   add_run_options(*app, o->run);
   app->add_option("--out", o->out, "Output folder (created if missing)")->capture_default_str();
@@ -615,7 +718,9 @@ Command make_identify_command(CLI::App& root) {
       "observation point, using the points where the platform stood still; reports each with its standard deviation "
       "and the residual before and after, and writes the corrected configuration (YAML). Record a run that stops at "
       "many poses (--stations): the paper's tests alone leave some offsets undetermined. Exit 5 when the data do not "
-      "determine the parameters or the solver does not converge.");
+      "determine the parameters, the thread hand is not decided (both signs fit alike) or the solver does not "
+      "converge; exit 4 if the configuration cannot be written. --json is printed on failure too, its status "
+      "agreeing with the exit code and null where there is no value.");
   add_log_options(*app, o->log);
   add_run_options(*app, o->run);
   app->add_option("--settle", o->settle,

@@ -239,7 +239,6 @@ int run_stream(StreamOptions o) {
   } else if (o.output != "stdout" && o.output != "-") {
     throw ExitError(kExitBadInput, fmt::format("--output: '{}' is neither stdout nor udp://HOST:PORT", printable(o.output)));
   }
-  if (o.busy_poll && !in_udp) throw ExitError(kExitBadInput, "--busy-poll: only with --input udp://HOST:PORT");
   if (o.busy_poll && o.rt_priority > 0 && rt_throttled())
     throw ExitError(kExitBadInput,
                     "--busy-poll with --rt-priority: the kernel throttles a SCHED_FIFO task that never sleeps (for "
@@ -352,12 +351,12 @@ Command make_stream_command(CLI::App& root) {
       ->capture_default_str();
   app->add_option("--max-velocity", o->max_velocity, "rate limit of each leg's command [m/s] (0: none)");
   app->add_option("--max-acceleration", o->max_acceleration, "acceleration limit of each leg's command [m/s^2] (0: none)");
-  app->add_option("--rate", o->rate, "input rate the limits assume [Hz]: one input every 1/rate s")->capture_default_str();
+  app->add_option("--rate", o->rate, "input rate the limits assume [Hz]: one input every 1/rate s; only with --max-velocity or --max-acceleration")->capture_default_str();
   app->add_option("--start", o->start,
                   "pose the platform stands at when the stream starts (x,y,z [m],roll,pitch,yaw [deg]), home or none; "
                   "default: home with rate limits, none without");
   app->add_option("--count", o->count, "stop after this many inputs (0: no limit)");
-  app->add_option("--idle-timeout", o->idle_timeout, "UDP: stop after this many seconds without a datagram (0: wait)");
+  app->add_option("--idle-timeout", o->idle_timeout, "UDP: stop after this many seconds without a datagram (0: wait); refused on stdin");
   app->add_option("--rt-priority", o->rt_priority, "run under SCHED_FIFO at this priority with memory locked (needs root)");
   app->add_option("--cpu", o->cpu, "pin the process to this CPU (0-based; default: any)");
   app->add_option("--receive-buffer", o->receive_buffer,
@@ -369,7 +368,15 @@ Command make_stream_command(CLI::App& root) {
                 "UDP: spin on a non-blocking receive instead of sleeping between datagrams (lower latency; one CPU "
                 "at 100 %)");
   app->add_flag("--quiet", o->quiet, "no summary on stderr");
-  return {app, [o] {
+  return {app, [o, app] {
+            // An option that has no effect in the chosen mode is refused, not ignored.
+            if (!is_udp(o->input))
+              for (const char* udp_only : {"--idle-timeout", "--receive-buffer", "--busy-poll"})
+                if (app->count(udp_only) > 0)
+                  throw ExitError(kExitBadInput, fmt::format("{}: only with --input udp://HOST:PORT", udp_only));
+            if (app->count("--rate") > 0 && o->max_velocity == 0 && o->max_acceleration == 0)
+              throw ExitError(kExitBadInput, "--rate: only with --max-velocity or --max-acceleration (the input rate "
+                                             "their limits assume)");
             if (!(o->rate > 0) || !std::isfinite(o->rate))
               throw ExitError(kExitBadInput, "--rate: expected a positive rate [Hz]");
             if (o->max_velocity < 0 || o->max_acceleration < 0 || !std::isfinite(o->max_velocity) ||

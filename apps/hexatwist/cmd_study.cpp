@@ -24,7 +24,7 @@ struct StudyOptions {
 int finish(const Rig& rig, const StudyOptions& o, const std::string& command, std::vector<ReportedTest>& tests,
            std::chrono::steady_clock::time_point start) {
   const ReportOptions ro{o.out, command, model_source(o.model), !o.no_figures, !o.no_csv};
-  std::fputs(simulate_and_report(rig, ro, tests, start).c_str(), stdout);
+  simulate_and_report(rig, ro, tests, start);
   return kExitOk;
 }
 
@@ -60,7 +60,8 @@ int run_simulate(const StudyOptions& o) {
 
 void add_common(CLI::App& app, StudyOptions& o) {
   add_model_options(app, o.model);
-  app.add_option("--out", o.out, "Output folder for summary.json, summary.md, CSVs and figures (created if missing)")
+  app.add_option("--out", o.out, "Output folder for summary.json, summary.md, CSVs and figures (created if missing), written as a set: all "
+                 "or none (exit 4); in a reused folder, an earlier run's files that this run does not write are removed")
       ->capture_default_str();
   app.add_flag("--no-figures", o.no_figures, "Skip the PNG/SVG figures (gnuplot)");
   app.add_flag("--no-csv", o.no_csv, "Skip the per-tick CSVs (about 9 MB per test and strategy at 1 kHz)");

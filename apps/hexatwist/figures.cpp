@@ -589,9 +589,20 @@ void write_figures(const std::vector<Figure>& figures) {
                         fmt::format("gnuplot did not write figure '{}.{}'", printable(figures[f].stem), ext));
     }
   }
-  for (std::size_t f = 0; f < figures.size(); ++f)
-    for (const char* ext : {"png", "svg"})
-      publish(scratch.path() / fmt::format("f{}.{}", f, ext), fmt::format("{}.{}", figures[f].stem, ext));
+  // A failure half way removes the figures already put in place: all of them or none.
+  std::vector<std::string> published;
+  try {
+    for (std::size_t f = 0; f < figures.size(); ++f)
+      for (const char* ext : {"png", "svg"}) {
+        const std::string to = fmt::format("{}.{}", figures[f].stem, ext);
+        publish(scratch.path() / fmt::format("f{}.{}", f, ext), to);
+        published.push_back(to);
+      }
+  } catch (...) {
+    std::error_code ignored;
+    for (const std::string& p : published) fs::remove(p, ignored);
+    throw;
+  }
 }
 
 }  // namespace hexatwist::cli

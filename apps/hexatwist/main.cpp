@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <iostream>
 #include <string>
 #include <string_view>
 
@@ -36,14 +37,24 @@ int main(int argc, char** argv) {
   const std::vector<Command> commands{make_study_command(app),   make_simulate_command(app), make_synth_command(app),
                                       make_measure_command(app), make_identify_command(app), make_stream_command(app),   make_ik_command(app),
                                       make_fk_command(app),      make_config_command(app),   make_linuxcnc_command(app)};
+  // Help and version go to standard output like every result: a failed write is exit 4.
+  const auto print_and_check = [&](const CLI::Error& e) {
+    const int code = app.exit(e);
+    std::cout.flush();
+    if (!std::cout || std::fflush(stdout) != 0) {
+      print_error("hexatwist: error: ", "cannot write to standard output");
+      return static_cast<int>(kExitOutputFailed);
+    }
+    return code;
+  };
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
+    return print_and_check(e);
   } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
+    return print_and_check(e);
   } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
+    return print_and_check(e);
   } catch (const CLI::ParseError& e) {
     // CLI11 reports an unknown subcommand as "a subcommand is required": name it instead. The
     // root takes no option with a value, so the first word that is not an option is the command.

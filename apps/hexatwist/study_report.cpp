@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 
 #include "cli_common.hpp"
 #include "figures.hpp"
@@ -172,7 +173,8 @@ void measured_json(JsonWriter& j, const ReportedMeasurement& r) {
   j.end_object();
 }
 
-std::string summary_json(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests) {
+std::string summary_json(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests,
+                         const std::vector<std::string>& files) {
   JsonWriter j;
   j.begin_object()
       .field("command", o.command)
@@ -197,6 +199,9 @@ std::string summary_json(const Rig& rig, const ReportOptions& o, const std::vect
     }
     j.end_object();
   }
+  j.end_array();
+  j.key("files").begin_array();
+  for (const std::string& f : files) j.value(f);
   j.end_array().end_object();
   return j.str();
 }
@@ -226,7 +231,8 @@ std::string mm(double m) {
   return v != 0.0 && std::abs(v) < 5e-5 ? fmt::format("{:.1e}", v) : fmt::format("{:.4f}", v);
 }
 
-std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests) {
+std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests,
+                       const std::vector<std::string>& files) {
   std::string s = fmt::format("# hexatwist {}: observation-point error\n\n", o.command);
   s += fmt::format(
       "Platform: {} (from {}). Control rate {} Hz, plant step {} s. Observation point ({}, {}, {}) m in "
@@ -270,20 +276,19 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
           "\n**{}**: measured points `{}`, {} commands. The tracker frame was registered on the {} points at rest "
           "among "
           "the {} of {} (t <= {:.3f} s): rms residual {} mm, largest {} mm (line {}), noise estimate {} mm per axis, "
-          "condition {:.3g}. The {} points after them are evaluated (`{}_measured.csv`, `{}_measured.png`).\n",
+          "condition {:.3g}. The {} points after them are evaluated (`{}_measured.csv`).\n",
           t.name, r.source, strategy_name(r.strategy), reg.count, m.window, r.window, m.window_end,
           mm(reg.rms_residual), mm(reg.max_residual),
           worst_line(m), mm(reg.sigma), reg.condition,
-          m.points.size() - m.window, t.name, t.name);
+          m.points.size() - m.window, t.name);
     }
   }
   if (const std::string notes = report_notes(rig, tests); !notes.empty()) s += "\n" + notes;
   s += "\nTests:\n\n";
   for (const ReportedTest& t : tests)
-    s += fmt::format(
-        "- **{}**: {}, {:.2f} s; `{}_conventional.csv`, `{}_compensated.csv`; figures `{}_error.png`, "
-        "`{}_legs.png` (and .svg)\n",
-        t.name, t.description, t.trajectory.duration(), t.name, t.name, t.name, t.name);
+    s += fmt::format("- **{}**: {}, {:.2f} s\n", t.name, t.description, t.trajectory.duration());
+  s += "\nFiles written by this run (beside this summary and summary.json):\n\n";
+  for (const std::string& f : files) s += fmt::format("- `{}`\n", f);
   if (o.command == "study") {
     s += "\nFor comparison, the paper's Table 1 (maximum error, mm; its lead, servo and trajectories are not "
          "given, so only the orders of magnitude compare):\n\n| | Lz | Lx | Rz | Ry |\n|---|---:|---:|---:|---:|\n";
@@ -470,7 +475,7 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std:
   bar.finish();
 }
 
-std::string simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<ReportedTest>& tests,
+void simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<ReportedTest>& tests,
                                 std::chrono::steady_clock::time_point start,
                                 const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation) {
   simulate_tests(rig, tests, o.out_dir);
@@ -489,7 +494,7 @@ std::string simulate_and_report(const Rig& rig, const ReportOptions& o, std::vec
   out += report_notes(rig, tests);
   out += fmt::format("\n{:.1f} s simulated ({} runs) in {:.1f} s; {} files written to {} in {:.1f} s in all\n",
                      simulated, 3 * tests.size(), sim_wall, files.size(), o.out_dir, wall);
-  return out;
+  write_stdout_or_withdraw(out, files);
 }
 
 std::string summary_table(const std::vector<ReportedTest>& tests) {
@@ -528,13 +533,24 @@ ReportedTest reported_test(const StudyTest& test) {
 ReportedTest reported_trajectory_file(const std::string& path, double dt, TimedPoses* commanded) {
   const std::string text = read_text_file(path, "--trajectory", "trajectory CSV file");
   ReportedTest t;
+  TimedPoses poses;
   try {
-    const TimedPoses poses = parse_trajectory_csv(text, path);
-    t.trajectory = resample(poses, dt);
-    if (commanded != nullptr) *commanded = poses;
+    poses = parse_trajectory_csv(text, path);
   } catch (const Error& e) {
     throw ExitError(kExitBadInput, e.what());
   }
+  // Shorter than one control period, there is nothing to simulate: no error would mean anything.
+  const double span = poses.t.back() - poses.t.front();
+  if (!(span >= dt))
+    throw ExitError(kExitBadInput, fmt::format("--trajectory: {} spans {:g} s, less than one control period ({:g} s, "
+                                               "simulation.control_rate): nothing to simulate",
+                                               printable(path), span, dt));
+  try {
+    t.trajectory = resample(poses, dt);
+  } catch (const Error& e) {
+    throw ExitError(kExitBadInput, fmt::format("--trajectory: {}: {}", printable(path), e.what()));
+  }
+  if (commanded != nullptr) *commanded = poses;
   // File-name-safe name from the file's stem.
   for (const char c : fs::path(path).stem().string())
     t.name += (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_') ? c : '_';
@@ -565,34 +581,107 @@ std::string report_notes(const Rig& rig, const std::vector<ReportedTest>& tests)
   return s;
 }
 
+namespace {
+
+// The files an earlier run left in the folder: every entry, and those its summary.json lists
+// as written by it (file names).
+struct EarlierRun {
+  std::vector<std::string> entries;
+  std::vector<std::string> listed;
+};
+
+EarlierRun earlier_run(const fs::path& dir) {
+  EarlierRun e;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    e.entries.push_back(it->path().filename().string());
+  std::sort(e.entries.begin(), e.entries.end());
+  const fs::path summary = dir / "summary.json";
+  if (!fs::is_regular_file(summary, ec)) return e;
+  // The list is one JSON array of plain file names (our own writer): read it without a parser.
+  std::ifstream in(summary, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  const std::string t = text.str();
+  const std::size_t key = t.rfind("\"files\": [");
+  if (key == std::string::npos) return e;
+  const std::size_t close = t.find(']', key);
+  for (std::size_t q = t.find('"', key + 9); q < close; q = t.find('"', q + 1)) {
+    const std::size_t r = t.find('"', q + 1);
+    if (r == std::string::npos || r > close) break;
+    const std::string name = t.substr(q + 1, r - q - 1);
+    if (!name.empty() && name.find('/') == std::string::npos && name.find('\\') == std::string::npos)
+      e.listed.push_back(name);
+    q = r;
+  }
+  return e;
+}
+
+}  // namespace
+
 std::vector<std::string> write_report(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests) {
   const fs::path dir(o.out_dir);
   prepare_output_folder(o.out_dir);
-  std::vector<std::string> written;
-  const auto put = [&](const fs::path& path, std::string_view content) {
-    write_output_file(path.string(), content);
-    written.push_back(path.string());
+  const EarlierRun earlier = earlier_run(dir);
+  OutputSet set;
+  std::vector<std::string> names;  // this run's files other than the summaries, as named in them
+  const auto put = [&](const std::string& name, std::string content) {
+    set.add((dir / name).string(), std::move(content));
+    names.push_back(name);
   };
   std::vector<Figure> figures;
   for (const ReportedTest& t : tests) {
     if (o.csv) {
-      put(dir / (t.name + "_conventional.csv"), csv(t, t.run.conventional, rig.model()));
-      put(dir / (t.name + "_compensated.csv"), csv(t, t.run.compensated, rig.model()));
+      put(t.name + "_conventional.csv", csv(t, t.run.conventional, rig.model()));
+      put(t.name + "_compensated.csv", csv(t, t.run.compensated, rig.model()));
     }
-    if (t.measured) put(dir / (t.name + "_measured.csv"), measured_csv(*t.measured));
+    if (t.measured) put(t.name + "_measured.csv", measured_csv(*t.measured));
     if (o.figures)
       for (Figure& f : figures_of(dir, t, rig.model())) figures.push_back(std::move(f));
   }
+  for (const Figure& f : figures)
+    for (const char* ext : {".png", ".svg"}) names.push_back(fs::path(f.stem + ext).filename().string());
+  std::vector<std::string> all = names;
+  all.push_back("summary.md");
+  all.push_back("summary.json");
+  set.add((dir / "summary.md").string(), summary_md(rig, o, tests, names));
+  set.add((dir / "summary.json").string(), summary_json(rig, o, tests, names));
+  // Everything is written before anything is put in place: a failure leaves the folder as it was.
+  set.stage();
   if (!figures.empty()) {
     write_figures(figures);
-    for (const Figure& f : figures) {
-      written.push_back(f.stem + ".png");
-      written.push_back(f.stem + ".svg");
-    }
+    for (const Figure& f : figures)
+      for (const char* ext : {".png", ".svg"}) set.adopt(f.stem + ext);
   }
-  put(dir / "summary.md", summary_md(rig, o, tests));
-  put(dir / "summary.json", summary_json(rig, o, tests));
-  return written;
+  set.commit();
+
+  // A reused folder: the earlier run's files (as its summary listed them) that this run did not
+  // write are removed, so the summary never sits beside results it does not describe; other files
+  // are left and named.
+  if (!earlier.entries.empty()) {
+    const auto ours = [&](const std::string& n) { return std::find(all.begin(), all.end(), n) != all.end(); };
+    std::size_t replaced = 0, removed = 0;
+    std::vector<std::string> others;
+    for (const std::string& n : earlier.entries) {
+      if (ours(n)) {
+        ++replaced;
+      } else if (std::find(earlier.listed.begin(), earlier.listed.end(), n) != earlier.listed.end()) {
+        std::error_code ec;
+        if (fs::remove(dir / n, ec)) ++removed;
+      } else {
+        others.push_back(n);
+      }
+    }
+    std::string note = fmt::format("hexatwist {}: note: --out '{}' was not empty: {} files replaced, {} of an earlier "
+                                   "run removed", o.command, printable(o.out_dir), replaced, removed);
+    if (!others.empty()) {
+      note += fmt::format("; {} other files left, not described by the summary:", others.size());
+      for (std::size_t k = 0; k < others.size() && k < 5; ++k) note += " " + printable(others[k]);
+      if (others.size() > 5) note += " ...";
+    }
+    std::fprintf(stderr, "%s\n", note.c_str());
+  }
+  return set.paths();
 }
 
 }  // namespace hexatwist::cli

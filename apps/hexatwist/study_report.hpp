@@ -62,9 +62,10 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std:
 
 /// What study, simulate and measure do once their tests are set up: simulate_tests, then
 /// `after_simulation` (may be empty; returns lines to print before the table, e.g. the
-/// measurement's registration), then write_report. Returns the text for the terminal: the platform,
-/// those lines, the table, the notes, and the time taken since `start`.
-std::string simulate_and_report(const Rig& rig, const ReportOptions& options, std::vector<ReportedTest>& tests,
+/// measurement's registration), then write_report, then prints the text for the terminal: the
+/// platform, those lines, the table, the notes, and the time taken since `start`. If standard
+/// output cannot be written, the report's files are removed (ExitError(4)): all or nothing.
+void simulate_and_report(const Rig& rig, const ReportOptions& options, std::vector<ReportedTest>& tests,
                                 std::chrono::steady_clock::time_point start,
                                 const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation = {});
 
@@ -75,9 +76,11 @@ std::string report_notes(const Rig& rig, const std::vector<ReportedTest>& tests)
 /// the tests with a measurement.
 std::string summary_table(const std::vector<ReportedTest>& tests);
 
-/// Writes summary.json, summary.md, the CSVs and (optionally) the figures into out_dir; returns
-/// the files written. Every file is written whole to a temporary name and renamed; on failure
-/// throws ExitError(kExitOutputFailed) naming the file (files already complete stay).
+/// Writes summary.json, summary.md, the CSVs and (optionally) the figures into out_dir as one set
+/// (OutputSet): on failure ExitError(kExitOutputFailed) names the file and none of the set nor any
+/// temporary is left. The summaries list the files written. In a folder that was not empty, the
+/// files an earlier summary listed and this run did not write are removed, and a note on stderr
+/// says what was replaced, removed and left. Returns the files written.
 std::vector<std::string> write_report(const Rig& rig, const ReportOptions& options,
                                       const std::vector<ReportedTest>& tests);
 
