@@ -79,7 +79,7 @@ Outcome run(const std::vector<std::string>& args, const std::string* input = nul
   Outcome r;
   const std::filesystem::path err_path = temp_dir() / "stderr.txt";
   r.command = shell_quote(HEXATWIST_CLI);
-  for (const std::string& a : args) r.command += " " + shell_quote(a);
+  for (const std::string& a : args) (r.command += ' ') += shell_quote(a);
   if (input != nullptr) r.command += " <" + shell_quote(write_file("stdin.txt", *input));
   FILE* pipe = popen((r.command + " 2>" + shell_quote(err_path.string())).c_str(), "r");
   if (pipe == nullptr) return r;
@@ -1002,8 +1002,9 @@ TEST(CliIdentify, DataThatCannotDetermineTheParametersExitFiveInOneLine) {
 
 TEST(CliIdentify, BadRunsAndLogsAreOneLineErrors) {
   const std::string log = (temp_dir() / "stations.csv").string();
-  if (!std::filesystem::exists(log))
+  if (!std::filesystem::exists(log)) {
     ASSERT_EQ(run({"synth", "--stations", "40", "--station-seed", "3", "--out", log}).code, 0);
+  }
   // No run, two runs.
   expect_error(run({"identify", "--points", log}), 2, {"--test", "--trajectory", "--stations"});
   expect_error(run({"identify", "--points", log, "--stations", "40", "--test", "Rz"}), 2, {"excludes"});
@@ -1105,7 +1106,10 @@ TEST(CliLinuxcnc, TheIniCarriesHomeJointsAndAxisReachOfTheKinematics) {
         std::vector<double> q(6, 0.0);
         q[static_cast<std::size_t>(k)] = v * scale - offset + sign * step;
         std::string pose;
-        for (const double x : q) pose += (pose.empty() ? "" : ",") + fmt_double(x);
+        for (const double x : q) {
+          if (!pose.empty()) pose += ',';
+          pose += fmt_double(x);
+        }
         const Outcome ik = run({"ik", "--pose=" + pose});
         EXPECT_EQ(ik.code, step < 0 ? 0 : 3) << section << " " << end << " " << pose << "\n" << ik.err;
       }
@@ -1140,7 +1144,7 @@ Outcome run_to_full_disk(const std::vector<std::string>& args) {
   Outcome r;
   const std::filesystem::path err_path = temp_dir() / "stderr-full.txt";
   r.command = shell_quote(HEXATWIST_CLI);
-  for (const std::string& a : args) r.command += " " + shell_quote(a);
+  for (const std::string& a : args) (r.command += ' ') += shell_quote(a);
   const int status = std::system((r.command + " >/dev/full 2>" + shell_quote(err_path.string())).c_str());
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   r.err = read_file(err_path);
