@@ -142,6 +142,9 @@ static void test_limits(const hexatwist_model* m) {
   CHECK(hexatwist_motor_commands(m, nan_pose, HEXATWIST_COMPENSATED, command, NULL) == HEXATWIST_NON_FINITE_INPUT, "NaN");
   CHECK(hexatwist_motor_commands(NULL, outside, HEXATWIST_COMPENSATED, command, NULL) == HEXATWIST_INVALID_ARGUMENT, "NULL");
   CHECK(hexatwist_motor_commands(m, outside, (hexatwist_strategy)7, command, NULL) == HEXATWIST_INVALID_ARGUMENT, "enum");
+  hexatwist_fk_result fk;
+  CHECK(hexatwist_forward_kinematics(m, command, (hexatwist_length_kind)5, NULL, NULL, &fk) == HEXATWIST_INVALID_ARGUMENT,
+        "length kind");
   CHECK(strcmp(hexatwist_status_name(HEXATWIST_OK), "ok") == 0, "name");
   CHECK(strcmp(hexatwist_status_name(HEXATWIST_PLATFORM_SINGULARITY), "platform_singularity") == 0, "name");
   CHECK(strcmp(hexatwist_status_name(HEXATWIST_INVALID_ARGUMENT), "invalid_argument") == 0, "name");

@@ -38,19 +38,26 @@ typedef enum hexatwist_status {
   HEXATWIST_SINGULAR_JACOBIAN = 9,     /**< forward kinematics met a singular Jacobian */
   HEXATWIST_PLATFORM_SINGULARITY = 17, /**< the pose is too close to a platform (Jacobian) singularity */
   HEXATWIST_ASSEMBLY_MODE_CHANGED = 18,/**< forward kinematics would land on another assembly mode */
-  HEXATWIST_INVALID_ARGUMENT = 100     /**< a null pointer or an unknown enum value was passed */
+  HEXATWIST_INVALID_ARGUMENT = 100,    /**< a null pointer or an unknown enum value was passed */
+  HEXATWIST_STATUS_MAX_ENUM = 0x7FFFFFFF
 } hexatwist_status;
+
+/* Each enum ends with a *_MAX_ENUM member so that it spans every non-negative int: a value from
+ * another language that is no enumerator is then still a value of the type, and the call answers
+ * HEXATWIST_INVALID_ARGUMENT instead of reading an invalid enum. */
 
 /** How motor-side commands are formed. */
 typedef enum hexatwist_strategy {
   HEXATWIST_CONVENTIONAL = 0, /**< joint-to-joint length minus offset; the twist ignored */
-  HEXATWIST_COMPENSATED = 1   /**< the twist's length change subtracted (paper Eq. 12) */
+  HEXATWIST_COMPENSATED = 1,  /**< the twist's length change subtracted (paper Eq. 12) */
+  HEXATWIST_STRATEGY_MAX_ENUM = 0x7FFFFFFF
 } hexatwist_strategy;
 
 /** What a set of leg lengths means. */
 typedef enum hexatwist_length_kind {
   HEXATWIST_GEOMETRIC = 0, /**< joint-to-joint lengths [m] */
-  HEXATWIST_MOTOR = 1      /**< motor-side lengths [m] (twist and offsets included) */
+  HEXATWIST_MOTOR = 1,     /**< motor-side lengths [m] (twist and offsets included) */
+  HEXATWIST_LENGTH_KIND_MAX_ENUM = 0x7FFFFFFF
 } hexatwist_length_kind;
 
 /** The validated platform model (opaque, immutable). */
