@@ -37,12 +37,12 @@ void check_resampled(const TimedPoses& s) {
     fuzz::require(overflow || !(std::isfinite(dt) && dt > 0.0), "resample refused a usable step");
     return;
   }
-  // The grid t0 + k dt covers the samples' span and stops at its end: floor(span / dt) + 1 poses.
-  // dt is not exactly span / 256 when the span is subnormal (dt rounds to a few ulps), so the count
-  // is checked against the dt actually used.
+  // The grid t0 + k dt covers the samples' whole span, a last time between two ticks reached on the
+  // next tick: ceil(span / dt) + 1 poses. dt is not exactly span / 256 when the span is subnormal
+  // (dt rounds to a few ulps), so the count is checked against the dt actually used.
   const double ratio = (s.t.back() - s.t.front()) / tr.dt;
-  const auto count = static_cast<double>(tr.poses.size());
-  fuzz::require(tr.dt == dt && !tr.poses.empty() && count - 1.0 <= ratio + 1e-6 && count >= ratio - 1e-6,
+  const auto steps = static_cast<double>(tr.poses.size()) - 1.0;
+  fuzz::require(tr.dt == dt && !tr.poses.empty() && steps >= ratio - 1e-6 && steps < ratio + 1.0 + 1e-6,
                 "resample gave an unexpected number of poses");
   for (int c = 0; c < 6; ++c) {
     double lo = INFINITY, hi = -INFINITY;
