@@ -280,7 +280,7 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
                             r.where(root.Mark()), kind(root)));
   const Field top{root, "", root.Mark()};
   r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "length_offsets", "limits",
-                   "observation_point", "pivot", "servo", "load", "simulation", "study"});
+                   "observation_point", "pivot", "servo", "load", "simulation", "study", "mechanism"});
 
   ModelSpec spec;
   const Field name = Reader::child(top, "name");
@@ -473,7 +473,8 @@ void read_extras(const Reader& r, const Field& top, Locations& locs, ConfigSpec&
   const Field servo = section("servo", {"motor_inertia", "screw_inertia", "viscous_friction", "coulomb_friction",
                                         "friction_speed", "torque_time_constant", "torque_limit",
                                         "max_speed_rpm", "encoder_counts", "gear_ratio", "pole_frequency_hz", "kp", "ki",
-                                        "kd", "velocity_feedforward", "acceleration_feedforward"});
+                                        "kd", "velocity_feedforward", "acceleration_feedforward",
+                                        "peak_corner_rpm", "peak_torque_at_max_speed", "continuous_torque"});
   num(servo, "motor_inertia", "rotor inertia [kg m^2]", Positive, sv.motor_inertia);
   num(servo, "screw_inertia", "screw and coupling inertia [kg m^2]", NonNegative, sv.screw_inertia);
   num(servo, "viscous_friction", "at the motor shaft [N m s/rad]", NonNegative, sv.viscous_friction);
@@ -490,13 +491,42 @@ void read_extras(const Reader& r, const Field& top, Locations& locs, ConfigSpec&
   num(servo, "kd", "[N m s/rad]; 0 = from pole_frequency_hz", NonNegative, sv.kd);
   num(servo, "velocity_feedforward", "fraction of the viscous torque", NonNegative, sv.velocity_feedforward);
   num(servo, "acceleration_feedforward", "fraction of the inertia torque", NonNegative, sv.acceleration_feedforward);
+  num(servo, "peak_corner_rpm", "speed up to which the peak torque holds [rpm]", Positive, sv.peak_corner_speed, kRpm,
+      "servo.peak_corner_speed");
+  num(servo, "peak_torque_at_max_speed", "peak torque left at the maximum speed [N m]", NonNegative,
+      sv.peak_torque_at_max_speed);
+  num(servo, "continuous_torque", "largest RMS torque [N m]", Positive, sv.continuous_torque);
 
   LoadSpec& ld = out.rig.load;
-  const Field load = section("load", {"mass", "center_of_mass", "inertia", "gravity"});
+  const Field load = section("load", {"mass", "center_of_mass", "inertia", "products_of_inertia", "gravity"});
   num(load, "mass", "platform + payload [kg]", Positive, ld.mass);
   vec(load, "center_of_mass", "x, y, z [m, platform frame]", ld.center_of_mass_P);
   vec(load, "inertia", "principal moments Ixx, Iyy, Izz about the centre of mass [kg m^2]", ld.inertia);
+  vec(load, "products_of_inertia", "Ixy, Ixz, Iyz of the inertia tensor about the centre of mass [kg m^2]",
+      ld.products);
   num(load, "gravity", "[m/s^2]", NonNegative, ld.gravity);
+
+  MechanismSpec& mc = out.rig.mechanism;
+  const Field mech = section("mechanism", {"housing", "rod", "efficiency", "back_efficiency"});
+  const auto leg_body = [&](const char* key, LegBodySpec& b) {
+    if (!mech.present()) return;
+    const Field f = Reader::child(mech, key);
+    if (!f.present()) return;
+    r.require_map(f, "mass, center, axial_inertia, transverse_inertia");
+    r.only_keys(f, {"mass", "center", "axial_inertia", "transverse_inertia"});
+    num(f, "mass", "[kg]", NonNegative, b.mass);
+    if (const Field c = Reader::child(f, "center"); c.present()) {
+      b.center = r.number(c, "distance of the centre of mass from the body's U-joint along the leg [m]");
+      locs[c.path] = loc(c);
+    }
+    num(f, "axial_inertia", "about the leg axis [kg m^2]", NonNegative, b.axial_inertia);
+    num(f, "transverse_inertia", "across the leg through the centre of mass [kg m^2]", NonNegative,
+        b.transverse_inertia);
+  };
+  leg_body("housing", mc.housing);
+  leg_body("rod", mc.rod);
+  num(mech, "efficiency", "screw efficiency, motor driving the load, in (0, 1]", Positive, mc.efficiency);
+  num(mech, "back_efficiency", "screw efficiency, load driving the motor, in (0, 1]", Positive, mc.back_efficiency);
 
   SimulationSpec& sm = out.rig.simulation;
   const Field sim = section("simulation", {"control_rate_hz", "plant_step"});

@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
+#include <utility>
 
 #include "hexatwist/dynamics.hpp"
 #include "hexatwist/error.hpp"
@@ -26,10 +28,12 @@ constexpr double kMaxBandwidthRatio = 0.5;
 
 }  // namespace
 
-Rig::Rig(const RigSpec& spec) : Rig(Model(spec.model), spec.servo, spec.load, spec.simulation) {}
+Rig::Rig(const RigSpec& spec)
+    : Rig(Model(spec.model), spec.servo, spec.load, spec.simulation, spec.mechanism) {}
 
-Rig::Rig(Model model, const ServoSpec& servo, const LoadSpec& load, const SimulationSpec& simulation)
-    : model_(std::move(model)), servo_(servo), load_(load), simulation_(simulation) {
+Rig::Rig(Model model, const ServoSpec& servo, const LoadSpec& load, const SimulationSpec& simulation,
+         const MechanismSpec& mechanism)
+    : model_(std::move(model)), servo_(servo), load_(load), simulation_(simulation), mechanism_(mechanism) {
   validate_and_derive();
 }
 
@@ -57,11 +61,50 @@ void Rig::validate_and_derive() {
          "expected > 0 when ki or kd is given (or leave all three at 0 to derive them from servo.pole_frequency)");
   non_negative(s.velocity_feedforward, "servo.velocity_feedforward", "(fraction)");
   non_negative(s.acceleration_feedforward, "servo.acceleration_feedforward", "(fraction)");
+  positive(s.peak_corner_speed, "servo.peak_corner_speed", "rad/s");
+  if (s.peak_corner_speed > s.max_speed)
+    fail("servo.peak_corner_speed", fmt::format("{} rad/s is above servo.max_speed ({} rad/s)", s.peak_corner_speed,
+                                                s.max_speed));
+  non_negative(s.peak_torque_at_max_speed, "servo.peak_torque_at_max_speed", "N m");
+  if (s.peak_torque_at_max_speed > s.torque_limit)
+    fail("servo.peak_torque_at_max_speed",
+         fmt::format("{} N m is above the peak torque servo.torque_limit ({} N m)", s.peak_torque_at_max_speed,
+                     s.torque_limit));
+  positive(s.continuous_torque, "servo.continuous_torque", "N m");
+  if (s.continuous_torque > s.torque_limit)
+    fail("servo.continuous_torque", fmt::format("{} N m is above the peak torque servo.torque_limit ({} N m)",
+                                                s.continuous_torque, s.torque_limit));
 
   positive(load_.mass, "load.mass", "kg");
   if (!load_.center_of_mass_P.allFinite()) fail("load.center_of_mass", "expected three finite numbers");
   for (int i = 0; i < 3; ++i) positive(load_.inertia[i], "load.inertia", "kg m^2 for each principal moment");
   non_negative(load_.gravity, "load.gravity", "m/s^2");
+  if (!load_.products.allFinite()) fail("load.products_of_inertia", "expected three finite numbers");
+  {
+    // A physical inertia tensor is positive definite and its principal moments obey the triangle
+    // inequality (each at most the sum of the other two).
+    const Eigen::SelfAdjointEigenSolver<Matrix3d> eig(load_.inertia_tensor(), Eigen::EigenvaluesOnly);
+    const Vector3d l = eig.eigenvalues();
+    if (!(l.minCoeff() > 0.0) || l[2] > (l[0] + l[1]) * (1.0 + 1e-12))
+      fail("load.products_of_inertia",
+           fmt::format("the inertia tensor has principal moments {:.6g}, {:.6g}, {:.6g} kg m^2: not a rigid body's "
+                       "(each must be > 0 and at most the sum of the other two)",
+                       l[0], l[1], l[2]));
+  }
+  const auto body = [](const LegBodySpec& b, const char* mass, const char* center, const char* axial,
+                       const char* transverse) {
+    non_negative(b.mass, mass, "kg");
+    if (!std::isfinite(b.center)) fail(center, fmt::format("expected a finite distance [m], got {}", b.center));
+    non_negative(b.axial_inertia, axial, "kg m^2");
+    non_negative(b.transverse_inertia, transverse, "kg m^2");
+  };
+  body(mechanism_.housing, "mechanism.housing.mass", "mechanism.housing.center", "mechanism.housing.axial_inertia",
+       "mechanism.housing.transverse_inertia");
+  body(mechanism_.rod, "mechanism.rod.mass", "mechanism.rod.center", "mechanism.rod.axial_inertia",
+       "mechanism.rod.transverse_inertia");
+  for (const auto& [v, field] : {std::pair{mechanism_.efficiency, "mechanism.efficiency"},
+                                 std::pair{mechanism_.back_efficiency, "mechanism.back_efficiency"}})
+    if (!std::isfinite(v) || !(v > 0.0) || v > 1.0) fail(field, fmt::format("expected a fraction in (0, 1], got {}", v));
 
   positive(simulation_.control_rate, "simulation.control_rate", "Hz");
   positive(simulation_.plant_step, "simulation.plant_step", "s");

@@ -20,6 +20,11 @@ struct ServoSpec {
   double torque_time_constant = 0.5e-3;          ///< current loop: first-order lag of the torque [s]; 0 = instant
   double torque_limit = 28.0;                    ///< peak motor torque [N m]
   double max_speed = 3000.0 * 2.0 * kPi / 60.0;  ///< motor speed limit [rad/s] (3000 rpm)
+  /// Torque-speed envelope (mechanism.hpp, peak_torque_at): the peak torque holds up to this speed
+  /// [rad/s] (2000 rpm) ...
+  double peak_corner_speed = 2000.0 * 2.0 * kPi / 60.0;
+  double peak_torque_at_max_speed = 16.0;  ///< ... and falls linearly to this at max_speed [N m]
+  double continuous_torque = 9.5;          ///< largest RMS torque the motor carries without overheating [N m]
   double encoder_counts = 1048576;               ///< encoder counts per motor revolution (20 bit)
   double gear_ratio = 1.0;                       ///< motor revolutions per screw revolution
   /// Frequency of the closed-loop poles from which the PID gains are derived when kp, ki and kd
@@ -40,6 +45,37 @@ struct LoadSpec {
   Vector3d inertia =
       Vector3d(540.0, 540.0, 1080.0);  ///< principal moments about the centre of mass, along P's axes [kg m^2]
   double gravity = 9.81;               ///< gravitational acceleration, along -z of B [m/s^2]
+  /// Products of inertia: the off-diagonal elements (Ixy, Ixz, Iyz) of the inertia tensor about the
+  /// centre of mass along P's axes, as they stand in the matrix (-integral of x y dm, ...) [kg m^2].
+  Vector3d products = Vector3d::Zero();
+
+  /// The inertia tensor about the centre of mass, along P's axes [kg m^2].
+  Matrix3d inertia_tensor() const noexcept {
+    Matrix3d I;
+    I << inertia.x(), products.x(), products.y(), products.x(), inertia.y(), products.z(), products.y(), products.z(),
+        inertia.z();
+    return I;
+  }
+};
+
+/// One body of a leg, axisymmetric about the leg axis.
+struct LegBodySpec {
+  double mass = 0.0;                ///< [kg]
+  double center = 0.0;              ///< centre of mass: distance from the body's own U-joint centre along the leg [m]
+  double axial_inertia = 0.0;       ///< about the leg axis [kg m^2]
+  double transverse_inertia = 0.0;  ///< about an axis across the leg through the centre of mass [kg m^2]
+};
+
+/// The legs' bodies and the screw's efficiency (docs/theory.md §12 says where the defaults come
+/// from: a 3 kW electric cylinder of the seed's 1.9 m legs). The rotor and screw inertia are in
+/// ServoSpec; the motor sits on the body at the leg's driven side (ModelSpec, LegSpec::driven).
+struct MechanismSpec {
+  /// Outer tube, motor, belt drive and screw, on the base U-joint.
+  LegBodySpec housing{38.0, 0.45, 0.06, 4.5};
+  /// Inner tube with nut and rod end, on the platform U-joint (center measured from that joint).
+  LegBodySpec rod{16.0, 0.60, 0.015, 2.3};
+  double efficiency = 0.90;       ///< screw efficiency, motor driving the load [-]
+  double back_efficiency = 0.80;  ///< screw efficiency, load driving the motor [-]
 };
 
 /// Rates of the simulation.
@@ -55,6 +91,7 @@ struct RigSpec {
   ServoSpec servo;
   LoadSpec load;
   SimulationSpec simulation;
+  MechanismSpec mechanism;
 };
 
 /// The validated rig, with the per-leg numbers derived once. Construction throws hexatwist::Error
@@ -63,12 +100,14 @@ class Rig {
  public:
   explicit Rig(const RigSpec& spec);
   /// A rig from an already validated model (the other parts are validated here).
-  Rig(Model model, const ServoSpec& servo, const LoadSpec& load, const SimulationSpec& simulation);
+  Rig(Model model, const ServoSpec& servo, const LoadSpec& load, const SimulationSpec& simulation,
+      const MechanismSpec& mechanism = {});
 
   const Model& model() const noexcept { return model_; }
   const ServoSpec& servo() const noexcept { return servo_; }
   const LoadSpec& load() const noexcept { return load_; }
   const SimulationSpec& simulation() const noexcept { return simulation_; }
+  const MechanismSpec& mechanism() const noexcept { return mechanism_; }
 
   /// Motor-side length per motor radian, lead_i / (2 pi gear_ratio) [m/rad].
   const Vector6d& motor_gain() const noexcept { return motor_gain_; }
@@ -95,6 +134,7 @@ class Rig {
   ServoSpec servo_;
   LoadSpec load_;
   SimulationSpec simulation_;
+  MechanismSpec mechanism_;
   Vector6d motor_gain_;
   Vector6d nominal_inertia_;
   Vector6d kp_, ki_, kd_;
