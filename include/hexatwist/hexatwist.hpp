@@ -11,6 +11,7 @@
 #include "hexatwist/limits.hpp"
 #include "hexatwist/measurement.hpp"
 #include "hexatwist/model.hpp"
+#include "hexatwist/motor_sizing.hpp"
 #include "hexatwist/parameter_errors.hpp"
 #include "hexatwist/pose.hpp"
 #include "hexatwist/registration.hpp"
