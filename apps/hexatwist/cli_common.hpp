@@ -139,6 +139,7 @@ Command make_fk_command(CLI::App& root);
 Command make_config_command(CLI::App& root);
 Command make_study_command(CLI::App& root);
 Command make_simulate_command(CLI::App& root);
+Command make_dynamics_command(CLI::App& root);
 Command make_stream_command(CLI::App& root);
 Command make_synth_command(CLI::App& root);
 Command make_measure_command(CLI::App& root);

@@ -245,6 +245,7 @@ const char* dash(Series::Style style) {
     case Series::Style::Dotted:
       return "3";
     case Series::Style::Solid:
+    case Series::Style::Points:
       break;
   }
   return "1";
@@ -338,9 +339,13 @@ FigureCommands figure_commands(const Figure& fig, std::size_t f, const std::vect
     out += "plot";
     for (std::size_t s = 0; s < pn.series.size(); ++s) {
       const Series& series = pn.series[s];
-      out += fmt::format("{} {} using 1:2 with lines lw {} lc rgb '{}' dt {} title {}", s == 0 ? "" : ",",
-                         block_name(f, p, s), kLineWidth, kPalette[s % kPalette.size()], dash(series.style),
-                         gp_string(series.label));
+      if (series.style == Series::Style::Points)
+        out += fmt::format("{} {} using 1:2 with points pt 7 ps 0.4 lc rgb '{}' title {}", s == 0 ? "" : ",",
+                           block_name(f, p, s), kPalette[s % kPalette.size()], gp_string(series.label));
+      else
+        out += fmt::format("{} {} using 1:2 with lines lw {} lc rgb '{}' dt {} title {}", s == 0 ? "" : ",",
+                           block_name(f, p, s), kLineWidth, kPalette[s % kPalette.size()], dash(series.style),
+                           gp_string(series.label));
       if (s + 1 < pn.series.size()) out += " \\\n ";
     }
     out += "\n";

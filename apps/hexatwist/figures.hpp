@@ -8,11 +8,12 @@
 
 namespace hexatwist::cli {
 
-/// One curve: y against x, drawn as a line. Non-finite points are left out (the line breaks there).
+/// One curve: y against x, drawn as a line (or as dots, Style::Points: a scatter of operating
+/// points). Non-finite points are left out (the line breaks there).
 struct Series {
   std::string label;         ///< legend text, drawn literally (no markup)
   std::vector<double> x, y;  ///< same length [caller's units]
-  enum class Style { Solid, Dashed, Dotted } style = Style::Solid;
+  enum class Style { Solid, Dashed, Dotted, Points } style = Style::Solid;
 };
 
 /// One plot with its own axes; colours follow the order of `series` (a fixed palette of six).

@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
       "the data do not determine the parameters."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
-  const std::vector<Command> commands{make_study_command(app),   make_simulate_command(app), make_synth_command(app),
+  const std::vector<Command> commands{make_study_command(app),   make_simulate_command(app), make_dynamics_command(app), make_synth_command(app),
                                       make_measure_command(app), make_identify_command(app), make_stream_command(app),   make_ik_command(app),
                                       make_fk_command(app),      make_config_command(app),   make_linuxcnc_command(app)};
   // Help and version go to standard output like every result: a failed write is exit 4.
@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
       if (word.starts_with("-")) continue;
       for (const Command& c : commands) chosen = chosen || c.app->get_name() == word;
       if (chosen) break;
-      print_error("hexatwist: error: ", fmt::format("unknown subcommand '{}'; expected study, simulate, synth, "
+      print_error("hexatwist: error: ", fmt::format("unknown subcommand '{}'; expected study, simulate, dynamics, synth, "
                                                     "measure, identify, stream, ik, fk, config or linuxcnc (see --help)",
                                                     word));
       return kExitBadInput;
