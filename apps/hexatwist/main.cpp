@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "hexatwist: twist-aware kinematics of lead-screw Stewart platforms.\n"
       "Poses are typed as x,y,z [m] and roll,pitch,yaw [deg] (R = Rz*Ry*Rx); all JSON output is SI (m, rad).\n"
-      "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit or numerical failure, 4 output not written, 5 identify: "
+      "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit, numerical failure or (dynamics) a motor outside its envelope, 4 output not written, 5 identify: "
       "the data do not determine the parameters."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
