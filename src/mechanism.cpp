@@ -1,20 +1,27 @@
 // Dynamics of the whole mechanism: velocities and accelerations of every body from the platform's
 // motion, Newton-Euler on each body, projected onto the platform's coordinates by virtual power
-// (docs/theory.md §12; the symbols below are the section's).
+// (docs/theory.md §14; the symbols below are the section's).
 #include "hexatwist/mechanism.hpp"
 
 #include <Eigen/LU>
 #include <cmath>
 
 #include "hexatwist/twist.hpp"
+#include "mechanism_internal.hpp"
 
 namespace hexatwist {
 namespace {
 
+Matrix3d skew(const Vector3d& v) noexcept {
+  Matrix3d S;
+  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return S;
+}
+
 // Below this |j x s|^2 a U-joint is at its singularity: the spin of its body is undefined.
 constexpr double kSingularSpin = 1e-12;
 
-// The spin coefficient of a U-joint body (theory §12): for fixed axis j, the body's angular
+// The spin coefficient of a U-joint body (theory §14): for fixed axis j, the body's angular
 // velocity about s is f . s' with f = (j.s)(j x s)/|j x s|^2, and its rate of change along s'
 // (with j' the axis's own velocity) is f'.
 struct SpinCoefficient {
@@ -22,18 +29,24 @@ struct SpinCoefficient {
   Vector3d f_dot;
 };
 
-SpinCoefficient spin_coefficient(const Vector3d& j, const Vector3d& j_dot, const Vector3d& s,
-                                 const Vector3d& s_dot) noexcept {
+// f for axis j at leg axis s.
+Vector3d spin_f(const Vector3d& j, const Vector3d& s) noexcept {
+  const Vector3d u = j.cross(s);
+  return (j.dot(s) / u.squaredNorm()) * u;
+}
+
+// f' for the axis moving at j' and the leg axis at s'.
+Vector3d spin_f_dot(const Vector3d& j, const Vector3d& j_dot, const Vector3d& s, const Vector3d& s_dot) noexcept {
   const double g = j.dot(s);
   const Vector3d u = j.cross(s);
   const double q = u.squaredNorm();
   const double g_dot = j_dot.dot(s) + j.dot(s_dot);
   const Vector3d u_dot = j_dot.cross(s) + j.cross(s_dot);
   const double q_dot = 2.0 * u.dot(u_dot);
-  return {(g / q) * u, ((g_dot * u + g * u_dot) - (g * q_dot / q) * u) / q};
+  return ((g_dot * u + g * u_dot) - (g * q_dot / q) * u) / q;
 }
 
-// One leg's velocity-level state (theory §12, "Velocities").
+// One leg's velocity-level state (theory §14, "Velocities").
 struct LegMotion {
   Vector3d s, a;            // unit leg axis; pivot to platform joint [m, B]
   Vector3d u;               // velocity of the platform joint P_i [m/s]
@@ -41,7 +54,8 @@ struct LegMotion {
   Vector3d s_dot_rel;       // s' - w x s: s' seen from the platform
   Vector3d omega;           // the platform's angular velocity [rad/s]
   SpinCoefficient fa, fd;   // spin coefficients of the housing (ja) and the rod (jd)
-  Vector3d jd;              // platform axis [B]
+  Vector3d ja, jd;          // base and platform axes [B]
+  bool has_axes = true;
   double l = 0, l_dot = 0;  // length and its rate
   double wh = 0, wr = 0;    // spin rates of housing and rod about s [rad/s]
   double phi_dot = 0;       // motor speed [rad/s]
@@ -50,38 +64,52 @@ struct LegMotion {
   bool rotor_on_rod = false;
 };
 
-Status leg_motion(const Rig& rig, const LegState& legs, int i, const Vector3d& v, const Vector3d& w,
-                  LegMotion& m) noexcept {
+// The parts that depend on the pose only.
+Status leg_position(const Rig& rig, const LegState& legs, int i, bool twist, LegMotion& m) noexcept {
   const Model& model = rig.model();
   const Leg& leg = model.leg(i);
   m.s = legs.s_B.row(i).transpose();
   m.a = legs.arm_B.row(i).transpose();
   m.l = legs.length[i];
+  m.k = twist ? leg.twist_gain : 0.0;
+  m.c = rig.motor_gain()[i];
+  m.rotor_on_rod = leg.driven == DrivenSide::Platform;
+  m.eps = m.rotor_on_rod ? leg.twist_sign : -leg.twist_sign;
+  m.has_axes = model.geometry().has_axes[i] != 0.0;
+  if (!m.has_axes) {
+    // No U-joint axes given: the bodies do not spin about the leg (and there is no twist).
+    m.fa.f.setZero();
+    m.fd.f.setZero();
+    m.ja.setZero();
+    m.jd.setZero();
+    return Status::Ok;
+  }
+  m.ja = leg.axis_base_B;
+  m.jd = legs.axis_platform_B.row(i).transpose();
+  if (m.ja.cross(m.s).squaredNorm() < kSingularSpin) return Status::SingularBase;
+  if (m.jd.cross(m.s).squaredNorm() < kSingularSpin) return Status::SingularPlatform;
+  m.fa.f = spin_f(m.ja, m.s);
+  m.fd.f = spin_f(m.jd, m.s);
+  return Status::Ok;
+}
+
+// The parts that depend on the platform's velocity too.
+void leg_velocity(const Vector3d& v, const Vector3d& w, LegMotion& m) noexcept {
   m.omega = w;
   m.u = v + w.cross(m.a);
   m.l_dot = m.s.dot(m.u);
   m.s_dot = (m.u - m.l_dot * m.s) / m.l;
   m.s_dot_rel = m.s_dot - w.cross(m.s);
-  m.k = leg.twist_gain;
-  m.c = rig.motor_gain()[i];
-  m.rotor_on_rod = leg.driven == DrivenSide::Platform;
-  m.eps = m.rotor_on_rod ? leg.twist_sign : -leg.twist_sign;
-  if (model.geometry().has_axes[i] == 0.0) {
-    // No U-joint axes given: the bodies do not spin about the leg (and there is no twist).
-    m.fa = m.fd = {Vector3d::Zero(), Vector3d::Zero()};
-    m.jd.setZero();
+  if (m.has_axes) {
+    m.fa.f_dot = spin_f_dot(m.ja, Vector3d::Zero(), m.s, m.s_dot);
+    m.fd.f_dot = spin_f_dot(m.jd, w.cross(m.jd), m.s, m.s_dot);
   } else {
-    const Vector3d& ja = leg.axis_base_B;
-    m.jd = legs.axis_platform_B.row(i).transpose();
-    if (ja.cross(m.s).squaredNorm() < kSingularSpin) return Status::SingularBase;
-    if (m.jd.cross(m.s).squaredNorm() < kSingularSpin) return Status::SingularPlatform;
-    m.fa = spin_coefficient(ja, Vector3d::Zero(), m.s, m.s_dot);
-    m.fd = spin_coefficient(m.jd, w.cross(m.jd), m.s, m.s_dot);
+    m.fa.f_dot.setZero();
+    m.fd.f_dot.setZero();
   }
   m.wh = m.fa.f.dot(m.s_dot);
   m.wr = w.dot(m.s) + m.fd.f.dot(m.s_dot_rel);
   m.phi_dot = (m.l_dot - m.k * (m.wr - m.wh)) / m.c;
-  return Status::Ok;
 }
 
 // One leg's accelerations: either the part linear in the platform's acceleration (bias = false;
@@ -110,7 +138,7 @@ LegAcceleration leg_acceleration(const LegMotion& m, const Vector3d& u_dd, const
 }
 
 // A leg's generalised force, as coefficients of the virtual velocities it is written in: the
-// virtual power is Au.du + As.ds' + cwh dwh + cwr dwr + cphi dphi' (theory §12).
+// virtual power is Au.du + As.ds' + cwh dwh + cwr dwr + cphi dphi' (theory §14).
 struct LegForce {
   Vector3d Au = Vector3d::Zero(), As = Vector3d::Zero();
   double cwh = 0, cwr = 0, cphi = 0;
@@ -206,67 +234,129 @@ struct Mechanism {
   Vector3d v, w;
 };
 
-Status mechanism_motion(const Rig& rig, const LegState& legs, const Vector6d& velocity, Mechanism& mech) noexcept {
+void set_velocity(const Vector6d& velocity, Mechanism& mech) noexcept {
   mech.v = velocity.head<3>();
   mech.w = velocity.tail<3>();
-  mech.platform = platform_frame(rig, legs.R_BP);
-  for (int i = 0; i < kLegs; ++i)
-    if (const Status s = leg_motion(rig, legs, i, mech.v, mech.w, mech.legs[static_cast<std::size_t>(i)]);
-        s != Status::Ok)
-      return s;
-  return Status::Ok;
+  for (LegMotion& m : mech.legs) leg_velocity(mech.v, mech.w, m);
 }
 
-// Generalised inertial force (legs and drives; platform separately) for the acceleration part of
-// `acc` [v'; w'] (bias = false) or the velocity products (bias = true; acc unused).
-void legs_force(const Rig& rig, const Mechanism& mech, const Vector6d& acc, bool bias, Part part, Vector6d& Q,
-                Vector6d& cphi) noexcept {
-  const Vector3d vd = acc.head<3>(), wd = acc.tail<3>();
-  for (int i = 0; i < kLegs; ++i) {
-    const LegMotion& m = mech.legs[static_cast<std::size_t>(i)];
-    const Vector3d u_dd = bias ? Vector3d(mech.w.cross(mech.w.cross(m.a))) : Vector3d(vd + wd.cross(m.a));
-    const LegAcceleration a = leg_acceleration(m, u_dd, bias ? Vector3d::Zero() : wd, bias);
-    LegForce F;
-    add_inertia(rig, m, a, bias, part, F);
-    add_generalised(m, F, Q);
-    cphi[i] += F.cphi;
-  }
+Status mechanism_motion(const Rig& rig, const LegState& legs, const Vector6d& velocity, Mechanism& mech,
+                        bool twist = true) noexcept {
+  mech.platform = platform_frame(rig, legs.R_BP);
+  for (int i = 0; i < kLegs; ++i)
+    if (const Status s = leg_position(rig, legs, i, twist, mech.legs[static_cast<std::size_t>(i)]); s != Status::Ok)
+      return s;
+  set_velocity(velocity, mech);
+  return Status::Ok;
 }
 
 Vector3d gravity_vector(const Rig& rig) noexcept { return Vector3d(0.0, 0.0, -rig.load().gravity); }
 
-// All parts of the generalised force at (legs, velocity, acceleration).
+// All parts of the generalised force at (legs, velocity, acceleration): each leg's accelerations
+// are computed once, split into the part linear in the platform's acceleration and the
+// velocity-product part (theory §14).
 struct Forces {
-  Vector6d gravity = Vector6d::Zero(), platform = Vector6d::Zero(), velocity = Vector6d::Zero(),
-           legs = Vector6d::Zero(), drives = Vector6d::Zero();
-  Vector6d cphi_velocity = Vector6d::Zero(), cphi_drives = Vector6d::Zero();
-  Vector6d velocity_drives = Vector6d::Zero();  // the drives' part of `velocity` (generalised)
-  Vector6d cphi_velocity_drives = Vector6d::Zero();
+  Vector6d gravity = Vector6d::Zero();          // -m g of every body
+  Vector6d platform = Vector6d::Zero();         // the platform's inertia, linear part
+  Vector6d velocity = Vector6d::Zero();         // velocity products of the platform and the leg bodies
+  Vector6d legs = Vector6d::Zero();             // the leg bodies' inertia, linear part
+  Vector6d drives = Vector6d::Zero();           // rotors and screws, linear part (generalised) ...
+  Vector6d cphi_drives = Vector6d::Zero();      // ... and through the motor angles
+  Vector6d drives_velocity = Vector6d::Zero();  // rotors and screws, velocity products (generalised) ...
+  Vector6d cphi_drives_velocity = Vector6d::Zero();  // ... and through the motor angles
+  Vector6d phi_dd = Vector6d::Zero();           // motor acceleration [rad/s^2]
+  Vector6d phi_dd_bias = Vector6d::Zero();      // its velocity-product part, J_phi' x'
 };
 
-void all_forces(const Rig& rig, const Mechanism& mech, const Vector6d& acceleration, bool with_gravity,
-                Forces& f) noexcept {
+// `linear` false: zero platform acceleration (only gravity and velocity products are computed).
+void all_forces(const Rig& rig, const Mechanism& mech, const Vector6d& acceleration, bool linear, Forces& f) noexcept {
   const double M = rig.load().mass;
   const PlatformFrame& p = mech.platform;
   const Vector3d& w = mech.w;
   const Vector3d vd = acceleration.head<3>(), wd = acceleration.tail<3>();
   const Vector3d g = gravity_vector(rig);
   // Platform: a_c = v' + w' x c + w x (w x c); torque about the centre of mass I w' + w x I w.
-  add_platform_force(p, M, vd + wd.cross(p.c), p.I * wd, f.platform);
+  if (linear) add_platform_force(p, M, vd + wd.cross(p.c), p.I * wd, f.platform);
   add_platform_force(p, M, w.cross(w.cross(p.c)), w.cross(p.I * w), f.velocity);
-  if (with_gravity) {
-    add_platform_force(p, M, -g, Vector3d::Zero(), f.gravity);
-    for (int i = 0; i < kLegs; ++i) {
-      LegForce F;
-      add_leg_gravity(rig, mech.legs[static_cast<std::size_t>(i)], g, F);
-      add_generalised(mech.legs[static_cast<std::size_t>(i)], F, f.gravity);
-    }
+  add_platform_force(p, M, -g, Vector3d::Zero(), f.gravity);
+  for (int i = 0; i < kLegs; ++i) {
+    const LegMotion& m = mech.legs[static_cast<std::size_t>(i)];
+    LegForce gravity;
+    add_leg_gravity(rig, m, g, gravity);
+    add_generalised(m, gravity, f.gravity);
+    const LegAcceleration bias = leg_acceleration(m, w.cross(w.cross(m.a)), Vector3d::Zero(), true);
+    LegForce legs_velocity, drives_velocity;
+    add_inertia(rig, m, bias, true, Part::Legs, legs_velocity);
+    add_inertia(rig, m, bias, true, Part::Drives, drives_velocity);
+    add_generalised(m, legs_velocity, f.velocity);
+    add_generalised(m, drives_velocity, f.drives_velocity);
+    f.cphi_drives_velocity[i] = drives_velocity.cphi;
+    f.phi_dd_bias[i] = bias.phi_dd;
+    f.phi_dd[i] = bias.phi_dd;
+    if (!linear) continue;
+    const LegAcceleration lin = leg_acceleration(m, vd + wd.cross(m.a), wd, false);
+    LegForce legs, drives;
+    add_inertia(rig, m, lin, false, Part::Legs, legs);
+    add_inertia(rig, m, lin, false, Part::Drives, drives);
+    add_generalised(m, legs, f.legs);
+    add_generalised(m, drives, f.drives);
+    f.cphi_drives[i] = drives.cphi;
+    f.phi_dd[i] += lin.phi_dd;
   }
-  Vector6d unused = Vector6d::Zero();
-  legs_force(rig, mech, acceleration, false, Part::Legs, f.legs, unused);
-  legs_force(rig, mech, acceleration, true, Part::Legs, f.velocity, unused);
-  legs_force(rig, mech, acceleration, false, Part::Drives, f.drives, f.cphi_drives);
-  legs_force(rig, mech, acceleration, true, Part::Drives, f.velocity_drives, f.cphi_velocity_drives);
+}
+
+// Adds w (the generalised direction of a velocity written in (u, w_platform) = (P_i', w)) as
+// weight * q q^T to M: q = [q_u; q_w + a x q_u] (theory §14, "Mass matrix").
+void add_rank_one(const Vector3d& a, const Vector3d& q_u, const Vector3d& q_w, double weight, Matrix6d& M) noexcept {
+  if (weight == 0.0) return;
+  Vector6d q;
+  q.head<3>() = q_u;
+  q.tail<3>() = q_w + a.cross(q_u);
+  M.noalias() += weight * q * q.transpose();
+}
+
+// The mass matrix from the kinetic energy, split into the load (platform and leg bodies) and the
+// drives (rotors and screws).
+void mass_matrix_of(const Rig& rig, const Mechanism& mech, Matrix6d& M_load, Matrix6d& M_drives) noexcept {
+  const PlatformFrame& p = mech.platform;
+  const double mass = rig.load().mass;
+  const Matrix3d C = skew(p.c);
+  M_load.topLeftCorner<3, 3>() = mass * Matrix3d::Identity();
+  M_load.topRightCorner<3, 3>() = -mass * C;
+  M_load.bottomLeftCorner<3, 3>() = mass * C;
+  M_load.bottomRightCorner<3, 3>() = p.I - mass * C * C;
+  M_drives.setZero();
+  const MechanismSpec& mc = rig.mechanism();
+  const ServoSpec& sv = rig.servo();
+  const LegBodySpec& h = mc.housing;
+  const LegBodySpec& r = mc.rod;
+  for (const LegMotion& m : mech.legs) {
+    const double il = 1.0 / m.l;
+    // Translation and tumbling of the leg bodies: K_uu = gamma I - beta s s^T with s' = P u / l.
+    const double tumble = (h.mass * h.center * h.center + h.transverse_inertia + r.transverse_inertia +
+                           r.mass * r.center * r.center) * il * il;
+    const double across = r.mass - 2.0 * r.mass * r.center * il + tumble;  // along P = I - s s^T
+    const double gamma = across, beta = across - r.mass;                  // K_uu = gamma I - beta s s^T
+    const Matrix3d A = skew(m.a);
+    M_load.topLeftCorner<3, 3>() += gamma * Matrix3d::Identity();
+    M_load.topRightCorner<3, 3>() -= gamma * A;
+    M_load.bottomLeftCorner<3, 3>() += gamma * A;
+    M_load.bottomRightCorner<3, 3>() -= gamma * A * A;
+    add_rank_one(m.a, m.s, Vector3d::Zero(), -beta, M_load);
+    // Spins about the leg: housing (fa / l on u), rod (fd / l on u, s + fd x s on w).
+    const Vector3d hu = m.fa.f * il;
+    const Vector3d ru = m.fd.f * il, rw = m.s + m.fd.f.cross(m.s);
+    add_rank_one(m.a, hu, Vector3d::Zero(), h.axial_inertia, M_load);
+    add_rank_one(m.a, ru, rw, r.axial_inertia, M_load);
+    // Rotor and screw: the driven body's spin plus eps phi' (or eps phi' / N).
+    const Vector3d pu = (m.s + m.k * il * (m.fa.f - m.fd.f)) / m.c;
+    const Vector3d pw = -m.k / m.c * rw;
+    const Vector3d Du = m.rotor_on_rod ? ru : hu;
+    const Vector3d Dw = m.rotor_on_rod ? rw : Vector3d::Zero();
+    const double inv_n = 1.0 / sv.gear_ratio;
+    add_rank_one(m.a, Du + m.eps * pu, Dw + m.eps * pw, sv.motor_inertia, M_drives);
+    add_rank_one(m.a, Du + m.eps * inv_n * pu, Dw + m.eps * inv_n * pw, sv.screw_inertia, M_drives);
+  }
 }
 
 Status motor_jacobian_of(const Mechanism& mech, Matrix6d& J) noexcept {
@@ -334,18 +424,23 @@ Status motor_angles(const Rig& rig, const Placement& placement, Vector6d& angle)
   return Status::Ok;
 }
 
-Vector6d drive_friction(const Rig& rig, const Vector6d& speed, const Vector6d& screw_torque) noexcept {
-  const ServoSpec& sv = rig.servo();
+Vector6d detail::efficiency_loss(const Rig& rig, const Vector6d& speed, const Vector6d& screw_torque) noexcept {
   const MechanismSpec& mech = rig.mechanism();
   const Vector6d d = drive_share(rig, speed, screw_torque);
   Vector6d f;
   for (int i = 0; i < kLegs; ++i) {
-    // Driving: tau = tau_s / eta; driven back: tau = tau_s * eta' (theory §12), blended by d.
+    // Driving: tau = tau_s / eta; driven back: tau = tau_s * eta' (theory §14), blended by d.
     const double factor = d[i] / mech.efficiency + (1.0 - d[i]) * mech.back_efficiency;
-    f[i] = sv.viscous_friction * speed[i] + sv.coulomb_friction * std::tanh(speed[i] / sv.friction_speed) +
-           (factor - 1.0) * screw_torque[i];
+    f[i] = (factor - 1.0) * screw_torque[i];
   }
   return f;
+}
+
+Vector6d drive_friction(const Rig& rig, const Vector6d& speed, const Vector6d& screw_torque) noexcept {
+  const ServoSpec& sv = rig.servo();
+  return sv.viscous_friction * speed +
+         sv.coulomb_friction * (speed / sv.friction_speed).array().tanh().matrix() +
+         detail::efficiency_loss(rig, speed, screw_torque);
 }
 
 Status inverse_dynamics(const Rig& rig, const PlatformMotion& motion, InverseDynamics& out) noexcept {
@@ -364,27 +459,18 @@ Status inverse_dynamics(const Rig& rig, const PlatformMotion& motion, InverseDyn
   Forces f;
   all_forces(rig, mech, motion.acceleration, true, f);
   Eigen::Matrix<double, 6, 6> rhs;
-  rhs << f.gravity, f.platform, f.velocity, f.legs, f.drives, f.velocity_drives;
+  rhs << f.gravity, f.platform, f.velocity, f.legs, f.drives, f.drives_velocity;
   const Eigen::Matrix<double, 6, 6> tau = lu.solve(rhs);
   out.gravity = tau.col(0);
   out.platform_inertia = tau.col(1);
   out.legs = tau.col(3);
   // The drives' share is all of their inertial torque (rotor and screw accelerating with phi'',
   // which has a velocity-product part of its own); velocity_product is that of the other bodies.
-  out.drives = tau.col(4) + f.cphi_drives + tau.col(5) + f.cphi_velocity_drives;
+  out.drives = tau.col(4) + f.cphi_drives + tau.col(5) + f.cphi_drives_velocity;
   out.velocity_product = tau.col(2);
 
-  for (int i = 0; i < kLegs; ++i) {
-    const LegMotion& m = mech.legs[static_cast<std::size_t>(i)];
-    out.speed[i] = m.phi_dot;
-    const Vector3d u_dd = motion.acceleration.head<3>() + motion.acceleration.tail<3>().cross(m.a) +
-                          m.omega.cross(m.omega.cross(m.a));
-    // phi'' in one pass: the linear and the velocity parts of the leg's accelerations.
-    const LegAcceleration lin = leg_acceleration(m, u_dd - m.omega.cross(m.omega.cross(m.a)),
-                                                 motion.acceleration.tail<3>(), false);
-    const LegAcceleration vel = leg_acceleration(m, m.omega.cross(m.omega.cross(m.a)), Vector3d::Zero(), true);
-    out.acceleration[i] = lin.phi_dd + vel.phi_dd;
-  }
+  for (int i = 0; i < kLegs; ++i) out.speed[i] = mech.legs[static_cast<std::size_t>(i)].phi_dot;
+  out.acceleration = f.phi_dd;
   out.angle = (out.legs_state.length - model.length_home() - model.geometry().twist_gain.cwiseProduct(dtheta))
                   .cwiseQuotient(rig.motor_gain());
   // What the screw passes to the load: everything but the drives' own inertia and friction.
@@ -401,17 +487,9 @@ Status mechanism_mass_matrix(const Rig& rig, const Placement& placement, Matrix6
   if (const Status s = inverse_kinematics(rig.model(), placement, legs); s != Status::Ok) return s;
   Mechanism mech;
   if (const Status s = mechanism_motion(rig, legs, Vector6d::Zero(), mech); s != Status::Ok) return s;
-  Matrix6d J;
-  motor_jacobian_of(mech, J);
-  for (int j = 0; j < 6; ++j) {
-    const Vector6d e = Vector6d::Unit(j);
-    Vector6d Q = Vector6d::Zero(), cphi = Vector6d::Zero();
-    add_platform_force(mech.platform, rig.load().mass, e.head<3>() + Vector3d(e.tail<3>()).cross(mech.platform.c),
-                       mech.platform.I * e.tail<3>(), Q);
-    legs_force(rig, mech, e, false, Part::Legs, Q, cphi);
-    legs_force(rig, mech, e, false, Part::Drives, Q, cphi);
-    M.col(j) = Q + J.transpose() * cphi;
-  }
+  Matrix6d M_drives;
+  mass_matrix_of(rig, mech, M, M_drives);
+  M += M_drives;
   return Status::Ok;
 }
 
@@ -424,8 +502,8 @@ Status mechanism_bias(const Rig& rig, const Placement& placement, const Vector6d
   Matrix6d J;
   motor_jacobian_of(mech, J);
   Forces f;
-  all_forces(rig, mech, Vector6d::Zero(), true, f);
-  bias = f.gravity + f.velocity + f.velocity_drives + J.transpose() * f.cphi_velocity_drives;
+  all_forces(rig, mech, Vector6d::Zero(), false, f);
+  bias = f.gravity + f.velocity + f.drives_velocity + J.transpose() * f.cphi_drives_velocity;
   return Status::Ok;
 }
 
@@ -493,6 +571,39 @@ Status potential_energy(const Rig& rig, const Placement& placement, double& ener
   energy = g * (height(legs) + rig.load().mass * placement.t.z() - height(home));
   return Status::Ok;
 }
+
+namespace detail {
+
+Status drive_load(const Rig& rig, const LegState& legs, const Vector6d& speed, const Vector6d& motor_acceleration,
+                  bool twist, DriveLoad& out) noexcept {
+  Mechanism mech;
+  if (const Status s = mechanism_motion(rig, legs, Vector6d::Zero(), mech, twist); s != Status::Ok) return s;
+  motor_jacobian_of(mech, out.jacobian);
+  Eigen::PartialPivLU<Matrix6d> lu_T;
+  if (const Status s = factor_transpose(out.jacobian, lu_T); s != Status::Ok) return s;
+  const Eigen::PartialPivLU<Matrix6d> lu(out.jacobian);
+  const Vector6d velocity = lu.solve(speed);
+  set_velocity(velocity, mech);
+  Matrix6d M_load, M_drives;
+  mass_matrix_of(rig, mech, M_load, M_drives);
+  Forces f;
+  all_forces(rig, mech, Vector6d::Zero(), false, f);
+  const Vector6d bias_load = f.gravity + f.velocity;
+  const Vector6d bias = bias_load + f.drives_velocity + out.jacobian.transpose() * f.cphi_drives_velocity;
+  const Vector6d& a_b = f.phi_dd_bias;  // the velocity-product part of the motor acceleration, J_phi' x'
+  // In motor angles: A phi'' = tau_net + L with A = J^-T M J^-1 and L = -J^-T bias + A a_b.
+  const Matrix6d Y = lu_T.solve(M_load + M_drives);  // J^-T M
+  out.inertia = lu_T.solve(Y.transpose()).transpose();
+  out.inertia = 0.5 * (out.inertia + out.inertia.transpose());
+  out.load = -lu_T.solve(bias) + out.inertia * a_b;
+  // What the screw passes to the load at the motor acceleration given.
+  const Vector6d x_dd = lu.solve(motor_acceleration - a_b);
+  out.screw_torque = lu_T.solve(M_load * x_dd + bias_load);
+  out.velocity = velocity;
+  return Status::Ok;
+}
+
+}  // namespace detail
 
 double peak_torque_at(const ServoSpec& servo, double speed) noexcept {
   const double w = std::abs(speed);

@@ -6,7 +6,8 @@
 #include <cmath>
 #include <utility>
 
-#include "hexatwist/dynamics.hpp"
+#include "hexatwist/kinematics.hpp"
+#include "mechanism_internal.hpp"
 #include "hexatwist/error.hpp"
 
 namespace hexatwist {
@@ -126,14 +127,14 @@ void Rig::validate_and_derive() {
   drive_inertia_ = s.motor_inertia + s.screw_inertia / (s.gear_ratio * s.gear_ratio);
   encoder_step_ = 2.0 * kPi / s.encoder_counts;
 
-  // The load each motor sees at home: the diagonal of the leg-space mass matrix, reflected
-  // through the screw (m = k theta, so the inertia scales with k^2).
+  // The inertia each motor sees at home: the diagonal of the whole mechanism's inertia in motor
+  // angles (drive, leg bodies and the platform reflected through the legs; theory §9, §14).
   LegState home;
-  LegDynamics dyn;
+  detail::DriveLoad at_home;
   if (inverse_kinematics(model_, Placement{}, home) != Status::Ok ||
-      leg_dynamics(model_, load_, home, LengthKind::Motor, dyn) != Status::Ok)
+      detail::drive_load(*this, home, Vector6d::Zero(), Vector6d::Zero(), true, at_home) != Status::Ok)
     throw Error("legs: the platform Jacobian is singular at home; cannot size the servo");
-  nominal_inertia_ = Vector6d::Constant(drive_inertia_) + motor_gain_.cwiseAbs2().cwiseProduct(dyn.mass.diagonal());
+  nominal_inertia_ = at_home.inertia.diagonal();
 
   if (derive) {
     const double w = 2.0 * kPi * s.pole_frequency;

@@ -3,8 +3,9 @@
 #include <Eigen/LU>
 #include <cmath>
 
-#include "hexatwist/dynamics.hpp"
+#include "hexatwist/mechanism.hpp"
 #include "hexatwist/servo.hpp"
+#include "mechanism_internal.hpp"
 
 namespace hexatwist {
 namespace {
@@ -46,17 +47,19 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   const bool compensated = twist_in_plant && strategy == Strategy::Compensated;
   std::vector<Vector6d> command(n);
   CommandReport report;
-  LegDynamics dyn;
+  InverseDynamics still;
   const double torque_limit = rig.servo().torque_limit;
   for (std::size_t k = 0; k < n; ++k) {
     if (const Status s = compute_commands(model, trajectory.poses[k], report); s != Status::Ok)
       return fail(issue, s, k, trajectory, report.limit);
     command[k] = compensated ? report.compensated : report.conventional;
-    // Every motor must at least be able to hold the load standing still at every pose.
-    if (const Status s = leg_dynamics(model, rig.load(), report.legs, LengthKind::Motor, dyn); s != Status::Ok)
-      return fail(issue, s, k, trajectory);
+    // Every motor must at least be able to hold the mechanism standing still at every pose
+    // (gravity's share of the inverse dynamics: platform, payload and legs).
+    PlatformMotion rest;
+    rest.placement = placement_from_pose(trajectory.poses[k]);
+    if (const Status s = inverse_dynamics(rig, rest, still); s != Status::Ok) return fail(issue, s, k, trajectory);
     for (int i = 0; i < kLegs; ++i) {
-      const double hold = std::abs(rig.motor_gain()[i] * dyn.gravity[i]);
+      const double hold = std::abs(still.gravity[i]);
       if (hold > torque_limit) {
         LimitReport limit;
         limit.status = Status::TorqueAboveMax;
@@ -140,7 +143,6 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
     return s;
 
   const Model& model = rig.model();
-  const LoadSpec& load = rig.load();
   const LengthKind kind = options.twist_in_plant ? LengthKind::Motor : LengthKind::Geometric;
   const Vector6d& gain = rig.motor_gain();
   const Vector3d& obs = model.spec().observation_P;
@@ -155,22 +157,25 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
                                           placement_from_pose(trajectory.poses[0]), fk);
       s != Status::Ok)
     return fail(issue, s, 0, trajectory);
-  LegDynamics dyn;
-  if (const Status s = leg_dynamics(model, load, fk.legs, kind, dyn); s != Status::Ok)
+  // The mechanism's load on the motors (docs/theory.md §9, §14), at the start and then once per
+  // control period, held over it.
+  detail::DriveLoad load;
+  Vector6d motor_acceleration = plan.reference[0].acceleration;
+  if (const Status s = detail::drive_load(rig, fk.legs, drives.speed, motor_acceleration, options.twist_in_plant, load);
+      s != Status::Ok)
     return fail(issue, s, 0, trajectory);
-  // Holding torque: the motor balances the gravity force along its leg (m = k theta).
-  const Vector6d load_torque0 = gain.cwiseProduct(dyn.gravity);
+  // Holding torque: the motor balances the load (and the viscous friction at its speed).
+  const Vector6d holding = rig.servo().viscous_friction * drives.speed - load.load +
+                           detail::efficiency_loss(rig, drives.speed, load.screw_torque);
   Vector6d measured;
   read_encoder(rig, drives.angle, measured);
   ControllerState controller;
-  const Vector6d holding = rig.servo().viscous_friction * drives.speed - load_torque0;
   start_controller(rig, measured, holding, controller);
   drives.torque = holding;
 
   Vector6d twist_ref = Vector6d::Zero();
   Vector6d twist_now;
   Vector6d torque;
-  Matrix6d A;
   samples.reserve(n);
   for (std::size_t k = 0; k < n; ++k) {
     read_encoder(rig, drives.angle, measured);
@@ -193,12 +198,16 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
     if (options.progress && (k % kProgressEvery == 0 || k + 1 == n)) options.progress(k + 1, n);
     if (k + 1 == n) break;
 
-    // The load at the current pose, held over the control period.
-    if (const Status s = leg_dynamics(model, load, fk.legs, kind, dyn); s != Status::Ok)
-      return fail(issue, s, k, trajectory);
-    A = gain.asDiagonal() * dyn.mass * gain.asDiagonal();
-    A.diagonal().array() += rig.drive_inertia();
-    integrate_drives(rig, A.inverse(), gain.cwiseProduct(dyn.gravity), torque, drives);
+    // The load at the current state, held over the control period; the efficiency loss from the
+    // screw torque at the last period's motor acceleration.
+    if (k > 0)
+      if (const Status s = detail::drive_load(rig, fk.legs, drives.speed, motor_acceleration, options.twist_in_plant, load);
+          s != Status::Ok)
+        return fail(issue, s, k, trajectory);
+    const Vector6d speed_before = drives.speed;
+    integrate_drives(rig, load.inertia.inverse(), load.load - detail::efficiency_loss(rig, drives.speed, load.screw_torque),
+                     torque, drives);
+    motor_acceleration = (drives.speed - speed_before) / rig.control_period();
     motor = model.length_home() + gain.cwiseProduct(drives.angle);
     const Placement previous = fk.placement;  // warm start from the last tick
     if (const Status s =

@@ -69,7 +69,9 @@ TEST_P(SeedTest, CompensationIsExactAndAddsNothingToTheServoError) {
   EXPECT_LE(worst, 1e-6) << test.name;  // the 1 um; measured <= 1.0e-7 m (Lx)
   EXPECT_LE(run.compensated.total.max - run.compensated.tracking_only.max, 1e-6) << test.name;
   // The conventional loop carries the twist error, far above the servo's.
-  EXPECT_GT(run.conventional.total.max, 10 * run.conventional.tracking_only.max) << test.name;  // measured 20-90x
+  // Measured 7-32x on the full mechanism (20-90x without the screw's efficiency, whose load-dependent
+  // losses the integrators take out: theory §9).
+  EXPECT_GT(run.conventional.total.max, 5 * run.conventional.tracking_only.max) << test.name;
   EXPECT_NEAR(run.conventional.total.max, run.conventional.twist_only.max, 0.02 * run.conventional.twist_only.max);
   EXPECT_EQ(run.conventional.tracking_only.max, run.compensated.tracking_only.max);
 }

@@ -1,4 +1,4 @@
-// Dynamics of the whole mechanism (docs/theory.md §12): the platform with its payload, the two
+// Dynamics of the whole mechanism (docs/theory.md §14): the platform with its payload, the two
 // bodies of each leg (housing with the motor on the base U-joint, rod with the nut on the platform
 // U-joint), the rotor and screw spinning about the leg, screw efficiency and friction. The rods
 // spin with the twist, and the screw's angle in its nut is the motor's angle plus the twist.
@@ -22,7 +22,7 @@ struct PlatformMotion {
 };
 
 /// The motion of a pose given in roll-pitch-yaw with its time derivatives: w = E(rpy) rpy',
-/// w' = E rpy'' + E' rpy' (docs/theory.md §12).
+/// w' = E rpy'' + E' rpy' (docs/theory.md §14).
 PlatformMotion platform_motion(const Pose& pose, const Vector6d& pose_rate, const Vector6d& pose_acceleration) noexcept;
 
 /// Motor torques for a motion, and what they are made of. The six contributions add up to
@@ -44,7 +44,7 @@ struct InverseDynamics {
 };
 
 /// Motor torques for `motion` (Newton-Euler on every body, projected by virtual power;
-/// docs/theory.md §12). Returns the status of inverse kinematics or of the twist Jacobian, or
+/// docs/theory.md §14). Returns the status of inverse kinematics or of the twist Jacobian, or
 /// SingularJacobian where the motor angles do not determine the pose. Limits are not checked.
 [[nodiscard]] Status inverse_dynamics(const Rig& rig, const PlatformMotion& motion, InverseDynamics& out) noexcept;
 
@@ -64,7 +64,7 @@ struct InverseDynamics {
 [[nodiscard]] Status motor_angles(const Rig& rig, const Placement& placement, Vector6d& angle) noexcept;
 
 /// Friction torque at each motor shaft for motor speeds `speed` and the torque the screw
-/// transmits to the load `screw_torque` (docs/theory.md §12): viscous + smoothed dry friction +
+/// transmits to the load `screw_torque` (docs/theory.md §14): viscous + smoothed dry friction +
 /// the efficiency loss [N m].
 Vector6d drive_friction(const Rig& rig, const Vector6d& speed, const Vector6d& screw_torque) noexcept;
 

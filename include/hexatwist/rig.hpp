@@ -66,7 +66,7 @@ struct LegBodySpec {
   double transverse_inertia = 0.0;  ///< about an axis across the leg through the centre of mass [kg m^2]
 };
 
-/// The legs' bodies and the screw's efficiency (docs/theory.md §12 says where the defaults come
+/// The legs' bodies and the screw's efficiency (docs/theory.md §14 says where the defaults come
 /// from: a 3 kW electric cylinder of the seed's 1.9 m legs). The rotor and screw inertia are in
 /// ServoSpec; the motor sits on the body at the leg's driven side (ModelSpec, LegSpec::driven).
 struct MechanismSpec {
