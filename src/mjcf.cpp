@@ -10,11 +10,15 @@
 namespace hexatwist {
 namespace {
 
-// Stand-ins for the bodies hexatwist treats as massless (rod ends, the rotor's and screw's mass,
-// which is in the housing's or rod's): MuJoCo needs every moving body's mass and inertia above
-// mjMINVAL (1e-15).
+// Mass and inertia are shared out so that no constrained body is nearly massless (MuJoCo scales
+// each constraint's softness by its bodies' inverse weights, docs/theory.md §14): the rod end,
+// welded to the platform, carries 1/7 of the load; rotor and screw, whose centre of mass is put at
+// the centre of mass of the leg body that carries them, carry 1/3 of that body's mass each.
+// kTinyMass stands in for a mass of 0 (MuJoCo needs > mjMINVAL); kTinyInertia keeps a disc's
+// inertia on the right side of MuJoCo's check A + B >= C after rounding.
 constexpr double kTinyMass = 1e-6;      // [kg]
 constexpr double kTinyInertia = 1e-9;   // [kg m^2]
+constexpr double kLoadShare = 1.0 / 7.0;  // of the load, in the platform body and in each rod end
 // Solver settings (docs/theory.md §14: the step and the constraints' stiffness were chosen by
 // the study of bench/bench_mjcf.cpp and the residuals of tests/test_mjcf.cpp).
 constexpr double kTimestep = 1e-3;      // [s]
@@ -90,8 +94,13 @@ std::string mjcf_model(const Rig& rig) {
   const Matrix3d I_rod_platform = any_platform ? leg_body_inertia(mech.rod, lumped, "mechanism.rod.transverse_inertia")
                                                : Matrix3d::Zero();
   const Matrix3d I_rod_plain = leg_body_inertia(mech.rod, 0.0, "mechanism.rod.transverse_inertia");
-  const double housing_mass = std::max(mech.housing.mass, kTinyMass);
-  const double rod_mass = std::max(mech.rod.mass, kTinyMass);
+  // The mass of the body carrying motor and screw is split in three (itself, rotor, screw).
+  const double housing_share = std::max(mech.housing.mass / 3.0, kTinyMass);
+  const double rod_share = std::max(mech.rod.mass / 3.0, kTinyMass);
+  const double housing_whole = std::max(mech.housing.mass, kTinyMass);
+  const double rod_whole = std::max(mech.rod.mass, kTinyMass);
+  const double load_share = std::max(load.mass * kLoadShare, kTinyMass);
+  const Matrix3d load_inertia_share = kLoadShare * load.inertia_tensor();
 
   std::string t = fmt::format(
       "<!-- MuJoCo model (MJCF) of the lead-screw Stewart platform \"{}\", written by hexatwist (hexatwist mjcf).\n"
@@ -101,12 +110,13 @@ std::string mjcf_model(const Rig& rig) {
       "     about the leg axis s (legN_screw + legN_nut = the rod's rotation relative to the housing, hexatwist's\n"
       "     twist; legN_slide = leg length minus its home length); endN on the rod (hinges legN_je = unit(s x jd),\n"
       "     fixed in the rod, then legN_jd, fixed in the platform), welded to the platform (legN_weld).\n"
-      "     legN_helix: the screw-nut pair, slide = sigma lead / 2 pi * nut; legN_gear: screw = +-rotor / N.\n"
+      "     legN_helix: the screw-nut pair, nut = slide / (sigma lead / 2 pi); legN_gear: screw = +-rotor / N.\n"
       "     motorN drives legN_rotor; its force is the motor torque [N m], positive lengthens the leg.\n"
-      "     Massless parts (rotor and screw mass, rod ends) carry {} kg and {} kg m^2 (MuJoCo needs > 0); the\n"
-      "     rotor's and screw's transverse inertia (J/2, a disc's) is taken out of the body that carries them.\n"
+      "     Shares: the platform body and each rod end carry 1/7 of the load's mass and inertia (the rod ends are\n"
+      "     welded to the platform); rotor, screw and the leg body carrying them 1/3 of its mass each, all at its\n"
+      "     centre of mass; the rotor's and screw's transverse inertia (J/2, a disc's) is taken out of that body.\n"
       "     docs/theory.md section 14 describes the model. -->\n",
-      comment_text(model.spec().name), num(kTinyMass), num(kTinyInertia));
+      comment_text(model.spec().name));
   t += fmt::format("<mujoco model=\"hexatwist\">\n"
                    "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>\n"
                    "  <option timestep=\"{}\" gravity=\"0 0 {}\" integrator=\"Euler\" solver=\"Newton\" "
@@ -140,20 +150,22 @@ std::string mjcf_model(const Rig& rig) {
     const Vector3d c_h = mech.housing.center * s;          // from the base joint [m, B]
     const Vector3d c_r = (L - mech.rod.center) * s;        // from the base joint, at home [m, B]
     const auto indent = [](int level) { return std::string(static_cast<std::size_t>(2 * level), ' '); };
+    const double motor_body_share = base_driven ? housing_share : rod_share;
     const auto rotor_body = [&](int level, const Vector3d& com) {
       return fmt::format("{0}<body name=\"rotor{1}\">\n"
                          "{0}  <joint name=\"leg{1}_rotor\" type=\"hinge\" axis=\"{2}\"/>\n"
                          "{0}  {3}\n"
                          "{0}</body>\n",
-                         indent(level), n, vec(s), inertial(com, kTinyMass, axisymmetric(s, Jm, disc(Jm))));
+                         indent(level), n, vec(s), inertial(com, motor_body_share, axisymmetric(s, Jm, disc(Jm))));
     };
     const auto end_body = [&](int level) {
       return fmt::format("{0}<body name=\"end{1}\">\n"
                          "{0}  <joint name=\"leg{1}_je\" type=\"hinge\" axis=\"{2}\"/>\n"
                          "{0}  <joint name=\"leg{1}_jd\" type=\"hinge\" axis=\"{3}\"/>\n"
-                         "{0}  <inertial pos=\"0 0 0\" mass=\"{4}\" diaginertia=\"{5} {5} {5}\"/>\n"
+                         "{0}  {4}\n"
                          "{0}</body>\n",
-                         indent(level), n, vec(je), vec(jd), num(kTinyMass), num(kTinyInertia));
+                         indent(level), n, vec(je), vec(jd),
+                         inertial(load.center_of_mass_P - leg.platform_P, load_share, load_inertia_share));
     };
     const std::string rod_geom = fmt::format("<geom type=\"capsule\" fromto=\"0 0 0 {}\" size=\"0.02\" rgba=\"0.7 0.7 0.75 1\"/>",
                                              vec(-0.5 * L * s));
@@ -167,7 +179,7 @@ std::string mjcf_model(const Rig& rig) {
                      "      <joint name=\"leg{0}_jb\" type=\"hinge\" axis=\"{3}\"/>\n"
                      "      {4}\n"
                      "      {5}\n",
-                     n, vec(leg.base_B), vec(ja), vec(jb), inertial(c_h, housing_mass, I_h), housing_geom);
+                     n, vec(leg.base_B), vec(ja), vec(jb), inertial(c_h, base_driven ? housing_share : housing_whole, I_h), housing_geom);
     if (base_driven) {
       // Motor and screw in the housing, nut in the rod.
       t += rotor_body(3, c_h);
@@ -179,8 +191,8 @@ std::string mjcf_model(const Rig& rig) {
                        "          <joint name=\"leg{0}_slide\" type=\"slide\" axis=\"{1}\"/>\n"
                        "          {4}\n"
                        "          {5}\n",
-                       n, vec(s), inertial(c_h, kTinyMass, axisymmetric(s, Js, disc(Js))), vec(L * s),
-                       inertial(-mech.rod.center * s, rod_mass, I_r), rod_geom);
+                       n, vec(s), inertial(c_h, housing_share, axisymmetric(s, Js, disc(Js))), vec(L * s),
+                       inertial(-mech.rod.center * s, rod_whole, I_r), rod_geom);
       t += end_body(5);
       t += "        </body>\n      </body>\n";
     } else {
@@ -194,8 +206,8 @@ std::string mjcf_model(const Rig& rig) {
                        "          <joint name=\"leg{0}_screw\" type=\"hinge\" axis=\"{1}\"/>\n"
                        "          {4}\n"
                        "          {5}\n",
-                       n, vec(s), inertial(c_r, kTinyMass, axisymmetric(s, Js, disc(Js))), vec(L * s),
-                       inertial(-mech.rod.center * s, rod_mass, I_r), rod_geom);
+                       n, vec(s), inertial(c_r, rod_share, axisymmetric(s, Js, disc(Js))), vec(L * s),
+                       inertial(-mech.rod.center * s, rod_share, I_r), rod_geom);
       t += rotor_body(5, -mech.rod.center * s);
       t += end_body(5);
       t += "        </body>\n      </body>\n";
@@ -210,19 +222,22 @@ std::string mjcf_model(const Rig& rig) {
                    "      <geom type=\"cylinder\" pos=\"{}\" size=\"{} 0.03\" rgba=\"0.2 0.45 0.7 0.6\"/>\n"
                    "    </body>\n"
                    "  </worldbody>\n",
-                   vec(platform_home_B), inertial(com_P, std::max(load.mass, kTinyMass), load.inertia_tensor()),
+                   vec(platform_home_B), inertial(com_P, load_share, load_inertia_share),
                    vec(model.spec().pivot_P), num(model.condition_length()));
   t += "  <equality>\n";
   for (int i = 0; i < kLegs; ++i) {
     const Leg& leg = model.leg(i);
     const int n = i + 1;
+    // The screw-nut pair as nut = slide / k, in radians: MuJoCo softens a joint equality by the sum of
+    // its two joints' inverse weights whatever the coefficient, and the nut's (1/J_s) would make
+    // a row in metres 1/k^2 softer (docs/theory.md §14).
     // The rotor's angle relative to the body carrying the motor is -sigma phi (base-driven) or
     // +sigma phi (platform-driven), phi the motor angle that lengthens the leg (theory §4).
     const double gear_sign = leg.driven == DrivenSide::Base ? 1.0 : -1.0;
     t += fmt::format("    <weld name=\"leg{0}_weld\" body1=\"platform\" body2=\"end{0}\"/>\n"
-                     "    <joint name=\"leg{0}_helix\" joint1=\"leg{0}_slide\" joint2=\"leg{0}_nut\" polycoef=\"0 {1} 0 0 0\"/>\n"
+                     "    <joint name=\"leg{0}_helix\" joint1=\"leg{0}_nut\" joint2=\"leg{0}_slide\" polycoef=\"0 {1} 0 0 0\"/>\n"
                      "    <joint name=\"leg{0}_gear\" joint1=\"leg{0}_screw\" joint2=\"leg{0}_rotor\" polycoef=\"0 {2} 0 0 0\"/>\n",
-                     n, num(leg.twist_gain), num(gear_sign / N));
+                     n, num(1.0 / leg.twist_gain), num(gear_sign / N));
   }
   t += "  </equality>\n  <actuator>\n";
   for (int i = 0; i < kLegs; ++i) {

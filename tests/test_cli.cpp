@@ -1152,7 +1152,7 @@ TEST(CliMjcf, WritesTheMujocoModelToStdoutOrAFileAndNoFileOnBadInput) {
   const std::string malformed = write_file("mjcf_malformed.yaml", replace_line(kSymmetric, 4, "  Rb: abc"));
   expect_error(run({"mjcf", "--config", malformed, "--out", bad_out}), 2, {"mjcf_malformed.yaml", "Rb"});
   const std::string plain = write_file("mjcf_plain.yaml", replace_line(kSymmetric, 9, "  lead: 0"));
-  expect_error(run({"mjcf", "--config", plain, "--out", bad_out}), 2, {"leg 1", "lead"});
+  expect_error(run({"mjcf", "--config", plain, "--out", bad_out}), 2, {"mjcf_plain.yaml", "lead"});
   expect_error(run({"mjcf", "--config", (temp_dir() / "missing.yaml").string(), "--out", bad_out}), 2, {"missing.yaml"});
   EXPECT_FALSE(std::filesystem::exists(bad_out));
   expect_error(run({"mjcf", "--out", (temp_dir() / "no/such/dir/x.xml").string()}), 4, {"x.xml"});
