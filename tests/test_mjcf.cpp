@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "hexatwist/mechanism.hpp"
 #include "mjcf_support.hpp"
 #include "support.hpp"
 
@@ -32,6 +33,12 @@ std::vector<std::pair<std::string, Rig>> rigs() {
   spec.model.legs[2].length_offset = 0.002;
   r.emplace_back("platform-driven left-hand gear 2", Rig(spec));
   return r;
+}
+
+std::string fmt_vector(const Vector6d& v) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "[%.3f %.3f %.3f %.3f %.3f %.3f]", v[0], v[1], v[2], v[3], v[4], v[5]);
+  return buf;
 }
 
 Placement placement(double x, double y, double z, double roll_deg, double pitch_deg, double yaw_deg) {
@@ -245,6 +252,88 @@ TEST(Mjcf, ALegBodyLighterAcrossThanItsRotorAndScrewIsRefusedNamingTheField) {
   mech.housing.transverse_inertia = 1e-3;  // less than (J_m + J_s) / 2 = 1.1e-3
   const Rig rig(seed.model(), seed.servo(), seed.load(), seed.simulation(), mech);
   expect_error_line([&] { (void)mjcf_model(rig); }, "mechanism.housing.transverse_inertia:", {"rotor", "rigid"});
+}
+
+}  // namespace
+}  // namespace hexatwist::test
+
+namespace hexatwist::test {
+namespace {
+
+// A fast motion: x 0.2 m and yaw 25 deg at 0.6 Hz (0.75 m/s, 94 deg/s), with heave and roll.
+struct FastMotion {
+  static constexpr double w = 2.0 * kPi * 0.6;  // [rad/s]
+  Vector6d amplitude = (Vector6d() << 0.2, 0.0, 0.05, deg2rad(4.0), 0.0, deg2rad(25.0)).finished();
+  Vector6d frequency = (Vector6d() << 1.0, 1.0, 2.0, 1.0, 1.0, 1.0).finished();
+  Vector6d phase = (Vector6d() << 0.0, 0.0, 0.3, 1.0, 0.0, 0.5).finished();
+  // Pose [m, rad] and its first and second time derivatives at t.
+  void at(double t, Vector6d& q, Vector6d& qd, Vector6d& qdd) const {
+    for (int k = 0; k < 6; ++k) {
+      const double a = frequency[k] * w;
+      q[k] = amplitude[k] * std::sin(a * t + phase[k]);
+      qd[k] = amplitude[k] * a * std::cos(a * t + phase[k]);
+      qdd[k] = -amplitude[k] * a * a * std::sin(a * t + phase[k]);
+    }
+  }
+  Placement placement(double t) const {
+    Vector6d q, qd, qdd;
+    at(t, q, qd, qdd);
+    return placement_from_pose(Pose{q.head<3>(), q.tail<3>()});
+  }
+};
+
+TEST(Mjcf, MujocoInverseDynamicsGivesHexatwistsMotorTorquesWithoutFriction) {
+  RigSpec spec{default_config().rig.model().spec(), default_config().rig.servo(), default_config().rig.load(),
+               default_config().rig.simulation(), default_config().rig.mechanism()};
+  spec.servo.viscous_friction = spec.servo.coulomb_friction = 0.0;
+  spec.mechanism.efficiency = spec.mechanism.back_efficiency = 1.0;
+  const Rig rig(spec);
+  const Model& model = rig.model();
+  MjSim sim(mjcf_model(rig));
+  const FastMotion motion;
+  const double h = 2e-4, period = 1.0 / 0.6;
+  const int nv = sim.m->nv, nq = sim.m->nq;
+  Eigen::VectorXd q_minus(nq), q0(nq), q_plus(nq), v1(nv), v2(nv), qvel(nv), qacc(nv);
+  double worst = 0.0, peak = 0.0;
+  for (int k = 0; k < 50; ++k) {
+    const double t = period * k / 50.0;
+    for (auto [dt, q] : {std::pair{-h, &q_minus}, std::pair{0.0, &q0}, std::pair{h, &q_plus}}) {
+      ASSERT_LT(pose_and_solve(sim, model, motion.placement(t + dt), k == 0 && dt < 0 ? 4 : 1), 1e-12);
+      *q = Eigen::Map<const Eigen::VectorXd>(sim.d->qpos, nq);
+    }
+    mj_differentiatePos(sim.m, qvel.data(), 2.0 * h, q_minus.data(), q_plus.data());
+    mj_differentiatePos(sim.m, v1.data(), h, q_minus.data(), q0.data());
+    mj_differentiatePos(sim.m, v2.data(), h, q0.data(), q_plus.data());
+    qacc = (v2 - v1) / h;
+    Eigen::Map<Eigen::VectorXd>(sim.d->qpos, nq) = q0;
+    Eigen::Map<Eigen::VectorXd>(sim.d->qvel, nv) = qvel;
+    Eigen::Map<Eigen::VectorXd>(sim.d->qacc, nv) = qacc;
+    mj_inverse(sim.m, sim.d);
+    // qfrc_inverse = Jc^T lambda + (actuator moments)^T tau.
+    const int ne = sim.d->nefc;
+    Eigen::MatrixXd A(nv, ne + 6);
+    A.leftCols(ne) = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+                         sim.d->efc_J, ne, nv).transpose();
+    A.rightCols(6) = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+                         sim.d->actuator_moment, 6, nv).transpose();
+    const Eigen::VectorXd x = A.colPivHouseholderQr().solve(Eigen::Map<const Eigen::VectorXd>(sim.d->qfrc_inverse, nv));
+    const Vector6d tau_mj = x.tail(6);
+
+    Vector6d q, qd, qdd;
+    motion.at(t, q, qd, qdd);
+    const PlatformMotion pm = platform_motion(Pose{q.head<3>(), q.tail<3>()}, qd, qdd);
+    InverseDynamics id;
+    ASSERT_EQ(inverse_dynamics(rig, pm, id), Status::Ok);
+    worst = std::max(worst, (tau_mj - id.torque).cwiseAbs().maxCoeff());
+    peak = std::max(peak, id.torque.cwiseAbs().maxCoeff());
+    if (k % 10 == 0)
+      std::printf("  t %.3f s: |v| %.3f m/s, |w| %.1f deg/s, tau_hx %s, max |tau_mj - tau_hx| %.3g N m\n", t,
+                  pm.velocity.head<3>().norm(), rad2deg(pm.velocity.tail<3>().norm()),
+                  fmt_vector(id.torque).c_str(), (tau_mj - id.torque).cwiseAbs().maxCoeff());
+  }
+  report("max |tau_mujoco - tau_hexatwist| [N m]", worst);
+  report("peak |tau_hexatwist| [N m]", peak);
+  EXPECT_LT(worst, 1e-6 * peak);  // measured 2.3e-6 N m of 23 N m (the issue asked for 0.5 %)
 }
 
 }  // namespace
