@@ -64,7 +64,7 @@ void BM_MjStep(benchmark::State& state) {
   state.counters["sim_s_per_wall_s"] =
       benchmark::Counter(dt * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_MjStep)->Arg(2000)->Arg(1000)->Arg(500)->Arg(250)->Arg(100)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_MjStep)->Arg(2000)->Arg(1000)->Arg(500)->Arg(400)->Arg(250)->Arg(100)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

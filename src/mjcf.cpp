@@ -21,8 +21,8 @@ constexpr double kTinyInertia = 1e-9;   // [kg m^2]
 constexpr double kLoadShare = 1.0 / 7.0;  // of the load, in the platform body and in each rod end
 // Solver settings (docs/theory.md §14: the step and the constraints' stiffness were chosen by
 // the study of bench/bench_mjcf.cpp and the residuals of tests/test_mjcf.cpp).
-constexpr double kTimestep = 1e-3;      // [s]
-constexpr double kTimeConstant = 2e-3;  // equality constraints' time constant, 2 timesteps [s]
+constexpr double kTimestep = 4e-4;      // [s]
+constexpr double kTimeConstant = 8e-4;  // equality constraints' time constant, 2 timesteps [s]
 
 // Numbers that read back to the same double.
 std::string num(double v) { return fmt::format("{}", v == 0.0 ? 0.0 : v); }  // shortest exact form

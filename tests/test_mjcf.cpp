@@ -188,7 +188,7 @@ Settled settle(const Rig& rig, const Vector6d& phi, const Placement& start, bool
   for (int k = 0; k < sim.m->nv; ++k) sim.m->dof_damping[k] = 200.0;
   for (int k = 0; k < 6; ++k) sim.m->dof_damping[sim.platform_dof() + k] = 2e4;
   Settled out;
-  for (out.steps = 0; out.steps < 20000; ++out.steps) {
+  for (out.steps = 0; out.steps < 60000; ++out.steps) {
     mj_step(sim.m, sim.d);
     double v = 0.0;
     for (int k = 0; k < sim.m->nv; ++k) v = std::max(v, std::abs(sim.d->qvel[k]));
@@ -228,15 +228,15 @@ TEST(Mjcf, WithTheMotorsHeldThePlatformRestsAtTwistAwareForwardKinematics) {
                 s.residual);
     report("|t_mujoco - t_fk| [m]", dt);
     report("rotation between them [rad]", dr);
-    EXPECT_LT(dt, 2e-7);  // measured 2.2e-8 m, 1.9e-9 rad: the equalities' softness under the load
-    EXPECT_LT(dr, 2e-8);
+    EXPECT_LT(dt, 4e-8);  // measured 3.5e-9 m, 3.0e-10 rad: the equalities' softness under the load
+    EXPECT_LT(dr, 4e-9);
 
     const Settled blind = settle(rig, phi, start, true);
     const double dt_blind = (blind.placement.t - fk.placement.t).norm();
     report("twist coupling removed: |t_mujoco - t_fk| [m]", dt_blind);
     report("twist coupling removed: |t_mujoco - t_geometric_fk| [m]", (blind.placement.t - geometric.placement.t).norm());
     EXPECT_GT(dt_blind, 50e-6);
-    EXPECT_LT((blind.placement.t - geometric.placement.t).norm(), 2e-7);
+    EXPECT_LT((blind.placement.t - geometric.placement.t).norm(), 4e-8);
   }
 }
 
