@@ -23,7 +23,7 @@ void platform_mass_matrix(const Model& model, const LoadSpec& load, const Matrix
   // 1/2 m |v - [c]x w|^2 + 1/2 w^T I_B w, with I_B = R I_P R^T about the centre of mass.
   const Vector3d c = com_from_pivot_B(model, load, R_BP);
   const Matrix3d C = skew(c);
-  const Matrix3d I_B = R_BP * load.inertia.asDiagonal() * R_BP.transpose();
+  const Matrix3d I_B = R_BP * load.inertia_tensor() * R_BP.transpose();
   const double m = load.mass;
   M.topLeftCorner<3, 3>() = m * Matrix3d::Identity();
   M.topRightCorner<3, 3>() = -m * C;

@@ -364,9 +364,9 @@ Status motor_jacobian_of(const Mechanism& mech, Matrix6d& J) noexcept {
   return Status::Ok;
 }
 
-// LU of J_phi^T with a relative determinant check (as leg_dynamics).
-Status factor_transpose(const Matrix6d& J, Eigen::PartialPivLU<Matrix6d>& lu) noexcept {
-  lu.compute(J.transpose());
+// LU of J_phi (or its transpose) with a relative determinant check (as leg_dynamics).
+Status factor(const Matrix6d& J, Eigen::PartialPivLU<Matrix6d>& lu) noexcept {
+  lu.compute(J);
   double scale = 1.0;
   for (int i = 0; i < 6; ++i) scale *= J.row(i).norm();
   if (!(std::abs(lu.determinant()) > 1e-12 * scale)) return Status::SingularJacobian;
@@ -454,7 +454,7 @@ Status inverse_dynamics(const Rig& rig, const PlatformMotion& motion, InverseDyn
   Matrix6d J;
   motor_jacobian_of(mech, J);
   Eigen::PartialPivLU<Matrix6d> lu;
-  if (const Status s = factor_transpose(J, lu); s != Status::Ok) return s;
+  if (const Status s = factor(J.transpose(), lu); s != Status::Ok) return s;
 
   Forces f;
   all_forces(rig, mech, motion.acceleration, true, f);
@@ -579,9 +579,8 @@ Status drive_load(const Rig& rig, const LegState& legs, const Vector6d& speed, c
   Mechanism mech;
   if (const Status s = mechanism_motion(rig, legs, Vector6d::Zero(), mech, twist); s != Status::Ok) return s;
   motor_jacobian_of(mech, out.jacobian);
-  Eigen::PartialPivLU<Matrix6d> lu_T;
-  if (const Status s = factor_transpose(out.jacobian, lu_T); s != Status::Ok) return s;
-  const Eigen::PartialPivLU<Matrix6d> lu(out.jacobian);
+  Eigen::PartialPivLU<Matrix6d> lu;
+  if (const Status s = factor(out.jacobian, lu); s != Status::Ok) return s;
   const Vector6d velocity = lu.solve(speed);
   set_velocity(velocity, mech);
   Matrix6d M_load, M_drives;
@@ -591,14 +590,16 @@ Status drive_load(const Rig& rig, const LegState& legs, const Vector6d& speed, c
   const Vector6d bias_load = f.gravity + f.velocity;
   const Vector6d bias = bias_load + f.drives_velocity + out.jacobian.transpose() * f.cphi_drives_velocity;
   const Vector6d& a_b = f.phi_dd_bias;  // the velocity-product part of the motor acceleration, J_phi' x'
-  // In motor angles: A phi'' = tau_net + L with A = J^-T M J^-1 and L = -J^-T bias + A a_b.
-  const Matrix6d Y = lu_T.solve(M_load + M_drives);  // J^-T M
-  out.inertia = lu_T.solve(Y.transpose()).transpose();
-  out.inertia = 0.5 * (out.inertia + out.inertia.transpose());
-  out.load = -lu_T.solve(bias) + out.inertia * a_b;
+  // In motor angles: A phi'' = tau_net + L with A = J^-T M J^-1 and L = J^-T (M J^-1 a_b - bias);
+  // A^-1 = J M^-1 J^T, from the Cholesky factor of M.
+  const Matrix6d M = M_load + M_drives;
+  const Eigen::LLT<Matrix6d> llt(M);
+  if (llt.info() != Eigen::Success) return Status::SingularJacobian;
+  out.inverse_inertia.noalias() = out.jacobian * llt.solve(out.jacobian.transpose());
+  out.load = lu.transpose().solve(Vector6d(M * lu.solve(a_b) - bias));
   // What the screw passes to the load at the motor acceleration given.
   const Vector6d x_dd = lu.solve(motor_acceleration - a_b);
-  out.screw_torque = lu_T.solve(M_load * x_dd + bias_load);
+  out.screw_torque = lu.transpose().solve(Vector6d(M_load * x_dd + bias_load));
   out.velocity = velocity;
   return Status::Ok;
 }

@@ -134,7 +134,7 @@ void Rig::validate_and_derive() {
   if (inverse_kinematics(model_, Placement{}, home) != Status::Ok ||
       detail::drive_load(*this, home, Vector6d::Zero(), Vector6d::Zero(), true, at_home) != Status::Ok)
     throw Error("legs: the platform Jacobian is singular at home; cannot size the servo");
-  nominal_inertia_ = at_home.inertia.diagonal();
+  nominal_inertia_ = at_home.inverse_inertia.inverse().diagonal();
 
   if (derive) {
     const double w = 2.0 * kPi * s.pole_frequency;

@@ -205,7 +205,7 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
           s != Status::Ok)
         return fail(issue, s, k, trajectory);
     const Vector6d speed_before = drives.speed;
-    integrate_drives(rig, load.inertia.inverse(), load.load - detail::efficiency_loss(rig, drives.speed, load.screw_torque),
+    integrate_drives(rig, load.inverse_inertia, load.load - detail::efficiency_loss(rig, drives.speed, load.screw_torque),
                      torque, drives);
     motor_acceleration = (drives.speed - speed_before) / rig.control_period();
     motor = model.length_home() + gain.cwiseProduct(drives.angle);
