@@ -111,11 +111,8 @@ void check(Status s, const char* what) {
 void expose_mechanism(py::module_& m) {
   m.def("_inverse_dynamics", &inverse_dynamics_batch, py::arg("config"), py::arg("poses"), py::arg("pose_rates"),
         py::arg("pose_accelerations"));
-  m.def("platform_motion", &platform_motion_batch, py::arg("poses"), py::arg("pose_rates"),
-        py::arg("pose_accelerations"),
-        "The platform's velocity and acceleration from poses [m, rad] and their time derivatives (the library's "
-        "platform_motion): w = E(rpy) rpy', w' = E rpy'' + E' rpy'. Returns a dict of (N, 6) arrays `velocity` "
-        "[v of the pivot m/s; w rad/s, B] and `acceleration` [m/s^2; rad/s^2, B].");
+  m.def("_platform_motion", &platform_motion_batch, py::arg("poses"), py::arg("pose_rates"),
+        py::arg("pose_accelerations"));
   m.def("mass_matrix", [](const py::object& config, const py::object& pose) {
     const auto rig = rig_of(config);
     Matrix6d M;

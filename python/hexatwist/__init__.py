@@ -38,7 +38,6 @@ from ._hexatwist import (  # noqa: F401  (re-exported)
     motor_angles,
     motor_jacobian,
     peak_torque_at,
-    platform_motion,
     potential_energy,
     get_num_threads,
     set_num_threads,
@@ -207,6 +206,16 @@ def identify(model: Model, motor, points, lead_effect: str = "twist") -> Result:
     """
     return Result(_core._identify(model, np.ascontiguousarray(motor, dtype=np.float64),
                                   np.ascontiguousarray(points, dtype=np.float64), lead_effect))
+
+
+def platform_motion(poses, pose_rates, pose_accelerations) -> Result:
+    """The platform's velocity and acceleration (mechanism.hpp, platform_motion) from (N, 6) poses [m, rad]
+    and their time derivatives [m/s, rad/s] and [m/s^2, rad/s^2]: w = E(rpy) rpy', w' = E rpy'' + E' rpy'.
+    Returns (N, 6) ``velocity`` = [v of the pivot [m/s]; w [rad/s]] and ``acceleration`` [m/s^2; rad/s^2],
+    both in the base frame B: the ``velocity`` that :func:`mass_matrix`, :func:`forward_dynamics` and the
+    energies take.
+    """
+    return Result(_core._platform_motion(poses, pose_rates, pose_accelerations))
 
 
 def inverse_dynamics(config, poses, pose_rates, pose_accelerations) -> Result:
