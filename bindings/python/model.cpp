@@ -124,7 +124,7 @@ std::string degrees(double rad) {
       auto r = std::to_chars(buf, buf + sizeof buf, c, std::chars_format::general, precision);
       double back = 0.0;
       std::from_chars(buf, r.ptr, back);
-      if (deg2rad(back) == rad) return std::string(buf, r.ptr);
+      if (deg2rad(back) == rad) return num(back);
     }
   }
   // Further neighbours (a few ulps away), shortest form.
