@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libcli11-dev libfmt-dev   # library and CLI
   libceres-dev                                      # identification (nonlinear least squares)
   libgtest-dev libgmock-dev libbenchmark-dev        # tests and benchmarks
+  libmujoco-dev                                     # MuJoCo 2.2: the tests and benchmark of the MJCF export
   gnuplot-nox                                       # figures
   clang libclang-rt-dev                             # fuzzing and sanitizer builds (libFuzzer, ASan, UBSan)
   linuxcnc-uspace linuxcnc-uspace-dev               # the LinuxCNC kinematics module and its tests (LinuxCNC 2.9)

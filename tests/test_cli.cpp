@@ -393,7 +393,7 @@ TEST(Cli, AxisParallelToItsLegIsBadInput) {
 }
 
 TEST(Cli, UnknownSubcommandOrOptionIsBadInput) {
-  expect_error(run({"bogus"}), 2, {"'bogus'", "ik, fk, config or linuxcnc"});
+  expect_error(run({"bogus"}), 2, {"'bogus'", "ik, fk, config, linuxcnc or mjcf"});
   expect_error(run({}), 2, {"subcommand"});
   expect_error(run({"ik", "--bogus"}), 2, {"--bogus"});
   expect_error(run({"fk"}), 2, {"--lengths"});
@@ -532,10 +532,12 @@ TEST(Cli, StudyRunsTheChosenTestsAndRefusesUnknownOnes) {
   expect_error(run({"study", "--tests", "Lq"}), 2, {"--tests", "'Lq'"});
   // A motor that cannot hold the load: refused before anything runs.
   const std::string weak =
-      write_file("weak.yaml", std::string(hexatwist::test::kSymmetricYaml) + "servo:\n  torque_limit: 3\n");
+      write_file("weak.yaml", std::string(hexatwist::test::kSymmetricYaml) +
+                                     "servo:\n  torque_limit: 3\n  peak_torque_at_max_speed: 2\n  continuous_torque: 2\n");
+  // 4.92 N m for the platform, the rest for the legs' own weight.
   expect_error(
       run({"study", "--config", weak, "--out", out.string()}), 3,
-      {"Lz: t = 0.000 s", "leg 1", "holding the load takes 4.9", "servo.torque_limit", "nothing was simulated"});
+      {"Lz: t = 0.000 s", "leg 1", "holding the load takes 5.2", "servo.torque_limit", "nothing was simulated"});
   EXPECT_FALSE(std::filesystem::exists(out));
   const std::string file = write_file("blocked", "a file, not a folder");
   expect_error(run({"study", "--tests", "Rz", "--no-figures", "--out", file}), 4, {"--out", file});
@@ -1139,6 +1141,30 @@ TEST(CliLinuxcnc, UnitsStrategyAndOutputs) {
   const int status = std::system((shell_quote(HEXATWIST_CLI) + " linuxcnc >/dev/full 2>" + shell_quote(err)).c_str());
   EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 4);
   EXPECT_NE(read_file(err).find("cannot write to standard output"), std::string::npos) << read_file(err);
+}
+
+TEST(CliMjcf, WritesTheMujocoModelToStdoutOrAFileAndNoFileOnBadInput) {
+  const Outcome r = run({"mjcf"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("<!-- Configuration: embedded seed platform -->\n", 0), 0u);
+  EXPECT_NE(r.out.find("<mujoco model=\"hexatwist\">"), std::string::npos);
+  EXPECT_NE(r.out.find("<motor name=\"motor6\""), std::string::npos);
+  EXPECT_EQ(r.out.substr(r.out.size() - 10), "</mujoco>\n");
+  const std::string out = (temp_dir() / "platform.xml").string();
+  std::filesystem::remove(out);
+  ASSERT_EQ(run({"mjcf", "--out", out}).code, 0);
+  EXPECT_EQ(read_file(out), r.out);
+  // A configuration that does not parse, and one MuJoCo cannot represent (lead 0: no screw):
+  // one line, exit 2, and no file.
+  const std::string bad_out = (temp_dir() / "bad_platform.xml").string();
+  std::filesystem::remove(bad_out);
+  const std::string malformed = write_file("mjcf_malformed.yaml", replace_line(kSymmetric, 4, "  Rb: abc"));
+  expect_error(run({"mjcf", "--config", malformed, "--out", bad_out}), 2, {"mjcf_malformed.yaml", "Rb"});
+  const std::string plain = write_file("mjcf_plain.yaml", replace_line(kSymmetric, 9, "  lead: 0"));
+  expect_error(run({"mjcf", "--config", plain, "--out", bad_out}), 2, {"mjcf_plain.yaml", "lead"});
+  expect_error(run({"mjcf", "--config", (temp_dir() / "missing.yaml").string(), "--out", bad_out}), 2, {"missing.yaml"});
+  EXPECT_FALSE(std::filesystem::exists(bad_out));
+  expect_error(run({"mjcf", "--out", (temp_dir() / "no/such/dir/x.xml").string()}), 4, {"x.xml"});
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <new>
 
+#include "hexatwist/config.hpp"
+#include "hexatwist/mechanism.hpp"
 #include "support.hpp"
 
 namespace {
@@ -36,6 +38,13 @@ static_assert(noexcept(check_limits(std::declval<const Model&>(), std::declval<c
 
 static_assert(noexcept(stream_line(std::declval<const Model&>(), std::declval<const StreamSettings&>(), std::string_view(),
                                    AngleUnit::Degrees, std::declval<StreamState&>(), std::declval<StreamOutput&>())));
+static_assert(noexcept(inverse_dynamics(std::declval<const Rig&>(), std::declval<const PlatformMotion&>(),
+                                        std::declval<InverseDynamics&>())));
+static_assert(noexcept(forward_dynamics(std::declval<const Rig&>(), std::declval<const Placement&>(),
+                                        std::declval<const Vector6d&>(), std::declval<const Vector6d&>(),
+                                        std::declval<Vector6d&>())));
+static_assert(noexcept(mechanism_mass_matrix(std::declval<const Rig&>(), std::declval<const Placement&>(),
+                                             std::declval<Matrix6d&>())));
 static_assert(noexcept(format_stream_output(std::declval<const StreamOutput&>(), StreamFormat::Json, std::span<char>())));
 
 TEST(RealTime, CountingAllocatorSeesAllocations) {
@@ -92,6 +101,32 @@ TEST(RealTime, CommandsTwistLimitsConditionAndFkDoNotAllocate) {
 
 namespace hexatwist::test {
 namespace {
+
+// The mechanism's dynamics: inverse dynamics for a drive's feed-forward, forward dynamics for a
+// plant model in a real-time loop.
+TEST(RealTime, DynamicsDoNotAllocate) {
+  const Config config = default_config();
+  const Rig& rig = config.rig;
+  std::mt19937_64 rng(kSeed + 60);
+  std::vector<PlatformMotion> motions;
+  for (int k = 0; k < 200; ++k) {
+    Vector6d rate, acc;
+    for (int j = 0; j < 6; ++j) rate[j] = uniform(rng, -0.5, 0.5), acc[j] = uniform(rng, -3.0, 3.0);
+    motions.push_back(platform_motion(random_valid_pose(rig.model(), rng, 0.3, deg2rad(20)), rate, acc));
+  }
+  InverseDynamics id;
+  Vector6d acc;
+  Matrix6d M;
+  const long before = g_allocations.load();
+  int ok = 0;
+  for (const PlatformMotion& m : motions) {
+    ok += inverse_dynamics(rig, m, id) == Status::Ok;
+    ok += forward_dynamics(rig, m.placement, m.velocity, id.torque, acc) == Status::Ok;
+    ok += mechanism_mass_matrix(rig, m.placement, M) == Status::Ok;
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(ok, 600);
+}
 
 // The whole per-line path of `hexatwist stream`: parse, check, rate-limit (with its forward
 // kinematics), hold or skip, format.

@@ -145,5 +145,6 @@ Command make_synth_command(CLI::App& root);
 Command make_measure_command(CLI::App& root);
 Command make_identify_command(CLI::App& root);
 Command make_linuxcnc_command(CLI::App& root);
+Command make_mjcf_command(CLI::App& root);
 
 }  // namespace hexatwist::cli

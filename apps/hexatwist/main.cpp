@@ -36,7 +36,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
   const std::vector<Command> commands{make_study_command(app),   make_simulate_command(app), make_dynamics_command(app), make_synth_command(app),
                                       make_measure_command(app), make_identify_command(app), make_stream_command(app),   make_ik_command(app),
-                                      make_fk_command(app),      make_config_command(app),   make_linuxcnc_command(app)};
+                                      make_fk_command(app),      make_config_command(app),   make_linuxcnc_command(app),
+                                      make_mjcf_command(app)};
   // Help and version go to standard output like every result: a failed write is exit 4.
   const auto print_and_check = [&](const CLI::Error& e) {
     const int code = app.exit(e);
@@ -66,7 +67,7 @@ int main(int argc, char** argv) {
       for (const Command& c : commands) chosen = chosen || c.app->get_name() == word;
       if (chosen) break;
       print_error("hexatwist: error: ", fmt::format("unknown subcommand '{}'; expected study, simulate, dynamics, synth, "
-                                                    "measure, identify, stream, ik, fk, config or linuxcnc (see --help)",
+                                                    "measure, identify, stream, ik, fk, config, linuxcnc or mjcf (see --help)",
                                                     word));
       return kExitBadInput;
     }

@@ -10,6 +10,7 @@
 #include "hexatwist/kinematics.hpp"
 #include "hexatwist/limits.hpp"
 #include "hexatwist/measurement.hpp"
+#include "hexatwist/mjcf.hpp"
 #include "hexatwist/model.hpp"
 #include "hexatwist/motor_sizing.hpp"
 #include "hexatwist/parameter_errors.hpp"
