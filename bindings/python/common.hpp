@@ -128,5 +128,6 @@ void expose_mechanism(py::module_& m);
 void expose_motor_sizing(py::module_& m);
 void expose_registration(py::module_& m);
 void expose_workspace(py::module_& m);
+void expose_mjcf(py::module_& m);
 
 }  // namespace hexatwist::python

@@ -18,4 +18,5 @@ PYBIND11_MODULE(_hexatwist, m) {
   expose_motor_sizing(m);
   expose_registration(m);
   expose_workspace(m);
+  expose_mjcf(m);
 }

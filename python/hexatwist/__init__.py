@@ -35,6 +35,7 @@ from ._hexatwist import (  # noqa: F401  (re-exported)
     forward_dynamics,
     kinetic_energy,
     mass_matrix,
+    mjcf,
     motor_angles,
     motor_jacobian,
     peak_torque_at,
@@ -57,7 +58,7 @@ __all__ = [
     "map_batch", "map_simulations", "describe_status", "set_num_threads", "get_num_threads",
     "Rig", "TORQUE_TERMS", "platform_motion", "inverse_dynamics", "mass_matrix", "bias", "forward_dynamics",
     "kinetic_energy", "potential_energy", "motor_angles", "motor_jacobian", "peak_torque_at", "size_motors",
-    "FkTracker", "forward_kinematics_tracked", "register_points", "axis_range", "COORDINATES",
+    "FkTracker", "forward_kinematics_tracked", "register_points", "axis_range", "COORDINATES", "mjcf",
 ]
 
 COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")

@@ -150,6 +150,7 @@ def kinetic_energy(config: ConfigLike, pose: PoseLike, velocity: PoseLike) -> fl
 def potential_energy(config: ConfigLike, pose: PoseLike) -> float: ...  # [J]
 def motor_angles(config: ConfigLike, pose: PoseLike) -> Array: ...  # (6,) [rad]
 def motor_jacobian(config: ConfigLike, pose: PoseLike) -> Array: ...  # (6, 6)
+def mjcf(config: ConfigLike = None) -> str: ...  # MJCF XML (mjcf.hpp)
 def peak_torque_at(config: ConfigLike, speed: float) -> float: ...  # [N m]
 # Motor sizing (motor_sizing.hpp).
 def size_motors(config: ConfigLike = None, trajectory: Union[str, os.PathLike[str], None] = None, *,

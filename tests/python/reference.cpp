@@ -12,6 +12,7 @@
 //   axis_range    in: unused; out: per strategy (compensated, conventional) and coordinate: lower,
 //                 upper, status of both limits, status
 //   tracked       in: N x 6 motor-side lengths; out per row: pose (6), status, iterations, residual
+//   mjcf          in: unused; out: the MJCF text of the seed rig
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -21,6 +22,7 @@
 
 #include "hexatwist/hexatwist.hpp"
 #include "hexatwist/mechanism.hpp"
+#include "hexatwist/mjcf.hpp"
 
 namespace {
 
@@ -163,6 +165,14 @@ int main(int argc, char** argv) {
     if (mode == "registration") return registration(argv[2], argv[3]);
     if (mode == "axis_range") return ranges(argv[3]);
     if (mode == "tracked") return tracked(argv[2], argv[3]);
+    if (mode == "mjcf") {
+      const std::string text = mjcf_model(default_config().rig);
+      std::FILE* o = std::fopen(argv[3], "wb");
+      if (!o) return 2;
+      std::fwrite(text.data(), 1, text.size(), o);
+      std::fclose(o);
+      return 0;
+    }
     return 2;
   }
   if (argc != 3) return 2;

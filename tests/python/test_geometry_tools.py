@@ -132,3 +132,22 @@ def test_yaml_with_degrees_reloads_to_the_same_model(bend, margin):
         assert np.array_equal(getattr(again, k), getattr(model, k)), k
     assert again.to_yaml() == model.to_yaml()
     assert f"bend_max_deg: {bend}\n" in model.to_yaml()  # the shortest text: what the user wrote
+
+
+def test_mjcf_is_the_library_text(tmp_path):
+    import subprocess
+    import xml.etree.ElementTree as ET
+    from conftest import tool
+    text = hexatwist.mjcf()
+    dst = tmp_path / "seed.xml"
+    subprocess.run([tool("HEXATWIST_REFERENCE"), "mjcf", "-", str(dst)], check=True, timeout=60)
+    assert text == dst.read_text()
+    root = ET.fromstring(text)
+    assert root.tag == "mujoco"
+    names = {a.get("name") for a in root.iter("motor")} | {a.get("name") for a in root.iter("general")}
+    assert {f"motor{i}" for i in range(1, 7)} <= names
+    assert hexatwist.mjcf(hexatwist.Rig()) == text == hexatwist.mjcf(hexatwist.seed_config_yaml())
+    no_lead = hexatwist.seed_config_yaml().replace("lead: 0.010", "lead: 0", 1)
+    if no_lead != hexatwist.seed_config_yaml():
+        with pytest.raises(hexatwist.ConfigError):
+            hexatwist.mjcf(no_lead)
