@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -89,6 +90,20 @@ inline Pose pose_row(const double* data, std::size_t i) noexcept {
 /// Throws ValueError "name row i holds NaN or inf" if any status is NonFiniteInput.
 void raise_non_finite(const std::int8_t* status, std::size_t n, const char* name);
 
+/// hexatwist.Rig: a validated configuration and the YAML text it came from (for pickling).
+struct PyRig {
+  std::shared_ptr<const Config> config;
+  std::string yaml;
+  std::string source;
+};
+/// The Rig of a `config` argument: a Rig itself, or one built from YAML text, a path or None (seed).
+std::shared_ptr<const PyRig> rig_of(const py::handle& src);
+/// A copy of that configuration.
+Config python_config(const py::object& src);
+
+/// A (6,) float64 vector argument (lists accepted); InputError naming it otherwise, or for NaN/inf.
+Vector6d vector6(const py::handle& obj, const char* name);
+
 /// The Python exception types (hexatwist.Error and its subclasses), set by expose_errors.
 struct Errors {
   py::object error, config_error, input_error, dtype_error, status_error;
@@ -108,5 +123,11 @@ void expose_forward(py::module_& m);
 void expose_simulation(py::module_& m);
 void expose_measurement(py::module_& m);
 void expose_stream(py::module_& m);
+void expose_rig(py::module_& m);
+void expose_mechanism(py::module_& m);
+void expose_motor_sizing(py::module_& m);
+void expose_registration(py::module_& m);
+void expose_workspace(py::module_& m);
+void expose_mjcf(py::module_& m);
 
 }  // namespace hexatwist::python

@@ -111,6 +111,32 @@ std::string num(double x) {
   auto r = std::to_chars(buf, buf + sizeof buf, x);
   return std::string(buf, r.ptr);
 }
+// Shortest decimal text of an angle in degrees that load_model turns back into exactly `rad`
+// (deg2rad of it == rad): rad2deg's nearest double does not always do that (1.5 deg -> rad -> deg
+// -> rad moves by one ulp). Every angle loaded from degrees has such a text; an angle given in
+// radians that no double in degrees maps to gets the nearest one.
+std::string degrees(double rad) {
+  const double d = rad2deg(rad);
+  if (!std::isfinite(d)) return num(d);
+  for (int precision = 1; precision <= 17; ++precision) {
+    for (double c : {d, std::nextafter(d, -INFINITY), std::nextafter(d, INFINITY)}) {
+      char buf[40];
+      auto r = std::to_chars(buf, buf + sizeof buf, c, std::chars_format::general, precision);
+      double back = 0.0;
+      std::from_chars(buf, r.ptr, back);
+      if (deg2rad(back) == rad) return num(back);
+    }
+  }
+  // Further neighbours (a few ulps away), shortest form.
+  double lo = d, hi = d;
+  for (int k = 0; k < 8; ++k) {
+    lo = std::nextafter(lo, -INFINITY);
+    hi = std::nextafter(hi, INFINITY);
+    if (deg2rad(lo) == rad) return num(lo);
+    if (deg2rad(hi) == rad) return num(hi);
+  }
+  return num(d);
+}
 std::string list3(const Vector3d& v) { return "[" + num(v[0]) + ", " + num(v[1]) + ", " + num(v[2]) + "]"; }
 
 std::string to_yaml(const Model& model) {
@@ -138,8 +164,8 @@ std::string to_yaml(const Model& model) {
   for (int i = 0; i < kLegs; ++i) o << (i ? ", " : "") << num(s.legs[static_cast<std::size_t>(i)].length_offset);
   o << "]\n";
   o << "limits:\n  length_min: " << num(s.limits.length_min) << "\n  length_max: " << num(s.limits.length_max)
-    << "\n  bend_max_deg: " << num(rad2deg(s.limits.bend_max))
-    << "\n  singularity_margin_deg: " << num(rad2deg(s.limits.singularity_margin))
+    << "\n  bend_max_deg: " << degrees(s.limits.bend_max)
+    << "\n  singularity_margin_deg: " << degrees(s.limits.singularity_margin)
     << "\n  jacobian_condition_max: " << num(s.limits.jacobian_condition_max) << "\n";
   o << "observation_point: " << list3(s.observation_P) << "\npivot: " << list3(s.pivot_P) << "\n";
   return o.str();

@@ -13,4 +13,10 @@ PYBIND11_MODULE(_hexatwist, m) {
   expose_simulation(m);
   expose_measurement(m);
   expose_stream(m);
+  expose_rig(m);
+  expose_mechanism(m);
+  expose_motor_sizing(m);
+  expose_registration(m);
+  expose_workspace(m);
+  expose_mjcf(m);
 }

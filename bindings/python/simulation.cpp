@@ -11,11 +11,7 @@ std::pair<std::string, std::string> read_yaml_source(const py::object& path_or_t
 
 namespace {
 
-Config config_of(const py::object& src) {
-  if (src.is_none()) return default_config();
-  auto [text, source] = read_yaml_source(src);
-  return load_config(text, source);
-}
+Config config_of(const py::object& src) { return python_config(src); }
 
 py::dict samples_dict(const std::vector<SimulationSample>& s) {
   const std::size_t n = s.size();
@@ -141,8 +137,6 @@ py::dict study_py(const py::object& config_src, const std::string& test, const p
 }
 
 }  // namespace
-
-Config python_config(const py::object& src) { return config_of(src); }
 
 void expose_simulation(py::module_& m) {
   m.def("_simulate", &simulate_py, py::arg("config") = py::none(), py::arg("test") = "Rz",

@@ -20,14 +20,26 @@ from ._hexatwist import (  # noqa: F401  (re-exported)
     ConfigError,
     DTypeError,
     Error,
+    FkTracker,
     InputError,
     Model,
+    Rig,
     StatusError,
     Stream,
+    TORQUE_TERMS,
     _input_copies,
+    bias,
     control_period,
     default_model,
     describe_status,
+    forward_dynamics,
+    kinetic_energy,
+    mass_matrix,
+    mjcf,
+    motor_angles,
+    motor_jacobian,
+    peak_torque_at,
+    potential_energy,
     get_num_threads,
     set_num_threads,
     load_model,
@@ -44,7 +56,12 @@ __all__ = [
     "inverse_kinematics", "twist", "length_error", "commands", "motor_command", "forward",
     "simulate", "study", "read_point_log", "measured_test", "observations_at_rest", "identify",
     "map_batch", "map_simulations", "describe_status", "set_num_threads", "get_num_threads",
+    "Rig", "TORQUE_TERMS", "platform_motion", "inverse_dynamics", "mass_matrix", "bias", "forward_dynamics",
+    "kinetic_energy", "potential_energy", "motor_angles", "motor_jacobian", "peak_torque_at", "size_motors",
+    "FkTracker", "forward_kinematics_tracked", "register_points", "axis_range", "COORDINATES", "mjcf",
 ]
+
+COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
 
 Status = enum.IntEnum("Status", [(name.upper(), code) for code, name in enumerate(STATUS_NAMES)])
 Status.__doc__ = "Status codes of the per-pose ``status`` arrays (the library's hexatwist::Status)."
@@ -190,3 +207,80 @@ def identify(model: Model, motor, points, lead_effect: str = "twist") -> Result:
     """
     return Result(_core._identify(model, np.ascontiguousarray(motor, dtype=np.float64),
                                   np.ascontiguousarray(points, dtype=np.float64), lead_effect))
+
+
+def platform_motion(poses, pose_rates, pose_accelerations) -> Result:
+    """The platform's velocity and acceleration (mechanism.hpp, platform_motion) from (N, 6) poses [m, rad]
+    and their time derivatives [m/s, rad/s] and [m/s^2, rad/s^2]: w = E(rpy) rpy', w' = E rpy'' + E' rpy'.
+    Returns (N, 6) ``velocity`` = [v of the pivot [m/s]; w [rad/s]] and ``acceleration`` [m/s^2; rad/s^2],
+    both in the base frame B: the ``velocity`` that :func:`mass_matrix`, :func:`forward_dynamics` and the
+    energies take.
+    """
+    return Result(_core._platform_motion(poses, pose_rates, pose_accelerations))
+
+
+def inverse_dynamics(config, poses, pose_rates, pose_accelerations) -> Result:
+    """Motor torques of the whole mechanism (mechanism.hpp, inverse_dynamics) for (N, 6) poses [m, rad] with
+    their time derivatives ``pose_rates`` [m/s, rad/s] and ``pose_accelerations`` [m/s^2, rad/s^2] (of x, y, z,
+    roll, pitch, yaw; the library's platform_motion turns them into [v of the pivot; w] in B).
+
+    ``config``: a :class:`Rig`, YAML text, a path, or None (the seed). Returns (N, 6) arrays: ``torque`` [N m]
+    (positive lengthens the leg), motor ``angle`` from home [rad], ``speed`` [rad/s], ``acceleration``
+    [rad/s^2], ``power`` = torque * speed [W] (negative: the load drives the motor); the torque's parts, which
+    add up to it (to rounding), ``gravity``, ``platform_inertia``, ``velocity_product``, ``legs``, ``drives``,
+    ``friction`` [N m]; ``screw_force`` axial force in the nut, tension positive [N]; and ``status`` (N,) int8
+    (NaN rows unless ok; limits are not checked). Batch like :func:`commands`: GIL released, threads.
+    """
+    return Result(_core._inverse_dynamics(config, poses, pose_rates, pose_accelerations))
+
+
+def size_motors(config=None, trajectory=None, *, times=None, poses=None, dt=None, t0: float = 0.0,
+                envelope_points: int = 64) -> Result:
+    """Motor sizing along a trajectory (motor_sizing.hpp, size_motors), as ``hexatwist dynamics`` does.
+
+    The trajectory: ``trajectory`` a CSV file or text (t, x, y, z, roll, pitch, yaw with unit suffixes, see the
+    CLI) resampled at the control period; or ``poses`` (T, 6) [m, rad] with ``times`` (T,) [s] (resampled
+    alike), or with a fixed period ``dt`` [s] (default: the control period) from ``t0`` [s]. Rates and
+    accelerations are central differences of the poses. Returns per sample: ``time`` (T,) [s], ``poses``
+    (T, 6) [m, rad] (the trajectory sized), ``torque`` [N m], ``speed`` [rad/s], ``power`` [W] and the
+    torque's parts (``TORQUE_TERMS``: gravity ... friction) [N m], each (T, 6); ``summary``: status (a pose
+    limit or numerical failure at ``failed_index`` / ``failed_time``, limit_leg/value/bound), ``envelope``
+    "ok" | "exceeded", ``first_violation`` (None or check, leg 0-based, index, time [s], value, bound) and
+    ``motors``, six dicts of peak_torque [N m], rms_torque, peak_speed [rad/s], peak_power [W], their times
+    [s], energy_driven / energy_regenerated [J], ``share`` per term (RMS of the term / RMS torque), usages
+    (peak_usage, speed_usage, rms_usage [-]) and its own ``violation``; ``figure``: the torque-speed figure's
+    data: ``operating`` (six dicts of speed [rad/s], torque [N m]), the closed peak ``envelope``,
+    ``continuous_torque`` [N m], ``max_speed`` [rad/s].
+    """
+    return Result(_core._size_motors(config, trajectory, times, poses, dt, t0, envelope_points))
+
+
+def forward_kinematics_tracked(model: Model, lengths, kind: str = "motor", start=None, max_iterations: int = 30,
+                               tolerance: float = 1e-12) -> Result:
+    """Forward kinematics along a motion with one :class:`FkTracker` (forward.hpp, forward_kinematics_tracked):
+    rows of ``lengths`` (N, 6) [m] solved in order, each from the last solution, ok only on the start's
+    assembly mode and away from a platform singularity. ``start``: None (home) or a pose [m, rad]. Returns
+    ``poses`` (N, 6) [m, rad] (NaN unless ok), ``status`` (N,) int8, ``iterations``, ``residual`` [m],
+    ``condition`` and ``det_sign`` [-].
+    """
+    return Result(FkTracker(model, kind, start).track(lengths, max_iterations, tolerance))
+
+
+def register_points(points_T, points_B, max_condition: float = 1e4) -> Result:
+    """Best-fit rigid transform X_BT (registration.hpp, Kabsch/Umeyama, no scale) mapping points measured in
+    the tracker frame ``points_T`` (N, 3) [m, T] onto the same points ``points_B`` (N, 3) [m, B]:
+    p_B ~ R_BT p_T + t_BT. Returns ``status`` (ok, too_few_points, degenerate_registration), ``R_BT`` (3, 3),
+    ``t_BT`` (3,) [m, B], ``count``, ``rms_residual``, ``max_residual`` [m], ``max_residual_index``, ``sigma``
+    noise per coordinate [m], ``singular_values`` (3,) [m^2], ``reflection`` (bool), ``condition`` [-].
+    """
+    return Result(_core._register_points(points_T, points_B, max_condition))
+
+
+def axis_range(model: Model, coordinate, strategy: str = "compensated", **options) -> Result:
+    """Reach along one pose coordinate alone, the others at home (workspace.hpp, axis_range): ``coordinate``
+    "x", "y", "z", "roll", "pitch", "yaw" or 0..5. Returns ``lower`` <= 0 <= ``upper`` [m or rad] inside every
+    limit for the commands of ``strategy``, and ``lower_limit`` / ``upper_limit`` (status, leg 0-based, value,
+    bound) met just beyond (status ok: the search bound). ``options``: linear_step [m], angular_step [rad],
+    linear_bound [m], angular_bound [rad], tolerance [m or rad]. Raises StatusError when home is outside a limit.
+    """
+    return Result(_core._axis_range(model, coordinate, strategy, **options))
