@@ -374,14 +374,23 @@ Status factor(const Matrix6d& J, Eigen::PartialPivLU<Matrix6d>& lu) noexcept {
 }
 
 // tanh-smoothed share of driving: 1 when the motor drives the load, 0 when the load drives it.
-Vector6d drive_share(const Rig& rig, const Vector6d& speed, const Vector6d& screw_torque) noexcept {
-  Vector6d d;
+// The efficiency loss for p = tanh(speed / friction_speed): the share of driving d = (1 + p sign
+// tau_s) / 2 is 1 when the motor drives the load and 0 when the load drives it.
+Vector6d efficiency_loss_of(const Rig& rig, const Vector6d& p, const Vector6d& screw_torque) noexcept {
+  const MechanismSpec& mech = rig.mechanism();
+  Vector6d f;
   for (int i = 0; i < kLegs; ++i) {
-    const double p = std::tanh(speed[i] / rig.servo().friction_speed);
     const double sign = screw_torque[i] > 0.0 ? 1.0 : (screw_torque[i] < 0.0 ? -1.0 : 0.0);
-    d[i] = 0.5 * (1.0 + p * sign);
+    const double d = 0.5 * (1.0 + p[i] * sign);
+    // Driving: tau = tau_s / eta; driven back: tau = tau_s * eta' (theory §14), blended by d.
+    const double factor = d / mech.efficiency + (1.0 - d) * mech.back_efficiency;
+    f[i] = (factor - 1.0) * screw_torque[i];
   }
-  return d;
+  return f;
+}
+
+Vector6d smoothed_sign(const Rig& rig, const Vector6d& speed) noexcept {
+  return (speed / rig.servo().friction_speed).array().tanh().matrix();
 }
 
 }  // namespace
@@ -425,22 +434,13 @@ Status motor_angles(const Rig& rig, const Placement& placement, Vector6d& angle)
 }
 
 Vector6d detail::efficiency_loss(const Rig& rig, const Vector6d& speed, const Vector6d& screw_torque) noexcept {
-  const MechanismSpec& mech = rig.mechanism();
-  const Vector6d d = drive_share(rig, speed, screw_torque);
-  Vector6d f;
-  for (int i = 0; i < kLegs; ++i) {
-    // Driving: tau = tau_s / eta; driven back: tau = tau_s * eta' (theory §14), blended by d.
-    const double factor = d[i] / mech.efficiency + (1.0 - d[i]) * mech.back_efficiency;
-    f[i] = (factor - 1.0) * screw_torque[i];
-  }
-  return f;
+  return efficiency_loss_of(rig, smoothed_sign(rig, speed), screw_torque);
 }
 
 Vector6d drive_friction(const Rig& rig, const Vector6d& speed, const Vector6d& screw_torque) noexcept {
   const ServoSpec& sv = rig.servo();
-  return sv.viscous_friction * speed +
-         sv.coulomb_friction * (speed / sv.friction_speed).array().tanh().matrix() +
-         detail::efficiency_loss(rig, speed, screw_torque);
+  const Vector6d p = smoothed_sign(rig, speed);
+  return sv.viscous_friction * speed + sv.coulomb_friction * p + efficiency_loss_of(rig, p, screw_torque);
 }
 
 Status inverse_dynamics(const Rig& rig, const PlatformMotion& motion, InverseDynamics& out) noexcept {

@@ -39,6 +39,10 @@ Rig::Rig(Model model, const ServoSpec& servo, const LoadSpec& load, const Simula
 }
 
 void Rig::validate_and_derive() {
+  // The envelope's values not given follow the peak torque and speed (rig.hpp).
+  if (std::isnan(servo_.peak_corner_speed)) servo_.peak_corner_speed = servo_.max_speed * (2.0 / 3.0);
+  if (std::isnan(servo_.peak_torque_at_max_speed)) servo_.peak_torque_at_max_speed = servo_.torque_limit * (4.0 / 7.0);
+  if (std::isnan(servo_.continuous_torque)) servo_.continuous_torque = servo_.torque_limit / 2.95;
   const ServoSpec& s = servo_;
   positive(s.motor_inertia, "servo.motor_inertia", "kg m^2");
   non_negative(s.screw_inertia, "servo.screw_inertia", "kg m^2");

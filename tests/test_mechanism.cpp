@@ -388,7 +388,7 @@ TEST(Mechanism, UnpoweredMotionConservesEnergyOverTenSeconds) {
 }
 
 TEST(Mechanism, PeakTorqueEnvelope) {
-  ServoSpec sv;
+  const ServoSpec sv = Rig(seed_rig_spec()).servo();
   EXPECT_EQ(peak_torque_at(sv, 0.0), sv.torque_limit);
   EXPECT_EQ(peak_torque_at(sv, -sv.peak_corner_speed), sv.torque_limit);
   EXPECT_NEAR(peak_torque_at(sv, sv.max_speed), sv.peak_torque_at_max_speed, 1e-12);
@@ -396,6 +396,13 @@ TEST(Mechanism, PeakTorqueEnvelope) {
               0.5 * (sv.torque_limit + sv.peak_torque_at_max_speed), 1e-12);
   EXPECT_EQ(peak_torque_at(sv, sv.max_speed * 1.0001), 0.0);
   EXPECT_EQ(peak_torque_at(sv, std::nan("")), 0.0);
+  // Not given: derived from the peak torque and speed (the seed's numbers).
+  RigSpec spec = seed_rig_spec();
+  spec.servo.peak_corner_speed = spec.servo.peak_torque_at_max_speed = spec.servo.continuous_torque = std::nan("");
+  const ServoSpec derived = Rig(spec).servo();
+  EXPECT_NEAR(derived.peak_corner_speed, sv.peak_corner_speed, 1e-12);
+  EXPECT_NEAR(derived.peak_torque_at_max_speed, sv.peak_torque_at_max_speed, 1e-12);
+  EXPECT_NEAR(derived.continuous_torque, sv.continuous_torque, 0.01);
 }
 
 TEST(Mechanism, SingularUJointIsReportedNotHidden) {

@@ -65,7 +65,7 @@ TEST(Simulation, LengthOffsetsAreCommandedAwayAndPutBackByThePlant) {
   // Offsets shift every command by -delta and the plant's real length by +delta: the closed loop
   // does what it does without them (up to the encoder's rounding of other angles), in the
   // twisting plant and in the twist-free one.
-  RigSpec spec{seed().rig.model().spec(), seed().rig.servo(), seed().rig.load(), seed().rig.simulation()};
+  RigSpec spec{seed().rig.model().spec(), seed().rig.servo(), seed().rig.load(), seed().rig.simulation(), seed().rig.mechanism()};
   const std::array<double, kLegs> delta{1e-3, -0.7e-3, 0.2e-3, -1e-3, 0.5e-3, 0.0};
   for (std::size_t i = 0; i < delta.size(); ++i) spec.model.legs[i].length_offset = delta[i];
   const Rig offset(spec);

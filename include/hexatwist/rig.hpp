@@ -2,6 +2,8 @@
 // simulation needs besides the trajectory (docs/theory.md §9). Immutable and validated, like Model.
 #pragma once
 
+#include <limits>
+
 #include "hexatwist/model.hpp"
 
 namespace hexatwist {
@@ -21,10 +23,13 @@ struct ServoSpec {
   double torque_limit = 28.0;                    ///< peak motor torque [N m]
   double max_speed = 3000.0 * 2.0 * kPi / 60.0;  ///< motor speed limit [rad/s] (3000 rpm)
   /// Torque-speed envelope (mechanism.hpp, peak_torque_at): the peak torque holds up to this speed
-  /// [rad/s] (2000 rpm) ...
-  double peak_corner_speed = 2000.0 * 2.0 * kPi / 60.0;
-  double peak_torque_at_max_speed = 16.0;  ///< ... and falls linearly to this at max_speed [N m]
-  double continuous_torque = 9.5;          ///< largest RMS torque the motor carries without overheating [N m]
+  /// [rad/s] ... NaN = derived by the Rig: two thirds of max_speed (2000 of 3000 rpm).
+  double peak_corner_speed = std::numeric_limits<double>::quiet_NaN();
+  /// ... and falls linearly to this at max_speed [N m]. NaN = 4/7 of torque_limit (16 of 28 N m).
+  double peak_torque_at_max_speed = std::numeric_limits<double>::quiet_NaN();
+  /// Largest RMS torque the motor carries without overheating [N m]. NaN = torque_limit / 2.95
+  /// (9.5 of 28 N m: 3 kW at 3000 rpm).
+  double continuous_torque = std::numeric_limits<double>::quiet_NaN();
   double encoder_counts = 1048576;               ///< encoder counts per motor revolution (20 bit)
   double gear_ratio = 1.0;                       ///< motor revolutions per screw revolution
   /// Frequency of the closed-loop poles from which the PID gains are derived when kp, ki and kd
@@ -104,6 +109,7 @@ class Rig {
       const MechanismSpec& mechanism = {});
 
   const Model& model() const noexcept { return model_; }
+  /// The servo, with the envelope's derived values filled in.
   const ServoSpec& servo() const noexcept { return servo_; }
   const LoadSpec& load() const noexcept { return load_; }
   const SimulationSpec& simulation() const noexcept { return simulation_; }
