@@ -1,15 +1,10 @@
 #include "hexatwist/dynamics.hpp"
+#include "geometry.hpp"
 
 #include <Eigen/LU>
 
 namespace hexatwist {
 namespace {
-
-Matrix3d skew(const Vector3d& v) noexcept {
-  Matrix3d S;
-  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return S;
-}
 
 // Centre of mass relative to the pivot [m, B].
 Vector3d com_from_pivot_B(const Model& model, const LoadSpec& load, const Matrix3d& R_BP) noexcept {
@@ -22,7 +17,7 @@ void platform_mass_matrix(const Model& model, const LoadSpec& load, const Matrix
   // Velocity of the centre of mass: v + w x c = v - [c]x w. Kinetic energy
   // 1/2 m |v - [c]x w|^2 + 1/2 w^T I_B w, with I_B = R I_P R^T about the centre of mass.
   const Vector3d c = com_from_pivot_B(model, load, R_BP);
-  const Matrix3d C = skew(c);
+  const Matrix3d C = detail::skew(c);
   const Matrix3d I_B = R_BP * load.inertia_tensor() * R_BP.transpose();
   const double m = load.mass;
   M.topLeftCorner<3, 3>() = m * Matrix3d::Identity();

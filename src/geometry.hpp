@@ -22,6 +22,13 @@ inline TwistXY twist_xy(const Vector3d& s, const Vector3d& ja, const Vector3d& j
   return {ja.dot(jd) - ja.dot(s) * jd.dot(s), s.dot(ja.cross(jd))};
 }
 
+/// The cross-product matrix: skew(v) w = v x w.
+inline Matrix3d skew(const Vector3d& v) noexcept {
+  Matrix3d S;
+  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return S;
+}
+
 /// Angle between two directions [rad], in [0, pi]; accurate near 0 and pi (unlike acos).
 inline double angle_between(const Vector3d& a, const Vector3d& b) noexcept {
   return std::atan2(a.cross(b).norm(), a.dot(b));

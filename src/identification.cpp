@@ -1,4 +1,5 @@
 #include "hexatwist/identification.hpp"
+#include "geometry.hpp"
 
 #include <ceres/ceres.h>
 #include <fmt/format.h>
@@ -19,12 +20,6 @@ namespace {
 constexpr int kModelParameters = kRotationIndex;
 
 using RowMajor3d = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-
-Matrix3d skew(const Vector3d& v) {
-  Matrix3d S;
-  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return S;
-}
 
 // The platform's residuals e_k = X_BT p_T,k - A_B,k and their Jacobian with respect to lead,
 // offsets and A, through twist-aware forward kinematics of every observation (theory §13). Each
@@ -107,7 +102,7 @@ class Evaluator {
       J_x_theta = -Eigen::PartialPivLU<Matrix6d>(J_f_x).solve(J_f_theta);
       // A_B = pivot_home + t + R_BP (A_P - pivot_P): left perturbation of R_BP turns arm_B.
       J_q_x.leftCols<3>().setIdentity();
-      J_q_x.rightCols<3>() = -skew(arm_B);
+      J_q_x.rightCols<3>() = -detail::skew(arm_B);
       J->block<3, 7>(row, 0) = -J_q_x * J_x_theta;
       J->block<3, 3>(row, kObservationIndex) = -fk.placement.R_BP;
     }
@@ -134,7 +129,7 @@ void full_jacobian(const Eigen::MatrixXd& J_model, std::span<const Observation> 
   J.leftCols<kModelParameters>() = J_model;
   for (std::size_t k = 0; k < observations.size(); ++k) {
     const Eigen::Index row = 3 * static_cast<Eigen::Index>(k);
-    J.block<3, 3>(row, kRotationIndex) = -skew(X_BT.R * observations[k].p_T);  // exp(dw) R p = R p + dw x R p
+    J.block<3, 3>(row, kRotationIndex) = -detail::skew(X_BT.R * observations[k].p_T);  // exp(dw) R p = R p + dw x R p
     J.block<3, 3>(row, kTranslationIndex).setIdentity();
   }
 }
@@ -154,7 +149,7 @@ class RotationManifold final : public ceres::Manifold {
     const Eigen::Map<const RowMajor3d> R(x);
     Eigen::Map<Eigen::Matrix<double, 9, 3, Eigen::RowMajor>> J(jacobian);
     for (int j = 0; j < 3; ++j) {
-      const RowMajor3d dR = skew(Vector3d::Unit(j)) * R;
+      const RowMajor3d dR = detail::skew(Vector3d::Unit(j)) * R;
       J.col(j) = Eigen::Map<const Eigen::Matrix<double, 9, 1>>(dR.data());
     }
     return true;

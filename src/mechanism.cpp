@@ -2,6 +2,7 @@
 // motion, Newton-Euler on each body, projected onto the platform's coordinates by virtual power
 // (docs/theory.md §14; the symbols below are the section's).
 #include "hexatwist/mechanism.hpp"
+#include "geometry.hpp"
 
 #include <Eigen/LU>
 #include <cmath>
@@ -11,12 +12,6 @@
 
 namespace hexatwist {
 namespace {
-
-Matrix3d skew(const Vector3d& v) noexcept {
-  Matrix3d S;
-  S << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return S;
-}
 
 // Below this |j x s|^2 a U-joint is at its singularity: the spin of its body is undefined.
 constexpr double kSingularSpin = 1e-12;
@@ -320,7 +315,7 @@ void add_rank_one(const Vector3d& a, const Vector3d& q_u, const Vector3d& q_w, d
 void mass_matrix_of(const Rig& rig, const Mechanism& mech, Matrix6d& M_load, Matrix6d& M_drives) noexcept {
   const PlatformFrame& p = mech.platform;
   const double mass = rig.load().mass;
-  const Matrix3d C = skew(p.c);
+  const Matrix3d C = detail::skew(p.c);
   M_load.topLeftCorner<3, 3>() = mass * Matrix3d::Identity();
   M_load.topRightCorner<3, 3>() = -mass * C;
   M_load.bottomLeftCorner<3, 3>() = mass * C;
@@ -337,7 +332,7 @@ void mass_matrix_of(const Rig& rig, const Mechanism& mech, Matrix6d& M_load, Mat
                            r.mass * r.center * r.center) * il * il;
     const double across = r.mass - 2.0 * r.mass * r.center * il + tumble;  // along P = I - s s^T
     const double gamma = across, beta = across - r.mass;                  // K_uu = gamma I - beta s s^T
-    const Matrix3d A = skew(m.a);
+    const Matrix3d A = detail::skew(m.a);
     M_load.topLeftCorner<3, 3>() += gamma * Matrix3d::Identity();
     M_load.topRightCorner<3, 3>() -= gamma * A;
     M_load.bottomLeftCorner<3, 3>() += gamma * A;

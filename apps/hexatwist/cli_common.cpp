@@ -50,6 +50,13 @@ std::string read_text_file(const std::string& path, const std::string& option, c
   return text.str();
 }
 
+void write_file_or_stdout(const std::string& path, std::string_view content) {
+  if (path.empty())
+    write_stdout(content);
+  else
+    write_output_file(path, content);
+}
+
 void write_output_file(const std::string& file, std::string_view content) {
   OutputSet set;
   set.add(file, std::string(content));

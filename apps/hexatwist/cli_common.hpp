@@ -58,6 +58,9 @@ std::string read_text_file(const std::string& path, const std::string& option, c
 /// naming the file if it cannot be written (no temporary is left).
 void write_output_file(const std::string& path, std::string_view content);
 
+/// `content` to the file `path` (as write_output_file), or to standard output when `path` is empty.
+void write_file_or_stdout(const std::string& path, std::string_view content);
+
 /// ExitError(2) if two of the (option, path) pairs name the same file (`synth --out c.csv
 /// --run-out c.csv`): one command's outputs never overwrite each other. Empty paths are skipped.
 void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs);

@@ -107,11 +107,7 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
 int run_linuxcnc(const LinuxcncOptions& o, const std::string& command_line) {
   const Config config = load_config_from(o.model);
   const std::string text = ini_text(o, config, command_line);
-  if (o.out.empty()) {
-    write_stdout(text);
-  } else {
-    write_output_file(o.out, text);
-  }
+  write_file_or_stdout(o.out, text);
   return kExitOk;
 }
 

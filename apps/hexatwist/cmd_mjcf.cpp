@@ -20,11 +20,7 @@ int run_mjcf(const MjcfOptions& o) {
   std::string source = printable(model_source(o.model));
   for (std::size_t k = source.find("--"); k != std::string::npos; k = source.find("--")) source.replace(k, 2, "- -");
   text.insert(0, fmt::format("<!-- Configuration: {} -->\n", source));
-  if (o.out.empty()) {
-    write_stdout(text);
-  } else {
-    write_output_file(o.out, text);
-  }
+  write_file_or_stdout(o.out, text);
   return kExitOk;
 }
 
