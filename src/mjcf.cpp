@@ -153,10 +153,11 @@ std::string mjcf_model(const Rig& rig) {
     const double motor_body_share = base_driven ? housing_share : rod_share;
     const auto rotor_body = [&](int level, const Vector3d& com) {
       return fmt::format("{0}<body name=\"rotor{1}\">\n"
-                         "{0}  <joint name=\"leg{1}_rotor\" type=\"hinge\" axis=\"{2}\"/>\n"
+                         "{0}  <joint name=\"leg{1}_rotor\" type=\"hinge\" axis=\"{2}\" damping=\"{4}\" frictionloss=\"{5}\"/>\n"
                          "{0}  {3}\n"
                          "{0}</body>\n",
-                         indent(level), n, vec(s), inertial(com, motor_body_share, axisymmetric(s, Jm, disc(Jm))));
+                         indent(level), n, vec(s), inertial(com, motor_body_share, axisymmetric(s, Jm, disc(Jm))),
+                         num(rig.servo().viscous_friction), num(rig.servo().coulomb_friction));
     };
     const auto end_body = [&](int level) {
       return fmt::format("{0}<body name=\"end{1}\">\n"

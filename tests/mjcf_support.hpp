@@ -91,7 +91,7 @@ class MjSim {
     double r = 0.0;
     for (int it = 0; it < iterations; ++it) {
       mj_fwdPosition(m, d);
-      const int ne = d->nefc;
+      const int ne = d->ne;  // the equality rows come first (then dry friction's, which are not positions)
       const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(d->efc_J, ne, m->nv);
       const Eigen::Map<const Eigen::VectorXd> pos(d->efc_pos, ne);
       r = pos.cwiseAbs().maxCoeff();

@@ -89,7 +89,8 @@ TEST(Mjcf, AtHomeEveryEqualityHoldsAndTheJointsAreWhereTheModelPutsThem) {
     const Model& model = rig.model();
     MjSim sim(mjcf_model(rig));
     mj_forward(sim.m, sim.d);
-    EXPECT_EQ(sim.d->nefc, 6 * 6 + 12);
+    EXPECT_EQ(sim.d->ne, 6 * 6 + 12);  // six welds and twelve joint equalities
+    EXPECT_EQ(sim.d->nf, rig.servo().coulomb_friction > 0.0 ? 6 : 0);  // the rotors' dry friction
     report("max |efc_pos| at qpos0 [m or rad]", sim.max_residual());
     EXPECT_LT(sim.max_residual(), 1e-14);
     LegState legs;
@@ -310,7 +311,8 @@ TEST(Mjcf, MujocoInverseDynamicsGivesHexatwistsMotorTorquesWithoutFriction) {
     Eigen::Map<Eigen::VectorXd>(sim.d->qacc, nv) = qacc;
     mj_inverse(sim.m, sim.d);
     // qfrc_inverse = Jc^T lambda + (actuator moments)^T tau.
-    const int ne = sim.d->nefc;
+    const int ne = sim.d->ne;  // the equality rows (the test's rig has no friction rows)
+    ASSERT_EQ(sim.d->nefc, ne);
     Eigen::MatrixXd A(nv, ne + 6);
     A.leftCols(ne) = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
                          sim.d->efc_J, ne, nv).transpose();
