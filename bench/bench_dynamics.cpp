@@ -5,7 +5,7 @@
 // Run in Release: build/bench/bench_dynamics.
 #include "bench_support.hpp"
 
-#include "hexatwist/mechanism.hpp"
+#include "hexatwist/dynamics/mechanism.hpp"
 #if defined(HEXATWIST_BENCH_MUJOCO)
 #include "../tests/mjcf_support.hpp"
 #endif

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "fuzz_support.hpp"
-#include "hexatwist/trajectory.hpp"
+#include "hexatwist/simulation/trajectory.hpp"
 
 namespace {
 

@@ -24,7 +24,7 @@ sanitizer_env=(ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks
 if [ ! -f build-asan/build.ninja ]; then
   echo "hexatwist: building with the sanitizers in build-asan/ (the first build takes several minutes)" >&2
 fi
-# Without AVX-512, so that this build runs the leg kernels in their two-packet form (src/lanes.hpp)
+# Without AVX-512, so that this build runs the leg kernels in their two-packet form (src/kinematics/lanes.hpp)
 # where the Release build, on a CPU with AVX-512, runs the one-packet form.
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DHEXATWIST_SANITIZE=ON \
   -DHEXATWIST_BUILD_BENCHMARKS=OFF -DCMAKE_CXX_FLAGS=-mno-avx512f >/dev/null

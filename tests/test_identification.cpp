@@ -1,4 +1,4 @@
-// Identification (include/hexatwist/identification.hpp, theory §13) on synthetic tracker data made
+// Identification (include/hexatwist/calibration/identification.hpp, theory §13) on synthetic tracker data made
 // here: the seed model is the nominal one, the "true" platform has its lead 5 % off, the other
 // thread hand, zero errors of up to 1 mm per leg and the observation point a few mm away, and a
 // tracker stands at a random place. The commands are the nominal model's compensated commands at

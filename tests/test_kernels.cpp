@@ -1,7 +1,7 @@
-// The internal kernels of the real-time path: vectorised sin/cos and atan2 (src/fast_math.hpp)
-// against libm, and the fixed-size 6x6 solver (src/linear_solve.hpp) against Eigen.
-#include "../src/fast_math.hpp"
-#include "../src/linear_solve.hpp"
+// The internal kernels of the real-time path: vectorised sin/cos and atan2 (src/kinematics/fast_math.hpp)
+// against libm, and the fixed-size 6x6 solver (src/kinematics/linear_solve.hpp) against Eigen.
+#include "kinematics/fast_math.hpp"
+#include "kinematics/linear_solve.hpp"
 
 #include <Eigen/LU>
 

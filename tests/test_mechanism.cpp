@@ -6,10 +6,10 @@
 
 #include <cmath>
 
-#include "hexatwist/config.hpp"
-#include "hexatwist/dynamics.hpp"
-#include "hexatwist/mechanism.hpp"
-#include "hexatwist/twist.hpp"
+#include "hexatwist/io/config.hpp"
+#include "hexatwist/dynamics/dynamics.hpp"
+#include "hexatwist/dynamics/mechanism.hpp"
+#include "hexatwist/kinematics/twist.hpp"
 #include "support.hpp"
 
 namespace hexatwist {

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "hexatwist/mechanism.hpp"
+#include "hexatwist/dynamics/mechanism.hpp"
 #include "mjcf_support.hpp"
 #include "support.hpp"
 

@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "hexatwist/config.hpp"
-#include "hexatwist/motor_sizing.hpp"
+#include "hexatwist/io/config.hpp"
+#include "hexatwist/dynamics/motor_sizing.hpp"
 
 namespace hexatwist {
 namespace {

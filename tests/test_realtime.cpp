@@ -3,8 +3,8 @@
 #include <cstdlib>
 #include <new>
 
-#include "hexatwist/config.hpp"
-#include "hexatwist/mechanism.hpp"
+#include "hexatwist/io/config.hpp"
+#include "hexatwist/dynamics/mechanism.hpp"
 #include "support.hpp"
 
 namespace {

@@ -3,9 +3,9 @@
 
 #include <functional>
 
-#include "hexatwist/config.hpp"
+#include "hexatwist/io/config.hpp"
 #include "hexatwist/error.hpp"
-#include "hexatwist/rig.hpp"
+#include "hexatwist/simulation/rig.hpp"
 
 namespace hexatwist {
 namespace {

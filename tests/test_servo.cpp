@@ -6,8 +6,8 @@
 #include <Eigen/LU>
 #include <cmath>
 
-#include "hexatwist/config.hpp"
-#include "hexatwist/servo.hpp"
+#include "hexatwist/io/config.hpp"
+#include "hexatwist/simulation/servo.hpp"
 
 namespace hexatwist {
 namespace {

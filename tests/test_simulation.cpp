@@ -4,9 +4,9 @@
 
 #include <cstdio>
 
-#include "hexatwist/config.hpp"
-#include "hexatwist/mechanism.hpp"
-#include "hexatwist/simulation.hpp"
+#include "hexatwist/io/config.hpp"
+#include "hexatwist/dynamics/mechanism.hpp"
+#include "hexatwist/simulation/simulation.hpp"
 
 namespace hexatwist {
 namespace {

@@ -1,4 +1,4 @@
-// The real-time command stream (include/hexatwist/stream.hpp): pose lines, reject policies, rate
+// The real-time command stream (include/hexatwist/kinematics/stream.hpp): pose lines, reject policies, rate
 // limits, answer lines.
 #include <yaml-cpp/yaml.h>
 

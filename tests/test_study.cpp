@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "hexatwist/config.hpp"
-#include "hexatwist/study.hpp"
+#include "hexatwist/io/config.hpp"
+#include "hexatwist/simulation/study.hpp"
 
 namespace hexatwist {
 namespace {

@@ -1,7 +1,7 @@
 // Reach along each pose coordinate alone (workspace.hpp): every value inside the interval is
 // accepted, the values just past its ends are refused by the limit it names, and the search
 // agrees with itself at another step size.
-#include "hexatwist/workspace.hpp"
+#include "hexatwist/kinematics/workspace.hpp"
 
 #include "support.hpp"
 

@@ -1,5 +1,5 @@
 // hexatwist stream: one pose per line (stdin) or datagram (UDP) in, one answer per input out,
-// in order: six checked motor commands and a status (include/hexatwist/stream.hpp does the work;
+// in order: six checked motor commands and a status (include/hexatwist/kinematics/stream.hpp does the work;
 // this file only moves bytes).
 #include <fmt/format.h>
 #include <sched.h>

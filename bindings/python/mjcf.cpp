@@ -1,6 +1,6 @@
 // The platform as a MuJoCo model (mjcf.hpp): MJCF XML text of a Rig.
 #include "common.hpp"
-#include "hexatwist/mjcf.hpp"
+#include "hexatwist/io/mjcf.hpp"
 
 namespace hexatwist::python {
 

@@ -6,9 +6,9 @@
 #include <string>
 
 #include "hexatwist/c/hexatwist.h"
-#include "hexatwist/limits.hpp"
-#include "hexatwist/model.hpp"
-#include "hexatwist/pose.hpp"
+#include "hexatwist/kinematics/limits.hpp"
+#include "hexatwist/kinematics/model.hpp"
+#include "hexatwist/kinematics/pose.hpp"
 #include "hexatwist/status.hpp"
 
 /// The opaque model of the C API: a validated hexatwist::Model and its name as a C string.

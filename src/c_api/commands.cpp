@@ -1,7 +1,7 @@
 // C API: motor commands (paper Eq. 1-12), the full command report and the twist; real-time.
 #include "c_api.hpp"
-#include "hexatwist/compensation.hpp"
-#include "hexatwist/twist.hpp"
+#include "hexatwist/kinematics/compensation.hpp"
+#include "hexatwist/kinematics/twist.hpp"
 
 using namespace hexatwist;
 

@@ -1,6 +1,6 @@
 // C API: forward kinematics from a guess and along a motion (the tracker); real-time.
 #include "c_api.hpp"
-#include "hexatwist/forward.hpp"
+#include "hexatwist/kinematics/forward.hpp"
 
 using namespace hexatwist;
 

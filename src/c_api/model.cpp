@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "c_api.hpp"
-#include "hexatwist/config.hpp"
+#include "hexatwist/io/config.hpp"
 #include "hexatwist/error.hpp"
 
 namespace {

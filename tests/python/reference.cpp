@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "hexatwist/hexatwist.hpp"
-#include "hexatwist/mechanism.hpp"
-#include "hexatwist/mjcf.hpp"
+#include "hexatwist/dynamics/mechanism.hpp"
+#include "hexatwist/io/mjcf.hpp"
 
 namespace {
 

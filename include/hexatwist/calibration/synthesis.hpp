@@ -1,0 +1,58 @@
+// Tracker-like point logs made from the closed-loop simulation of a platform whose real parameters
+// differ from its model by known errors, with the truth beside them: test data for `measure`
+// and for an identification, since no real measurement ships with hexatwist (docs/theory.md §12).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "hexatwist/calibration/measurement.hpp"
+#include "hexatwist/calibration/parameter_errors.hpp"
+
+namespace hexatwist {
+
+/// How to make a synthetic log.
+struct SynthesisOptions {
+  Strategy strategy = Strategy::Compensated;  ///< the commands the platform runs
+  ParameterErrors errors;                     ///< the real platform against the nominal model
+  /// Standard deviation of the tracker's Gaussian noise on each axis [m]. Default 10 um: the
+  /// laser-tracker class of the paper's experiment (a Leica AT960 is specified at 15 um + 6 um/m).
+  double noise = 10e-6;
+  /// Tracker samples per second [Hz]; the control rate must be a whole multiple of it. 100 Hz
+  /// resolves the servo (poles at 10 Hz, bandwidth ~39 Hz) and keeps a log small.
+  double rate = 100.0;
+  std::uint64_t seed = 1;  ///< seed of the tracker's placement and of the noise
+};
+
+/// A synthetic log and its truth.
+struct SyntheticLog {
+  /// The log as a tracker would give it: stamps are the trajectory's time [s]; points [m, T];
+  /// lines as in a CSV with one header line (point k on line k + 2).
+  PointLog log;
+  RigidTransform X_BT;             ///< the tracker frame in the base frame (what registration finds)
+  std::vector<Vector3d> true_B;    ///< the real observation point at each point, before transform and noise [m, B]
+  std::vector<std::size_t> ticks;  ///< the simulation tick of each point
+  std::vector<SimulationSample> simulation;  ///< the closed loop on the nominal model, every tick
+};
+
+/// A laser tracker's placement drawn from `seed`: a uniformly random orientation, and its origin
+/// 3 to 6 m from the base origin horizontally, 0 to 2 m above it (the platform within range).
+RigidTransform random_tracker_frame(std::uint64_t seed);
+
+/// Zero-length offsets drawn independently and uniformly from [-bound, bound] [m] (the same
+/// portable generator; another stream of `seed` than the tracker's).
+Vector6d random_zero_offsets(double bound, std::uint64_t seed);
+
+/// Simulates `trajectory` on `rig` in closed loop (`simulate`, with options.strategy; the
+/// controller and its encoders know only the nominal model) and, at every tracker sample, maps
+/// the motors' positions through the real platform: real_motor_lengths, then twist-aware forward
+/// kinematics of real_model (warm-started), gives the real pose and the real observation point;
+/// it is moved into the tracker frame (random_tracker_frame(seed)) and gets Gaussian noise
+/// (portable generator: the same seed gives the same log everywhere). Returns the simulation's
+/// status (Ok, or where it stopped in `issue`; forward kinematics failing on the real platform is
+/// reported there too). Throws hexatwist::Error for a rate that does not divide the control rate,
+/// a noise that is not finite and >= 0, or parameter errors that make no valid model.
+[[nodiscard]] Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisOptions& options,
+                                SyntheticLog& out, SimulationIssue& issue);
+
+}  // namespace hexatwist

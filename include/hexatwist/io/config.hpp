@@ -1,0 +1,58 @@
+// Platform configuration in YAML: parse text into a Model. Reading files is the caller's job.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "hexatwist/simulation/rig.hpp"
+#include "hexatwist/simulation/study.hpp"
+
+namespace hexatwist {
+
+/// The seed platform (configs/seed.yaml, embedded at build time) as YAML text.
+std::string_view seed_config_yaml() noexcept;
+
+/// Parses a YAML platform configuration. `source` names the text in error messages (a file name).
+/// Throws hexatwist::Error with a single line "source:line:column: field 'x.y': what was expected".
+ModelSpec parse_model_spec(std::string_view yaml_text, std::string_view source);
+
+/// parse_model_spec followed by Model validation (errors are prefixed with `source`).
+Model load_model(std::string_view yaml_text, std::string_view source);
+
+/// The embedded default: the seed platform with a 10 mm lead.
+Model default_model();
+
+/// A whole configuration: the platform and, in the optional sections `servo`, `load`,
+/// `simulation` and `study`, its drives, load, simulation rates and test motion (defaults where
+/// a section or key is absent; configs/seed.yaml lists them all).
+struct ConfigSpec {
+  RigSpec rig;
+  StudySpec study;
+};
+
+/// Parses a whole configuration (errors as parse_model_spec).
+ConfigSpec parse_config_spec(std::string_view yaml_text, std::string_view source);
+
+/// A validated configuration.
+struct Config {
+  Rig rig;
+  StudySpec study;
+};
+
+/// parse_config_spec followed by validation of the rig and the study (errors located in the text).
+Config load_config(std::string_view yaml_text, std::string_view source);
+
+/// The embedded seed configuration with its servo, load and study sections.
+Config default_config();
+
+/// The configuration `yaml_text` with what an identification corrects taken from `corrected`: the
+/// name, the lead and thread (in `screw`, and in every leg entry that gives its own), `length_offsets`
+/// and `observation_point`. Every other key keeps its value and its place; comments are dropped,
+/// and the lines of `header` (may be empty) open the text as comments. Numbers are written to
+/// round trip exactly. The legs of `corrected` must share one lead and thread (as
+/// corrected_spec's do). Throws hexatwist::Error as load_config for text that does not load, and
+/// for legs that differ in lead or thread.
+std::string corrected_config_yaml(std::string_view yaml_text, std::string_view source, const ModelSpec& corrected,
+                                  std::string_view header);
+
+}  // namespace hexatwist

@@ -1,0 +1,40 @@
+// Length error from the twist (Eq. 10) and the motor commands with and without compensation
+// (Eq. 11-12): what the servo must reach on the motor side.
+#pragma once
+
+#include "hexatwist/kinematics/limits.hpp"
+#include "hexatwist/kinematics/twist.hpp"
+
+namespace hexatwist {
+
+/// How motor-side commands are formed.
+enum class Strategy {
+  Conventional,  ///< command = IK length - length_offset; the twist is ignored
+  Compensated,   ///< command = IK length - length_offset - twist_gain * dtheta, Eq. (12)
+};
+
+/// Length error of each leg caused by its twist, Eq. (10) with the configured sign:
+/// real length - motor-side length = twist_gain_i * dtheta_i [m].
+void length_error(const Model& model, const Vector6d& dtheta, Vector6d& error) noexcept;
+
+/// Everything about one commanded pose (caller-owned workspace).
+struct CommandReport {
+  LegState legs;                            ///< inverse kinematics
+  Vector6d twist = Vector6d::Zero();        ///< dtheta relative to home [rad]
+  Vector6d length_error = Vector6d::Zero(); ///< Eq. (10) [m]
+  Vector6d conventional = Vector6d::Zero(); ///< motor-side command, twist ignored [m]
+  Vector6d compensated = Vector6d::Zero();  ///< motor-side command, Eq. (12) [m]
+  LimitReport limit;                        ///< first limit violated, if any
+};
+
+/// Full computation for a pose: IK, twist, Eq. (10), both commands and the limit check (pose
+/// limits, then both commands against the stroke). On any status other than Ok the commands
+/// must not be sent.
+[[nodiscard]] Status compute_commands(const Model& model, const Pose& pose, CommandReport& out) noexcept;
+
+/// Real-time path: the motor-side commands for one strategy [m], limits checked. `command` is
+/// written only when the result is Ok; `report` says which leg and limit otherwise.
+[[nodiscard]] Status motor_commands(const Model& model, const Pose& pose, Strategy strategy,
+                                    Vector6d& command, LimitReport& report) noexcept;
+
+}  // namespace hexatwist

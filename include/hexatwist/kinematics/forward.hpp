@@ -1,0 +1,84 @@
+// Forward kinematics: the pose for given leg lengths, by Newton's method on R^3 x SO(3), either
+// from geometric lengths or from motor-side lengths with the twist included.
+#pragma once
+
+#include "hexatwist/kinematics/kinematics.hpp"
+
+namespace hexatwist {
+
+/// What the given lengths are.
+enum class LengthKind {
+  Geometric,  ///< joint-to-joint leg lengths: solve |L_i(q)| = l_i
+  Motor,      ///< motor-side lengths: solve |L_i(q)| - length_offset_i - twist_gain_i * dtheta_i(q) = m_i
+};
+
+/// Newton settings.
+struct FkOptions {
+  int max_iterations = 30;     ///< Newton iterations before NoConvergence
+  double tolerance = 1e-12;    ///< max |residual| accepted [m]
+  double singular_ratio = 1e-12;  ///< smallest |pivot| ratio of the LU before SingularJacobian
+  /// Step cap (docs/theory.md §5): a Newton step whose translation |dt| or rotation |dw| is
+  /// longer than these is shortened, direction kept, before the line search.
+  double max_step_translation = 0.5;  ///< longest translation of one step [m]
+  double max_step_rotation = 0.5;     ///< largest rotation of one step [rad]
+};
+
+/// Result of forward kinematics (caller-owned).
+struct FkResult {
+  Placement placement;       ///< solution as displacement + rotation matrix
+  Pose pose;                 ///< the same as roll-pitch-yaw
+  int iterations = 0;        ///< Newton iterations taken
+  double residual = 0.0;     ///< max_i |residual_i| at `placement` [m]
+  LegState legs;             ///< inverse kinematics at the solution
+  /// Condition number of the Jacobian of the lengths of `kind` at the solution, defined as in
+  /// jacobian_condition (limits.hpp) [-]; NaN unless the status is Ok or AssemblyModeChanged.
+  double condition = 0.0;
+  /// Sign of det of that Jacobian at the solution (+1 or -1; 0 when it was not computed): the
+  /// assembly mode [-].
+  double det_sign = 0.0;
+};
+
+/// Caller-owned state of forward kinematics along a motion (forward_kinematics_tracked).
+struct FkTracker {
+  Placement last;        ///< the last solution, the next call's start [m, B]
+  double det_sign = 0;   ///< its assembly mode, the sign of the Jacobian's determinant [-]
+  bool valid = false;    ///< false until the first solution (the start is then home)
+};
+
+/// Jacobian of the lengths of `kind` at the state `legs` (inverse kinematics done) for the
+/// perturbation of length_jacobian: the length Jacobian, minus diag(twist_gain) times the twist
+/// Jacobian for motor-side lengths. Returns SingularBase/SingularPlatform as twist_jacobian does.
+[[nodiscard]] Status length_jacobian(const Model& model, const LegState& legs, LengthKind kind, Matrix6d& J) noexcept;
+
+/// Residual f(x) = g(x) - lengths, with g the geometric or motor-side lengths, and its Jacobian
+/// J_f_x for the perturbation t += dt, R = exp(dw) R. The motor-side rows include the twist's
+/// derivative.
+[[nodiscard]] Status fk_residual(const Model& model, const Placement& x, const Vector6d& lengths,
+                                 LengthKind kind, LegState& legs, Vector6d& f, Matrix6d* J_f_x) noexcept;
+
+/// Forward kinematics from `guess` (home by default in the CLI). Returns Ok, NoConvergence,
+/// SingularJacobian, SingularBase/SingularPlatform (an iterate crossed a U-joint singularity),
+/// NonFiniteInput, or AssemblyModeChanged when the solution's Jacobian determinant has another
+/// sign than the guess's (the pose found is on another assembly mode: out.placement holds it, but
+/// it is not the pose the guess was near). `out.residual` and `out.iterations` are set in every
+/// case; on failure `out.placement` is the best iterate.
+[[nodiscard]] Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKind kind,
+                                        const Placement& guess, FkResult& out,
+                                        const FkOptions& options = {}) noexcept;
+
+/// Forward kinematics along a motion: from tracker.last (home while !tracker.valid), Ok only when
+/// converged on the same assembly mode as the tracker's (home's while !valid) and with the
+/// Jacobian's condition inside limits.jacobian_condition_max (else PlatformSingularity: near a
+/// singularity the lengths no longer tell on which side the platform is). On Ok it stores
+/// the solution in `tracker`; on failure it leaves `tracker` as it was and returns the status of
+/// forward_kinematics (AssemblyModeChanged, NoConvergence, SingularJacobian, ...).
+[[nodiscard]] Status forward_kinematics_tracked(const Model& model, const Vector6d& lengths, LengthKind kind,
+                                                FkTracker& tracker, FkResult& out,
+                                                const FkOptions& options = {}) noexcept;
+
+/// Sets `tracker` to a known placement (after homing, or as a fallback start) with that
+/// placement's assembly mode for lengths of `kind`. Returns the status of inverse kinematics or of
+/// the Jacobian (SingularJacobian where its determinant is zero); `tracker` is unchanged then.
+[[nodiscard]] Status fk_tracker_set(const Model& model, const Placement& x, LengthKind kind, FkTracker& tracker) noexcept;
+
+}  // namespace hexatwist

@@ -1,0 +1,85 @@
+#include "hexatwist/calibration/synthesis.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "hexatwist/error.hpp"
+#include "calibration/random.hpp"
+
+namespace hexatwist {
+using detail::Random;
+
+RigidTransform random_tracker_frame(std::uint64_t seed) {
+  Random rng(seed);
+  // Uniform on SO(3): a uniform unit quaternion (Shoemake, Graphics Gems III, 1992).
+  const double u1 = rng.uniform(), u2 = 2.0 * kPi * rng.uniform(), u3 = 2.0 * kPi * rng.uniform();
+  const Eigen::Quaterniond q(std::sqrt(u1) * std::cos(u3), std::sqrt(1.0 - u1) * std::sin(u2),
+                             std::sqrt(1.0 - u1) * std::cos(u2), std::sqrt(u1) * std::sin(u3));
+  const double distance = 3.0 + 3.0 * rng.uniform(), azimuth = 2.0 * kPi * rng.uniform();
+  const double height = 2.0 * rng.uniform();
+  return {q.toRotationMatrix(), Vector3d(distance * std::cos(azimuth), distance * std::sin(azimuth), height)};
+}
+
+Vector6d random_zero_offsets(double bound, std::uint64_t seed) {
+  if (!(std::isfinite(bound) && bound >= 0.0))
+    throw Error(fmt::format("zero offsets: expected a finite bound >= 0 m, got {}", bound));
+  Vector6d offsets = Vector6d::Zero();
+  if (bound == 0.0) return offsets;
+  Random rng(seed ^ 0xD1B54A32D192ED03ull);
+  for (int i = 0; i < kLegs; ++i) offsets[i] = bound * rng.symmetric();
+  return offsets;
+}
+
+Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisOptions& options, SyntheticLog& out,
+                  SimulationIssue& issue) {
+  out = SyntheticLog{};
+  issue = SimulationIssue{};
+  const double control_rate = rig.simulation().control_rate;
+  const double ratio = control_rate / options.rate;
+  if (!(std::isfinite(options.rate) && options.rate > 0.0) || ratio < 1.0 - 1e-9 ||
+      std::abs(ratio - std::round(ratio)) > 1e-9 * ratio)
+    throw Error(fmt::format("rate: {} Hz does not divide the control rate {} Hz (choose {} Hz, {} Hz, ...)",
+                            options.rate, control_rate, control_rate, control_rate / 2.0));
+  if (!(std::isfinite(options.noise) && options.noise >= 0.0))
+    throw Error(fmt::format("noise: expected a finite standard deviation >= 0 m, got {}", options.noise));
+  const Model real = real_model(rig.model(), options.errors);
+  const auto every = static_cast<std::size_t>(std::round(ratio));
+
+  SimulationOptions sim;
+  sim.strategy = options.strategy;
+  if (const Status s = simulate(rig, trajectory, sim, out.simulation, issue); s != Status::Ok) return s;
+
+  out.X_BT = random_tracker_frame(options.seed);
+  const RigidTransform X_TB = inverse(out.X_BT);
+  Random noise(options.seed ^ 0x9E3779B97F4A7C15ull);  // another stream than the placement's
+  out.log.source = "synthetic log";
+  FkResult fk;
+  Placement guess = placement_from_pose(trajectory.poses.front());
+  Vector6d motor;
+  for (std::size_t k = 0; k < out.simulation.size(); k += every) {
+    const SimulationSample& sample = out.simulation[k];
+    real_motor_lengths(rig.model(), options.errors, sample.motor, motor);
+    if (const Status s = forward_kinematics(real, motor, LengthKind::Motor, guess, fk); s != Status::Ok) {
+      issue.status = s;
+      issue.index = k;
+      issue.time = sample.time;
+      issue.limit = LimitReport{};
+      issue.limit.status = s;
+      return s;
+    }
+    guess = fk.placement;
+    const Vector3d p_B = platform_point_B(real, fk.placement, real.spec().observation_P);
+    Vector3d p_T = apply(X_TB, p_B);
+    for (int a = 0; a < 3; ++a) p_T[a] += options.noise * noise.normal();
+    out.true_B.push_back(p_B);
+    out.ticks.push_back(k);
+    out.log.stamps.push_back(sample.time);
+    out.log.points_T.push_back(p_T);
+    out.log.lines.push_back(static_cast<int>(out.log.lines.size()) + 2);
+    out.log.stamp_columns.push_back(1);
+  }
+  return Status::Ok;
+}
+
+}  // namespace hexatwist

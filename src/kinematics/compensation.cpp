@@ -1,0 +1,117 @@
+#include "hexatwist/kinematics/compensation.hpp"
+
+#include "kinematics/lanes.hpp"
+#include "kinematics/twist_internal.hpp"
+
+namespace hexatwist {
+namespace {
+
+// Names a failure that is not a limit (non-finite input, singular joint) in the report.
+Status fail(LimitReport& report, Status status) noexcept {
+  report = LimitReport{};
+  report.status = status;
+  return status;
+}
+
+}  // namespace
+
+void length_error(const Model& model, const Vector6d& dtheta, Vector6d& error) noexcept {
+  // Eq. (10): lenP_i = dtheta_i / 2pi * P_h, with the thread-hand sign in twist_gain.
+  error = model.geometry().twist_gain.cwiseProduct(dtheta);
+}
+
+Status compute_commands(const Model& model, const Pose& pose, CommandReport& out) noexcept {
+  out.limit = LimitReport{};
+  if (!pose.is_finite()) return fail(out.limit, Status::NonFiniteInput);
+  if (const Status s = inverse_kinematics(model, pose, out.legs); s != Status::Ok) return fail(out.limit, s);
+  const Status pose_status = check_limits(model, out.legs, out.limit);
+  // The twist is defined wherever no U-joint is singular, also outside the other limits.
+  if (const Status s = twist(model, out.legs, out.twist); s != Status::Ok) {
+    if (pose_status != Status::Ok) return pose_status;
+    return fail(out.limit, s);
+  }
+  length_error(model, out.twist, out.length_error);
+  // Eq. (11)-(12) as absolute motor-side lengths; both commands take the legs' zero errors out.
+  out.conventional = out.legs.length - model.geometry().length_offset;
+  out.compensated = out.conventional - out.length_error;
+  if (pose_status != Status::Ok) return pose_status;
+  return check_stroke(model, out.compensated, out.limit);
+}
+
+namespace {
+
+// The real-time command in one pass over the legs, in registers (lanes.hpp): the kernels of
+// inverse_kinematics, check_limits, twist and check_stroke without the LegState between them,
+// and with the leg vectors L_i in place of the unit s_i, which spares a division on the
+// critical path (the tests and the twist's atan2 are homogeneous in the leg's scale). True,
+// with `command` written, if every test passes; false leaves the naming of the limit or joint
+// to the full path. The two decide alike except within rounding of a bound. The legs are kept in
+// `legs` for the Jacobian's condition, tested after the loop.
+bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, Vector6d& command) noexcept {
+  using namespace detail;
+  const LegLanes& g = model.geometry().lanes;
+  const Matrix3d R = detail::rotation_from_rpy(pose.rpy);
+  lane_m ok = all_set();
+  Vector6d out;
+  LegState state;
+  state.R_BP = R;
+#pragma GCC unroll 4
+  for (int k = 0; k < kPackets; ++k) {
+    const LegsAt legs = legs_at(model, R, pose.position, k);
+    store6(state.arm_B, legs.arm, k);
+    store6(state.axis_platform_B, legs.axis_platform, k);
+    store6(state.length.data(), legs.length, k);
+    store6(state.s_B, (1.0 / legs.length) * legs.leg, k);
+    const lanes3 ja = load_lanes(g.axis_base_B, k);
+    const lane_v dot_a = dot(legs.leg, ja), dot_d = dot(legs.leg, legs.axis_platform);
+    ok &= within_limits(model, limit_terms(model, R, legs.leg, legs.length, legs.length, dot_a, dot_d, k));
+    lane_v command_k = legs.length - load_lanes(g.length_offset, k);
+    if (compensated) {
+      // x scales with |L|^2 and y with |L|: one more |L| on y puts both on the same scale.
+      const TwistTerms t = twist_terms(legs.leg, ja, legs.axis_platform, dot_a, dot_d, legs.length2);
+      const lane_v y = legs.length * t.y;
+      command_k -= load_lanes(g.twist_gain, k) * twist_angle(model, t.x, y, true, k);  // Eq. (12)
+      ok &= twist_regular(model, t.x, y, legs.length2 * legs.length2, k) & within_stroke(model, command_k);
+    }
+    store6(out.data(), command_k, k);
+  }
+  if (!all_lanes(ok)) return false;
+  // The platform singularity last, once every leg passed (limits.hpp): a cheap proof that the
+  // condition is inside the limit, which holds for nearly every pose, else the exact number.
+  double condition;
+  if (!detail::condition_proven_within(model, state) && jacobian_condition(model, state, condition) != Status::Ok)
+    return false;
+  command = out;
+  return true;
+}
+
+}  // namespace
+
+Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, Vector6d& command,
+                      LimitReport& report) noexcept {
+  if (!pose.is_finite()) return fail(report, Status::NonFiniteInput);
+  const bool compensated = strategy == Strategy::Compensated && model.has_twist();
+  if (commands_in_lanes(model, pose, compensated, command)) {
+    report = LimitReport{};
+    return Status::Ok;
+  }
+  // Some test failed: the same computation through a LegState, which names the leg and limit.
+  LegState legs;
+  // The Placement overload: the Pose one would test finiteness a second time.
+  if (const Status s = inverse_kinematics(model, placement_from_pose(pose), legs); s != Status::Ok)
+    return fail(report, s);
+  if (const Status s = check_limits(model, legs, report); s != Status::Ok) return s;
+  const Vector6d& offset = model.geometry().length_offset;
+  if (!compensated) {
+    command = legs.length - offset;
+    return Status::Ok;
+  }
+  Vector6d dtheta;
+  if (const Status s = twist(model, legs, dtheta); s != Status::Ok) return fail(report, s);
+  Vector6d compensated_command = legs.length - offset - model.geometry().twist_gain.cwiseProduct(dtheta);  // Eq. (12)
+  if (const Status s = check_stroke(model, compensated_command, report); s != Status::Ok) return s;
+  command = compensated_command;
+  return Status::Ok;
+}
+
+}  // namespace hexatwist

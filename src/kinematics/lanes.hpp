@@ -1,0 +1,197 @@
+// Internal: the six legs side by side, one leg per lane, in the widest double vector the target
+// has: one packet of eight lanes with AVX-512, two of four with AVX, three of two with SSE2 or
+// NEON (lanes 6 and 7, where they exist, repeat leg 0, so they pass or fail every test with it
+// and need no mask). Inverse kinematics, the limit tests and the twist are written once here,
+// per packet, and shared by the functions that fill a LegState (kinematics.cpp, limits.cpp,
+// twist.cpp) and by the real-time command (compensation.cpp), which keeps everything in
+// registers. (GCC's generic eight-lane vectors on AVX2 spill to the stack: 3.5x slower.)
+#pragma once
+
+#include <cstring>
+
+#include "kinematics/fast_math.hpp"
+#include "hexatwist/kinematics/kinematics.hpp"
+#include "hexatwist/kinematics/model.hpp"
+
+namespace hexatwist::detail {
+
+using lane_m = mask_of<lane_v>;
+using lanes3 = vec3<lane_v>;
+/// Legs per packet, and packets for the six legs.
+inline constexpr int kWidth = sizeof(lane_v) / sizeof(double);
+inline constexpr int kPackets = (kLegs + kWidth - 1) / kWidth;
+static_assert(kPackets * kWidth <= 8, "LegLanes holds eight lanes");
+
+/// Legs k*kWidth ... of a 6-vector (or a column of a 6-row matrix); lanes past leg 5 repeat leg 0.
+/// Built from whole 2- and 4-lane loads and shuffles: element-wise it cost a third of the
+/// forward kinematics.
+inline lane_v load6(const double* p, int k) noexcept {
+  const auto load = [](const double* q, auto v) {
+    std::memcpy(&v, q, sizeof v);
+    return v;
+  };
+#if HEXATWIST_LANE_WIDTH == 2
+  return load(p + 2 * k, v2d{});
+#else
+  const v4d tail = __builtin_shufflevector(load(p + 4, v2d{}), load(p, v2d{}), 0, 1, 2, 2);  // legs 4, 5, 0, 0
+#if HEXATWIST_LANE_WIDTH == 4
+  return k == 0 ? load(p, v4d{}) : tail;
+#else
+  (void)k;  // one packet
+  return __builtin_shufflevector(load(p, v4d{}), tail, 0, 1, 2, 3, 4, 5, 6, 7);
+#endif
+#endif
+}
+/// Writes the legs of packet k (not the padding) into p[0..5], as whole 2- and 4-lane stores
+/// (a partial copy of the vector went through the stack).
+inline void store6(double* p, lane_v v, int k) noexcept {
+#if HEXATWIST_LANE_WIDTH == 2
+  std::memcpy(p + 2 * k, &v, sizeof v);
+#elif HEXATWIST_LANE_WIDTH == 4
+  if (k == 0) {
+    std::memcpy(p, &v, sizeof v);
+  } else {
+    const v2d legs45 = __builtin_shufflevector(v, v, 0, 1);
+    std::memcpy(p + 4, &legs45, sizeof legs45);
+  }
+#else
+  (void)k;  // one packet
+  const v4d legs0123 = __builtin_shufflevector(v, v, 0, 1, 2, 3);
+  const v2d legs45 = __builtin_shufflevector(v, v, 4, 5);
+  std::memcpy(p, &legs0123, sizeof legs0123);
+  std::memcpy(p + 4, &legs45, sizeof legs45);
+#endif
+}
+/// The rows of a LegVectors (leg i in lane i).
+inline lanes3 load6(const LegVectors& m, int k) noexcept {
+  return {load6(m.data(), k), load6(m.data() + kLegs, k), load6(m.data() + 2 * kLegs, k)};
+}
+inline void store6(LegVectors& m, const lanes3& v, int k) noexcept {
+  store6(m.data(), v.x, k);
+  store6(m.data() + kLegs, v.y, k);
+  store6(m.data() + 2 * kLegs, v.z, k);
+}
+/// Packet k of a quantity of the model's LegLanes.
+inline lane_v load_lanes(const double (&a)[8], int k) noexcept {
+  lane_v v;
+  std::memcpy(&v, a + k * kWidth, sizeof v);
+  return v;
+}
+inline lanes3 load_lanes(const double (&a)[3][8], int k) noexcept {
+  return {load_lanes(a[0], k), load_lanes(a[1], k), load_lanes(a[2], k)};
+}
+
+/// Every lane set.
+inline lane_m all_set() noexcept { return bits(splat<lane_v>(0.0)) == bits(splat<lane_v>(0.0)); }
+/// True if every lane of m is set.
+template <class M>
+inline bool all_lanes(M m) noexcept {
+  constexpr int width = sizeof(M) / sizeof(double);
+  if constexpr (width == 8) {
+    const auto m4 = __builtin_shufflevector(m, m, 0, 1, 2, 3) & __builtin_shufflevector(m, m, 4, 5, 6, 7);
+    const auto m2 = __builtin_shufflevector(m4, m4, 0, 1) & __builtin_shufflevector(m4, m4, 2, 3);
+    return (m2[0] & m2[1]) != 0;
+  } else if constexpr (width == 4) {
+    const auto m2 = __builtin_shufflevector(m, m, 0, 1) & __builtin_shufflevector(m, m, 2, 3);
+    return (m2[0] & m2[1]) != 0;
+  } else {
+    return (m[0] & m[1]) != 0;
+  }
+}
+
+/// The legs of packet k at one placement, Eq. (1)-(4).
+struct LegsAt {
+  lanes3 arm;            ///< R_BP * arm_P [m, B]
+  lanes3 axis_platform;  ///< R_BP * jd_P [-, B]
+  lanes3 leg;            ///< L_i [m, B]
+  lane_v length2;        ///< |L_i|^2 [m^2]
+  lane_v length;         ///< |L_i| [m]
+};
+
+inline LegsAt legs_at(const Model& model, const Matrix3d& R_BP, const Vector3d& t, int k) noexcept {
+  const LegLanes& g = model.geometry().lanes;
+  LegsAt out;
+  out.arm = rotate(R_BP, load_lanes(g.arm_P, k));
+  out.axis_platform = rotate(R_BP, load_lanes(g.axis_platform_P, k));
+  const Vector3d origin_B = model.pivot_home_B() + t;
+  const lanes3 base = load_lanes(g.base_B, k);
+  // L_i = (pivot_home + t) + R_BP * arm_P,i - base_B,i.
+  out.leg = {(out.arm.x - base.x) + origin_B.x(), (out.arm.y - base.y) + origin_B.y(),
+             (out.arm.z - base.z) + origin_B.z()};
+  out.length2 = dot(out.leg, out.leg);
+  out.length = vsqrt(out.length2);
+  return out;
+}
+
+/// What the pose limits test, per leg, for leg directions u = scale * s (u = s, scale = 1, or
+/// u = L, scale = |L|, which spares a division): stroke, U-joint bend as cosines to the home
+/// direction seen from each end, and singularity as (s . axis)^2 against cos^2(margin); no
+/// trigonometry.
+struct LimitTerms {
+  lane_v length;        ///< |L_i| [m]
+  lane_v scale;         ///< |u|
+  lane_v cos_base;      ///< u . s_home_B = scale * cos(bend at the base)
+  lane_v cos_platform;  ///< u . (R_BP s_home_B): the same seen from the platform
+  lane_v dot_a;         ///< u . ja (0 for legs without axes)
+  lane_v dot_d;         ///< u . jd (0 for legs without axes)
+};
+
+inline LimitTerms limit_terms(const Model& model, const Matrix3d& R_BP, const lanes3& u, lane_v scale, lane_v length,
+                              lane_v dot_a, lane_v dot_d, int k) noexcept {
+  const lanes3 home = load_lanes(model.geometry().lanes.s_home_B, k);
+  return {length, scale, dot(u, home), dot(u, rotate(R_BP, home)), dot_a, dot_d};
+}
+
+/// Lanes within every pose limit. NaN fails. With scale = 1 the tests are exactly those of
+/// unit vectors.
+inline lane_m within_limits(const Model& model, const LimitTerms& t) noexcept {
+  const LimitSpec& lim = model.spec().limits;
+  const lane_v cos_bend = model.cos_bend_max() * t.scale;
+  const lane_v cos2_margin = model.cos2_singularity_margin() * (t.scale * t.scale);
+  return (t.length >= lim.length_min) & (t.length <= lim.length_max) & (t.cos_base >= cos_bend) &
+         (t.cos_platform >= cos_bend) & (t.dot_a * t.dot_a <= cos2_margin) & (t.dot_d * t.dot_d <= cos2_margin);
+}
+
+/// Lanes whose command is within the stroke. NaN fails.
+inline lane_m within_stroke(const Model& model, lane_v command) noexcept {
+  const LimitSpec& lim = model.spec().limits;
+  return (command >= lim.length_min) & (command <= lim.length_max);
+}
+
+/// The twist terms of each leg: the coordinates of docs/theory.md §3, theta = atan2(y, x), and
+/// ja x jd, which the Jacobian reuses. For a leg direction u = scale * s, with ja_u = ja . u and
+/// jd_u = jd . u (the caller's) and u2 = scale^2, x comes out scaled by scale^2 and y by scale.
+/// (Small on purpose: GCC keeps a larger struct of vectors in memory.)
+struct TwistTerms {
+  lanes3 ja_x_jd;
+  lane_v x, y;
+};
+
+inline TwistTerms twist_terms(const lanes3& u, const lanes3& ja, const lanes3& jd, lane_v ja_u, lane_v jd_u,
+                              lane_v u2) noexcept {
+  TwistTerms t;
+  t.ja_x_jd = cross(ja, jd);
+  t.x = u2 * dot(ja, jd) - ja_u * jd_u;
+  t.y = dot(u, t.ja_x_jd);
+  return t;
+}
+
+/// Squared |s x ja| |s x jd| below which the U-joint's cross axis (Eq. 8) is undefined.
+inline constexpr double kSingularSin2 = 1e-24;
+
+/// Lanes away from a U-joint singularity or without axes, for (x, y) scaled by sqrt(unit2)
+/// (1 for unit vectors). NaN fails.
+inline lane_m twist_regular(const Model& model, lane_v x, lane_v y, lane_v unit2, int k) noexcept {
+  return (x * x + y * y) + (1.0 - load_lanes(model.geometry().lanes.has_axes, k)) * unit2 >= kSingularSin2 * unit2;
+}
+
+/// The twist theta - theta_home (relative) or theta (absolute) in one atan2: (x, y) rotated by
+/// -theta_home. Zero for legs without axes.
+inline lane_v twist_angle(const Model& model, lane_v x, lane_v y, bool relative, int k) noexcept {
+  const LegLanes& g = model.geometry().lanes;
+  const lane_v c0 = relative ? load_lanes(g.cos_theta_home, k) : splat<lane_v>(1.0);
+  const lane_v s0 = relative ? load_lanes(g.sin_theta_home, k) : splat<lane_v>(0.0);
+  return atan2(y * c0 - x * s0, x * c0 + y * s0) * load_lanes(g.has_axes, k);
+}
+
+}  // namespace hexatwist::detail

@@ -1,0 +1,173 @@
+#include "hexatwist/kinematics/limits.hpp"
+
+#include <cmath>
+
+#include "kinematics/geometry.hpp"
+#include "kinematics/lanes.hpp"
+#include "kinematics/linear_solve.hpp"
+#include "kinematics/twist_internal.hpp"
+
+namespace hexatwist {
+namespace {
+
+using detail::angle_between;
+using detail::Array6d;
+using detail::line_axis_angle;
+
+Status report_violation(LimitReport& r, Status s, int leg, double value, double bound) noexcept {
+  r.status = s;
+  r.leg = leg;
+  r.value = value;
+  r.bound = bound;
+  return s;
+}
+
+}  // namespace
+
+Status jacobian_condition(const Model& model, const LegState& state, double& condition) noexcept {
+  Matrix6d J;
+  condition = std::nan("");
+  if (model.has_twist()) {
+    if (const Status s = detail::motor_length_jacobian(model, state, J); s != Status::Ok) return s;
+  } else {
+    length_jacobian(state, J);
+  }
+  double det_sign;
+  condition = detail::scaled_condition(J, model.condition_length(), det_sign);
+  return condition <= model.spec().limits.jacobian_condition_max ? Status::Ok : Status::PlatformSingularity;
+}
+
+namespace detail {
+
+bool condition_proven_within(const Model& model, const LegState& state) noexcept {
+  Matrix6d J;
+  if (model.has_twist()) {
+    if (motor_length_jacobian(model, state, J) != Status::Ok) return false;
+  } else {
+    length_jacobian(state, J);
+  }
+  return scaled_condition_below(J, model.condition_length(), model.spec().limits.jacobian_condition_max);
+}
+
+}  // namespace detail
+
+void bend_angles(const Model& model, const LegState& state, Vector6d& bend_base, Vector6d& bend_platform) noexcept {
+  for (int i = 0; i < kLegs; ++i) {
+    const Vector3d s = state.s_B.row(i).transpose();
+    const Vector3d& s0 = model.leg(i).s_home_B;
+    bend_base[i] = angle_between(s, s0);
+    bend_platform[i] = angle_between(state.R_BP.transpose() * s, s0);
+  }
+}
+
+Status check_limits(const Model& model, const LegState& state, LimitReport& r) noexcept {
+  r = LimitReport{};
+  const LimitSpec& lim = model.spec().limits;
+  const LegGeometry& g = model.geometry();
+  const double cos_bend = model.cos_bend_max();
+  const double cos2_margin = model.cos2_singularity_margin();
+  const LegVectors& s = state.s_B;
+  // All legs at once (lanes.hpp).
+  detail::LimitTerms terms[detail::kPackets];
+  detail::lane_m ok = detail::all_set();
+  #pragma GCC unroll 4
+  for (int k = 0; k < detail::kPackets; ++k) {
+    const detail::lanes3 u = detail::load6(s, k);
+    terms[k] = detail::limit_terms(model, state.R_BP, u, detail::splat<detail::lane_v>(1.0),
+                                   detail::load6(state.length.data(), k),
+                                   detail::dot(u, detail::load_lanes(g.lanes.axis_base_B, k)),
+                                   detail::dot(u, detail::load6(state.axis_platform_B, k)), k);
+    ok &= detail::within_limits(model, terms[k]);
+  }
+  if (detail::all_lanes(ok)) {
+    // Most poses are far inside the condition limit: prove that cheaply, else compute it exactly.
+    if (detail::condition_proven_within(model, state)) return Status::Ok;
+    double condition;
+    if (const Status st = jacobian_condition(model, state, condition); st != Status::Ok)
+      return report_violation(r, st, -1, condition, lim.jacobian_condition_max);
+    return Status::Ok;
+  }
+  // Leg i's terms, as the test saw them.
+  const auto lane = [&](detail::lane_v detail::LimitTerms::*field, int i) {
+    return (terms[i / detail::kWidth].*field)[i % detail::kWidth];
+  };
+  Vector6d len, cos_base, cos_platform, dot_a, dot_d;
+  for (int i = 0; i < kLegs; ++i) {
+    len[i] = lane(&detail::LimitTerms::length, i);
+    cos_base[i] = lane(&detail::LimitTerms::cos_base, i);
+    cos_platform[i] = lane(&detail::LimitTerms::cos_platform, i);
+    dot_a[i] = lane(&detail::LimitTerms::dot_a, i);
+    dot_d[i] = lane(&detail::LimitTerms::dot_d, i);
+  }
+
+  // Some leg is out: name the first, with the first limit it breaks (stroke, bend, singularity).
+  for (int i = 0; i < kLegs; ++i) {
+    const Vector3d si = s.row(i).transpose();
+    if (!std::isfinite(len[i])) return report_violation(r, Status::NonFiniteInput, i, len[i], 0.0);
+    if (len[i] < lim.length_min) return report_violation(r, Status::StrokeBelowMin, i, len[i], lim.length_min);
+    if (len[i] > lim.length_max) return report_violation(r, Status::StrokeAboveMax, i, len[i], lim.length_max);
+    if (!(cos_base[i] >= cos_bend))
+      return report_violation(r, Status::BendBase, i, angle_between(si, model.leg(i).s_home_B), lim.bend_max);
+    if (!(cos_platform[i] >= cos_bend))
+      return report_violation(r, Status::BendPlatform, i, angle_between(state.R_BP.transpose() * si, model.leg(i).s_home_B),
+                              lim.bend_max);
+    if (g.has_axes[i] == 0.0) continue;
+    if (dot_a[i] * dot_a[i] > cos2_margin)
+      return report_violation(r, Status::SingularBase, i, line_axis_angle(si, model.leg(i).axis_base_B), lim.singularity_margin);
+    if (dot_d[i] * dot_d[i] > cos2_margin)
+      return report_violation(r, Status::SingularPlatform, i, line_axis_angle(si, state.axis_platform_B.row(i).transpose()),
+                              lim.singularity_margin);
+  }
+  return report_violation(r, Status::NonFiniteInput, -1, 0.0, 0.0);  // NaN in the leg axes
+}
+
+void nearest_limit(const Model& model, const LegState& state, double condition, LimitReport& nearest,
+                   double& margin) noexcept {
+  const LimitSpec& lim = model.spec().limits;
+  margin = INFINITY;
+  nearest = LimitReport{};
+  const auto consider = [&](double m, Status s, int leg, double value, double bound) {
+    if (m < margin || std::isnan(m)) {
+      margin = m;
+      nearest = LimitReport{s, leg, value, bound};
+    }
+  };
+  const double half_stroke = 0.5 * (lim.length_max - lim.length_min);
+  for (int i = 0; i < kLegs; ++i) {
+    const double len = state.length[i];
+    consider((len - lim.length_min) / half_stroke, Status::StrokeBelowMin, i, len, lim.length_min);
+    consider((lim.length_max - len) / half_stroke, Status::StrokeAboveMax, i, len, lim.length_max);
+    const Vector3d s = state.s_B.row(i).transpose();
+    const double bend_base = angle_between(s, model.leg(i).s_home_B);
+    const double bend_platform = angle_between(state.R_BP.transpose() * s, model.leg(i).s_home_B);
+    consider(1.0 - bend_base / lim.bend_max, Status::BendBase, i, bend_base, lim.bend_max);
+    consider(1.0 - bend_platform / lim.bend_max, Status::BendPlatform, i, bend_platform, lim.bend_max);
+    if (model.geometry().has_axes[i] == 0.0) continue;
+    const double free_range = kPi / 2 - lim.singularity_margin;
+    const double a = line_axis_angle(s, model.leg(i).axis_base_B);
+    const double d = line_axis_angle(s, state.axis_platform_B.row(i).transpose());
+    consider((a - lim.singularity_margin) / free_range, Status::SingularBase, i, a, lim.singularity_margin);
+    consider((d - lim.singularity_margin) / free_range, Status::SingularPlatform, i, d, lim.singularity_margin);
+  }
+  const double log_max = std::log(lim.jacobian_condition_max);
+  const double c = std::isnan(condition) ? INFINITY : std::max(condition, 1.0);  // NaN: no Jacobian there
+  consider(1.0 - std::log(c) / log_max, Status::PlatformSingularity, -1, condition,
+           lim.jacobian_condition_max);
+}
+
+Status check_stroke(const Model& model, const Vector6d& command, LimitReport& r) noexcept {
+  r = LimitReport{};
+  const LimitSpec& lim = model.spec().limits;
+  detail::lane_m ok = detail::all_set();
+  #pragma GCC unroll 4
+  for (int k = 0; k < detail::kPackets; ++k) ok &= detail::within_stroke(model, detail::load6(command.data(), k));
+  if (detail::all_lanes(ok)) return Status::Ok;
+  for (int i = 0; i < kLegs; ++i) {
+    if (!std::isfinite(command[i])) return report_violation(r, Status::NonFiniteInput, i, command[i], 0.0);
+    if (command[i] < lim.length_min) return report_violation(r, Status::StrokeBelowMin, i, command[i], lim.length_min);
+    if (command[i] > lim.length_max) return report_violation(r, Status::StrokeAboveMax, i, command[i], lim.length_max);
+  }
+  return Status::Ok;
+}
+
+}  // namespace hexatwist

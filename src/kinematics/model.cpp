@@ -1,0 +1,220 @@
+#include "hexatwist/kinematics/model.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+
+#include "hexatwist/error.hpp"
+#include "hexatwist/kinematics/limits.hpp"
+#include "kinematics/geometry.hpp"
+
+namespace hexatwist {
+namespace {
+
+// Smallest usable axis length before normalisation (an axis is a direction; any scale is fine).
+constexpr double kMinAxisNorm = 1e-9;
+// Largest condition number of the home Jacobian we accept as "the legs hold the platform".
+constexpr double kMaxHomeCondition = 1e8;
+
+// Every message is "field: what", field one of home_height, limits.<x>, observation_point, pivot,
+// legs, "leg N" or "leg N: <base|platform|lead|length_offset|base_axis|platform_axis>": src/io/config.cpp maps the
+// field back to the line of the YAML file it came from.
+[[noreturn]] void fail(const std::string& msg) { throw Error(msg); }
+
+void require_finite(const Vector3d& v, const std::string& what) {
+  if (!v.allFinite()) fail(fmt::format("{}: expected three finite numbers, got NaN or inf", what));
+}
+
+void require_finite(double v, const std::string& what) {
+  if (!std::isfinite(v)) fail(fmt::format("{}: expected a finite number, got {}", what, v));
+}
+
+Vector3d unit_axis(const Vector3d& axis, const std::string& what) {
+  require_finite(axis, what);
+  const double n = axis.norm();
+  if (n < kMinAxisNorm) fail(fmt::format("{}: axis is zero; expected a direction", what));
+  return axis / n;
+}
+
+}  // namespace
+
+Model::Model(const ModelSpec& spec) : spec_(spec) {
+  const LimitSpec& lim = spec.limits;
+  require_finite(spec.home_height, "home_height");
+  if (spec.home_height <= 0.0) fail(fmt::format("home_height: expected > 0 m, got {}", spec.home_height));
+  require_finite(lim.length_min, "limits.length_min");
+  require_finite(lim.length_max, "limits.length_max");
+  if (lim.length_min <= 0.0) fail(fmt::format("limits.length_min: expected > 0 m, got {}", lim.length_min));
+  if (lim.length_min >= lim.length_max)
+    fail(fmt::format("limits.length_min: expected less than limits.length_max ({} m), got {} m", lim.length_max,
+                     lim.length_min));
+  require_finite(lim.bend_max, "limits.bend_max");
+  if (lim.bend_max <= 0.0 || lim.bend_max > kPi / 2)
+    fail(fmt::format("limits.bend_max: expected an angle in (0, 90] deg, got {:.10g} deg", rad2deg(lim.bend_max)));
+  require_finite(lim.singularity_margin, "limits.singularity_margin");
+  if (lim.singularity_margin <= 0.0 || lim.singularity_margin >= kPi / 2)
+    fail(fmt::format("limits.singularity_margin: expected an angle in (0, 90) deg, got {:.10g} deg",
+                     rad2deg(lim.singularity_margin)));
+  require_finite(lim.jacobian_condition_max, "limits.jacobian_condition_max");
+  if (!(lim.jacobian_condition_max > 1.0))
+    fail(fmt::format("limits.jacobian_condition_max: expected a condition number > 1, got {}", lim.jacobian_condition_max));
+  require_finite(spec.observation_P, "observation_point");
+  require_finite(spec.pivot_P, "pivot");
+
+  cos_bend_max_ = std::cos(lim.bend_max);
+  cos2_singularity_margin_ = std::cos(lim.singularity_margin) * std::cos(lim.singularity_margin);
+  const Vector3d home_B(0.0, 0.0, spec.home_height);
+  pivot_home_B_ = home_B + spec.pivot_P;
+
+  for (int i = 0; i < kLegs; ++i) {
+    const LegSpec& ls = spec.legs[static_cast<std::size_t>(i)];
+    Leg& leg = legs_[static_cast<std::size_t>(i)];
+    const std::string who = fmt::format("leg {}", i + 1);
+    require_finite(ls.base_B, who + ": base");
+    require_finite(ls.platform_P, who + ": platform");
+    require_finite(ls.lead, who + ": lead");
+    if (ls.lead < 0.0) fail(fmt::format("{}: lead: expected >= 0 m, got {}", who, ls.lead));
+    // A screw turns at least once over its stroke: a longer lead (1e30 m) is a typing error.
+    if (!(ls.lead <= lim.length_max - lim.length_min))
+      fail(fmt::format("{}: lead: expected at most the stroke ({} m), got {} m", who, lim.length_max - lim.length_min,
+                       ls.lead));
+
+    leg.base_B = ls.base_B;
+    leg.platform_P = ls.platform_P;
+    leg.arm_P = ls.platform_P - spec.pivot_P;
+    const Vector3d L0 = home_B + ls.platform_P - ls.base_B;
+    leg.length_home = L0.norm();
+    if (!(leg.length_home > 0.0)) fail(fmt::format("{}: base and platform joints coincide at home", who));
+    leg.s_home_B = L0 / leg.length_home;
+    if (leg.length_home < lim.length_min || leg.length_home > lim.length_max)
+      fail(fmt::format("{}: home length {:.6f} m is outside the stroke [{}, {}] m", who, leg.length_home,
+                       lim.length_min, lim.length_max));
+
+    // An offset is a zero error of the motor-side length: one as long as the stroke is not.
+    require_finite(ls.length_offset, who + ": length_offset");
+    if (!(std::abs(ls.length_offset) < lim.length_max - lim.length_min))
+      fail(fmt::format("{}: length_offset: expected less than the stroke ({} m) in magnitude, got {} m", who,
+                       lim.length_max - lim.length_min, ls.length_offset));
+    leg.length_offset = ls.length_offset;
+    // The motor must reach home: its command there, real length minus offset, inside the stroke.
+    if (const double command = leg.length_home - ls.length_offset; command < lim.length_min || command > lim.length_max)
+      fail(fmt::format("{}: length_offset: {} m puts the home command {:.6f} m outside the stroke [{}, {}] m", who,
+                       ls.length_offset, command, lim.length_min, lim.length_max));
+
+    leg.lead = ls.lead;
+    leg.thread = ls.thread;
+    leg.driven = ls.driven;
+    // docs/theory.md §4: real = motor-side + lead*dtheta/2pi for a right-hand thread, whichever end
+    // is driven (swapping the screw and nut between housing and rod negates both the relative
+    // rotation and the axial sense); a left-hand thread negates it.
+    leg.twist_sign = ls.thread == ThreadSense::Right ? 1.0 : -1.0;
+    leg.twist_gain = leg.twist_sign * ls.lead / (2.0 * kPi);
+    length_home_[i] = leg.length_home;
+
+    // Axes are needed for the twist (lead > 0). With lead 0 they may be omitted (all zero).
+    const bool axes_given = !ls.axis_base_B.isZero(0.0) || !ls.axis_platform_P.isZero(0.0);
+    if (ls.lead > 0.0 || axes_given) {
+      leg.axis_base_B = unit_axis(ls.axis_base_B, who + ": base_axis");
+      leg.axis_platform_P = unit_axis(ls.axis_platform_P, who + ": platform_axis");
+      const double ab = detail::line_axis_angle(leg.s_home_B, leg.axis_base_B);
+      const double ap = detail::line_axis_angle(leg.s_home_B, leg.axis_platform_P);
+      constexpr const char* kTooClose =
+          "{}: {}: {:.3g} deg from the leg's home direction, inside the singularity margin {:.3g} deg "
+          "(the U-joint is singular at home)";
+      if (ab < lim.singularity_margin)
+        fail(fmt::format(kTooClose, who, "base_axis", rad2deg(ab), rad2deg(lim.singularity_margin)));
+      if (ap < lim.singularity_margin)
+        fail(fmt::format(kTooClose, who, "platform_axis", rad2deg(ap), rad2deg(lim.singularity_margin)));
+      const auto xy = detail::twist_xy(leg.s_home_B, leg.axis_base_B, leg.axis_platform_P);
+      leg.theta_home = std::atan2(xy.y, xy.x);
+      leg.cos_theta_home = std::cos(leg.theta_home);
+      leg.sin_theta_home = std::sin(leg.theta_home);
+      has_twist_ = has_twist_ || ls.lead > 0.0;
+    } else {
+      leg.axis_base_B.setZero();
+      leg.axis_platform_P.setZero();
+      leg.theta_home = std::nan("");
+      leg.cos_theta_home = 1.0;
+      leg.sin_theta_home = 0.0;
+    }
+  }
+
+  for (int i = 0; i < kLegs; ++i) {
+    const Leg& leg = legs_[static_cast<std::size_t>(i)];
+    const bool axes = !std::isnan(leg.theta_home);
+    geometry_.base_B.row(i) = leg.base_B.transpose();
+    geometry_.arm_P.row(i) = leg.arm_P.transpose();
+    geometry_.axis_base_B.row(i) = leg.axis_base_B.transpose();
+    geometry_.axis_platform_P.row(i) = leg.axis_platform_P.transpose();
+    geometry_.s_home_B.row(i) = leg.s_home_B.transpose();
+    geometry_.cos_theta_home[i] = leg.cos_theta_home;
+    geometry_.sin_theta_home[i] = leg.sin_theta_home;
+    geometry_.twist_gain[i] = leg.twist_gain;
+    geometry_.length_offset[i] = leg.length_offset;
+    geometry_.has_axes[i] = axes ? 1.0 : 0.0;
+    condition_length_ = std::max(i == 0 ? 0.0 : condition_length_, leg.arm_P.norm());
+  }
+  if (!(condition_length_ > 0.0)) fail("legs: every platform joint sits at the pivot; expected a platform of some size");
+  LegLanes& lanes = geometry_.lanes;
+  for (int lane = 0; lane < 8; ++lane) {
+    const int i = lane < kLegs ? lane : 0;
+    for (int k = 0; k < 3; ++k) {
+      lanes.base_B[k][lane] = geometry_.base_B(i, k);
+      lanes.arm_P[k][lane] = geometry_.arm_P(i, k);
+      lanes.axis_base_B[k][lane] = geometry_.axis_base_B(i, k);
+      lanes.axis_platform_P[k][lane] = geometry_.axis_platform_P(i, k);
+      lanes.s_home_B[k][lane] = geometry_.s_home_B(i, k);
+    }
+    lanes.cos_theta_home[lane] = geometry_.cos_theta_home[i];
+    lanes.sin_theta_home[lane] = geometry_.sin_theta_home[i];
+    lanes.twist_gain[lane] = geometry_.twist_gain[i];
+    lanes.length_offset[lane] = geometry_.length_offset[i];
+    lanes.has_axes[lane] = geometry_.has_axes[i];
+  }
+
+  // The six legs must hold the platform: the length Jacobian at home must be well conditioned.
+  Matrix6d J;
+  for (int i = 0; i < kLegs; ++i) {
+    const Leg& leg = legs_[static_cast<std::size_t>(i)];
+    J.row(i) << leg.s_home_B.transpose(), leg.arm_P.cross(leg.s_home_B).transpose();
+  }
+  const Eigen::JacobiSVD<Matrix6d> svd(J);
+  const double smax = svd.singularValues()(0), smin = svd.singularValues()(5);
+  if (!(smin > 0.0) || smax / smin > kMaxHomeCondition)
+    fail(fmt::format("legs: the six legs do not hold the platform at home (Jacobian condition number {:.3g})",
+                     smin > 0.0 ? smax / smin : INFINITY));
+  // Home must pass the platform-singularity limit, as it passes the others.
+  LegState home;
+  double condition = INFINITY;
+  if (inverse_kinematics(*this, Placement{}, home) == Status::Ok &&
+      jacobian_condition(*this, home, condition) == Status::PlatformSingularity)
+    fail(fmt::format("limits.jacobian_condition_max: the Jacobian's condition number at home is {:.4g}, above the "
+                     "limit {:.4g}", condition, lim.jacobian_condition_max));
+}
+
+PerLeg<LegSpec> symmetric_legs(const SymmetricSpec& s) {
+  // docs/theory.md §1: joints in pairs, fixed axes tangential (Eq. 6). Leg i joins base pair
+  // kBasePair[i] to platform pair kPlatformPair[i]; each joint sits d/2 along the tangent from its
+  // pair centre, on the side facing the pair it connects to (odd legs: base -, platform +).
+  constexpr std::array<int, kLegs> kBasePair{0, 1, 1, 2, 2, 0};
+  constexpr std::array<int, kLegs> kPlatformPair{0, 0, 1, 1, 2, 2};
+  PerLeg<LegSpec> legs;
+  for (int i = 0; i < kLegs; ++i) {
+    const double side = (i % 2 == 0) ? 1.0 : -1.0;
+    const double beta = s.base_pair_angles[static_cast<std::size_t>(kBasePair[i])];
+    const double alpha = s.platform_pair_angles[static_cast<std::size_t>(kPlatformPair[i])];
+    const Vector3d tb(-std::sin(beta), std::cos(beta), 0.0);
+    const Vector3d ta(-std::sin(alpha), std::cos(alpha), 0.0);
+    LegSpec& leg = legs[static_cast<std::size_t>(i)];
+    leg.base_B = s.Rb * Vector3d(std::cos(beta), std::sin(beta), 0.0) - side * 0.5 * s.db * tb;
+    leg.platform_P = s.Ra * Vector3d(std::cos(alpha), std::sin(alpha), 0.0) + side * 0.5 * s.da * ta;
+    leg.axis_base_B = tb;
+    leg.axis_platform_P = ta;
+  }
+  return legs;
+}
+
+}  // namespace hexatwist

@@ -1,0 +1,221 @@
+#include "hexatwist/simulation/simulation.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+
+#include "hexatwist/dynamics/mechanism.hpp"
+#include "hexatwist/simulation/servo.hpp"
+#include "dynamics/mechanism_internal.hpp"
+
+namespace hexatwist {
+namespace {
+
+// How often progress is reported [ticks].
+constexpr std::size_t kProgressEvery = 500;
+
+Status fail(SimulationIssue& issue, Status status, std::size_t index, const Trajectory& trajectory,
+            const LimitReport& limit = {}) {
+  issue.status = status;
+  issue.index = index;
+  issue.time = trajectory.time(index);
+  issue.limit = limit;
+  if (issue.limit.status == Status::Ok) issue.limit.status = status;
+  return status;
+}
+
+// The leg lengths forward kinematics of the plant takes for motor-side lengths `motor`: these
+// themselves when the plant twists (LengthKind::Motor), the real lengths (the legs' zero errors
+// added back) when it does not (LengthKind::Geometric).
+Vector6d plant_lengths(const Model& model, const Vector6d& motor, bool twist_in_plant) noexcept {
+  return twist_in_plant ? motor : Vector6d(motor + model.geometry().length_offset);
+}
+
+// The targets of a whole trajectory, computed (and checked) before the loop runs.
+struct Plan {
+  std::vector<Vector6d> command;          // motor-side target [m]
+  std::vector<ServoReference> reference;  // the same at the motor shaft, with speed and acceleration
+  std::vector<double> error_twist_only;   // observation error with perfect servos [m]
+};
+
+// Fills `plan` for one way of running (the commands of `strategy`, or the IK lengths for a plant
+// without twist) and checks every sample. With `check_both`, both commands are checked against the
+// stroke whatever the strategy (compute_commands does so).
+Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy, bool twist_in_plant, Plan* plan,
+                 SimulationIssue& issue) {
+  const Model& model = rig.model();
+  const std::size_t n = trajectory.poses.size();
+  const bool compensated = twist_in_plant && strategy == Strategy::Compensated;
+  std::vector<Vector6d> command(n);
+  CommandReport report;
+  InverseDynamics still;
+  const double torque_limit = rig.servo().torque_limit;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (const Status s = compute_commands(model, trajectory.poses[k], report); s != Status::Ok)
+      return fail(issue, s, k, trajectory, report.limit);
+    command[k] = compensated ? report.compensated : report.conventional;
+    // Every motor must at least be able to hold the mechanism standing still at every pose
+    // (gravity's share of the inverse dynamics: platform, payload and legs).
+    PlatformMotion rest;
+    rest.placement = placement_from_pose(trajectory.poses[k]);
+    if (const Status s = inverse_dynamics(rig, rest, still); s != Status::Ok) return fail(issue, s, k, trajectory);
+    for (int i = 0; i < kLegs; ++i) {
+      const double hold = std::abs(still.gravity[i]);
+      if (hold > torque_limit) {
+        LimitReport limit;
+        limit.status = Status::TorqueAboveMax;
+        limit.leg = i;
+        limit.value = hold;
+        limit.bound = torque_limit;
+        return fail(issue, Status::TorqueAboveMax, k, trajectory, limit);
+      }
+    }
+  }
+  // Motor speed by central differences of the targets (one-sided at the ends).
+  const double T = trajectory.dt;
+  const Vector6d& gain = rig.motor_gain();
+  const Vector6d inv_gain = gain.cwiseInverse();
+  std::vector<ServoReference> reference(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    ServoReference& r = reference[k];
+    r.angle = (command[k] - model.length_home()).cwiseProduct(inv_gain);
+    if (n < 2) continue;
+    const std::size_t a = k == 0 ? 0 : k - 1;
+    const std::size_t b = k + 1 == n ? k : k + 1;
+    r.speed = (command[b] - command[a]).cwiseProduct(inv_gain) / (T * static_cast<double>(b - a));
+    if (k > 0 && k + 1 < n)
+      r.acceleration = (command[k + 1] - 2.0 * command[k] + command[k - 1]).cwiseProduct(inv_gain) / (T * T);
+    for (int i = 0; i < kLegs; ++i)
+      if (std::abs(r.speed[i]) > rig.servo().max_speed) {
+        LimitReport limit;
+        limit.status = Status::MotorSpeedAboveMax;
+        limit.leg = i;
+        limit.value = std::abs(r.speed[i]);
+        limit.bound = rig.servo().max_speed;
+        return fail(issue, Status::MotorSpeedAboveMax, k, trajectory, limit);
+      }
+  }
+  if (plan == nullptr) return Status::Ok;
+  // What the twist alone does: the pose the motors reach if they follow the targets exactly.
+  const LengthKind kind = twist_in_plant ? LengthKind::Motor : LengthKind::Geometric;
+  plan->error_twist_only.resize(n);
+  FkResult fk;
+  Placement guess = placement_from_pose(trajectory.poses[0]);
+  const Vector3d& obs = model.spec().observation_P;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (const Status s = forward_kinematics(model, plant_lengths(model, command[k], twist_in_plant), kind, guess, fk);
+        s != Status::Ok)
+      return fail(issue, s, k, trajectory);
+    guess = fk.placement;
+    const Placement desired = placement_from_pose(trajectory.poses[k]);
+    plan->error_twist_only[k] =
+        (platform_point_B(model, fk.placement, obs) - platform_point_B(model, desired, obs)).norm();
+  }
+  plan->command = std::move(command);
+  plan->reference = std::move(reference);
+  return Status::Ok;
+}
+
+}  // namespace
+
+Status check_trajectory(const Rig& rig, const Trajectory& trajectory, SimulationIssue& issue) {
+  issue = SimulationIssue{};
+  if (trajectory.poses.empty()) return Status::Ok;
+  // compute_commands checks the pose and both commands; the speed is checked for both strategies.
+  if (const Status s = make_plan(rig, trajectory, Strategy::Conventional, true, nullptr, issue); s != Status::Ok)
+    return s;
+  if (!rig.model().has_twist()) return Status::Ok;
+  return make_plan(rig, trajectory, Strategy::Compensated, true, nullptr, issue);
+}
+
+Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOptions& options,
+                std::vector<SimulationSample>& samples, SimulationIssue& issue) {
+  samples.clear();
+  issue = SimulationIssue{};
+  const std::size_t n = trajectory.poses.size();
+  if (n == 0) return Status::Ok;
+  if (std::abs(trajectory.dt - rig.control_period()) > 1e-9 * rig.control_period() && n > 1)
+    return fail(issue, Status::NonFiniteInput, 0, trajectory);
+  // make_plan checks every sample of the commands this run sends (limits, stroke, motor speed,
+  // holding torque) before the loop starts; check_trajectory adds the other strategy's commands.
+  Plan plan;
+  if (const Status s = make_plan(rig, trajectory, options.strategy, options.twist_in_plant, &plan, issue);
+      s != Status::Ok)
+    return s;
+
+  const Model& model = rig.model();
+  const LengthKind kind = options.twist_in_plant ? LengthKind::Motor : LengthKind::Geometric;
+  const Vector6d& gain = rig.motor_gain();
+  const Vector3d& obs = model.spec().observation_P;
+
+  // Start settled at the first target: motors on it, at its speed, the integrators holding the load.
+  DriveState drives;
+  drives.angle = plan.reference[0].angle;
+  drives.speed = plan.reference[0].speed;
+  Vector6d motor = model.length_home() + gain.cwiseProduct(drives.angle);
+  FkResult fk;
+  if (const Status s = forward_kinematics(model, plant_lengths(model, motor, options.twist_in_plant), kind,
+                                          placement_from_pose(trajectory.poses[0]), fk);
+      s != Status::Ok)
+    return fail(issue, s, 0, trajectory);
+  // The mechanism's load on the motors (docs/theory.md §9, §14), at the start and then once per
+  // control period, held over it.
+  detail::DriveLoad load;
+  Vector6d motor_acceleration = plan.reference[0].acceleration;
+  if (const Status s = detail::drive_load(rig, fk.legs, drives.speed, motor_acceleration, options.twist_in_plant, load);
+      s != Status::Ok)
+    return fail(issue, s, 0, trajectory);
+  // Holding torque: the motor balances the load (and the viscous friction at its speed).
+  const Vector6d holding = rig.servo().viscous_friction * drives.speed - load.load +
+                           detail::efficiency_loss(rig, drives.speed, load.screw_torque);
+  Vector6d measured;
+  read_encoder(rig, drives.angle, measured);
+  ControllerState controller;
+  start_controller(rig, measured, holding, controller);
+  drives.torque = holding;
+
+  Vector6d twist_ref = Vector6d::Zero();
+  Vector6d twist_now;
+  Vector6d torque;
+  samples.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    read_encoder(rig, drives.angle, measured);
+    update_controller(rig, plan.reference[k], measured, controller, torque);
+
+    SimulationSample& out = samples.emplace_back();
+    out.time = trajectory.time(k);
+    out.desired = trajectory.poses[k].to_vector();
+    out.actual = pose_from_placement(fk.placement).to_vector();
+    out.command = plan.command[k];
+    out.encoder = model.length_home() + gain.cwiseProduct(measured);
+    out.motor = motor;
+    out.length = fk.legs.length;
+    if (twist_continued(model, fk.legs, twist_ref, twist_now) == Status::Ok) twist_ref = twist_now;
+    out.twist = twist_ref;
+    out.torque = torque;
+    const Placement desired = placement_from_pose(trajectory.poses[k]);
+    out.error = (platform_point_B(model, fk.placement, obs) - platform_point_B(model, desired, obs)).norm();
+    out.error_twist_only = plan.error_twist_only[k];
+    if (options.progress && (k % kProgressEvery == 0 || k + 1 == n)) options.progress(k + 1, n);
+    if (k + 1 == n) break;
+
+    // The load at the current state, held over the control period; the efficiency loss from the
+    // screw torque at the last period's motor acceleration.
+    if (k > 0)
+      if (const Status s = detail::drive_load(rig, fk.legs, drives.speed, motor_acceleration, options.twist_in_plant, load);
+          s != Status::Ok)
+        return fail(issue, s, k, trajectory);
+    const Vector6d speed_before = drives.speed;
+    integrate_drives(rig, load.inverse_inertia, load.load - detail::efficiency_loss(rig, drives.speed, load.screw_torque),
+                     torque, drives);
+    motor_acceleration = (drives.speed - speed_before) / rig.control_period();
+    motor = model.length_home() + gain.cwiseProduct(drives.angle);
+    const Placement previous = fk.placement;  // warm start from the last tick
+    if (const Status s =
+            forward_kinematics(model, plant_lengths(model, motor, options.twist_in_plant), kind, previous, fk);
+        s != Status::Ok)
+      return fail(issue, s, k + 1, trajectory);
+  }
+  return Status::Ok;
+}
+
+}  // namespace hexatwist
