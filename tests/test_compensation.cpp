@@ -2,6 +2,8 @@
 // term, and commands never emitted outside a limit.
 #include "support.hpp"
 
+#include <cstring>
+
 namespace hexatwist::test {
 namespace {
 
@@ -106,6 +108,84 @@ TEST(Compensation, RealTimePathAndFullReportReachTheSameLimitDecision) {
   }
   EXPECT_GT(rejected, 1000);  // the sample reaches far outside the limits
   EXPECT_LT(rejected, 2990);  // ... and inside them
+}
+
+// The command as it was before the cheap condition proof: every limit of check_limits, but the
+// platform singularity decided by the exact condition number (jacobian_condition) at every pose.
+Status reference_command(const Model& model, const Pose& p, Strategy strategy, Vector6d& command,
+                         LimitReport& r) {
+  r = LimitReport{};
+  if (!p.is_finite()) return r.status = Status::NonFiniteInput;
+  LegState legs;
+  if (const Status s = inverse_kinematics(model, p, legs); s != Status::Ok) return r.status = s;
+  if (const Status s = check_limits(model, legs, r); s != Status::Ok && s != Status::PlatformSingularity) return s;
+  double c;
+  if (const Status s = jacobian_condition(model, legs, c); s != Status::Ok) {
+    r = LimitReport{s, -1, c, model.spec().limits.jacobian_condition_max};
+    return s;
+  }
+  r = LimitReport{};
+  Vector6d dtheta = Vector6d::Zero();
+  if (strategy == Strategy::Compensated && model.has_twist()) {
+    if (const Status s = twist(model, legs, dtheta); s != Status::Ok) return r.status = s;
+    const Vector6d cmd = legs.length - model.geometry().length_offset - model.geometry().twist_gain.cwiseProduct(dtheta);
+    if (const Status s = check_stroke(model, cmd, r); s != Status::Ok) return s;
+    command = cmd;
+  } else {
+    command = legs.length - model.geometry().length_offset;
+  }
+  return Status::Ok;
+}
+
+TEST(Compensation, CheapConditionProofLeavesEveryVerdictBitForBit) {
+  // The proof that the condition is within the limit only spares the exact number: statuses and
+  // reports are those of the exact number at every pose, bit for bit, and so is which commands
+  // are written. Poses inside
+  // the workspace, far outside it, and around the seed's yaw-90 singularity (with the default
+  // limits, and with stroke and bend widened so that the condition limit is what refuses).
+  ModelSpec wide_spec = seed_model().spec();
+  wide_spec.limits.length_min = 0.5;
+  wide_spec.limits.length_max = 4.0;
+  wide_spec.limits.bend_max = deg2rad(89);
+  const Model wide(wide_spec);
+  std::mt19937_64 rng(kSeed + 61);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  long ok = 0, singular = 0, n = stress(200000);
+  for (long i = 0; i < n; ++i) {
+    const int kind = static_cast<int>(i % 4);
+    const Model& model = kind == 3 ? wide : seed_model();
+    Pose p;
+    if (kind == 0) {
+      p.position = {0.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng)};
+      p.rpy = {deg2rad(30) * u(rng), deg2rad(30) * u(rng), deg2rad(30) * u(rng)};
+    } else if (kind == 1) {
+      p.position = {1.5 * u(rng), 1.5 * u(rng), 1.5 * u(rng)};
+      p.rpy = {kPi * u(rng), kPi * u(rng), kPi * u(rng)};
+    } else {
+      p.position = {0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng)};
+      p.rpy = {deg2rad(3) * u(rng), deg2rad(3) * u(rng), (u(rng) < 0 ? -1 : 1) * deg2rad(90 + 15 * u(rng))};
+    }
+    for (const Strategy strategy : {Strategy::Compensated, Strategy::Conventional}) {
+      Vector6d cmd = Vector6d::Constant(-7.0), ref_cmd = Vector6d::Constant(-7.0);
+      LimitReport r, ref_r;
+      const Status s = motor_commands(model, p, strategy, cmd, r);
+      const Status ref = reference_command(model, p, strategy, ref_cmd, ref_r);
+      ASSERT_EQ(s, ref) << str(p) << " kind " << kind;
+      ASSERT_EQ(r.status, ref_r.status) << str(p);
+      ASSERT_EQ(r.leg, ref_r.leg) << str(p);
+      ASSERT_TRUE(std::memcmp(&r.value, &ref_r.value, sizeof(double)) == 0) << str(p) << " " << r.value << " " << ref_r.value;
+      ASSERT_EQ(r.bound, ref_r.bound) << str(p);
+      // The command itself comes before the condition in both (the fast path's lanes differ from
+      // the reference's LegState by rounding): written or not alike, and the same to rounding.
+      ASSERT_EQ(cmd == Vector6d::Constant(-7.0), ref_cmd == Vector6d::Constant(-7.0)) << str(p);
+      ASSERT_LT((cmd - ref_cmd).cwiseAbs().maxCoeff(), 1e-12) << str(p);
+      ok += s == Status::Ok;
+      singular += s == Status::PlatformSingularity;
+    }
+  }
+  std::printf("  %ld poses: %ld commands Ok, %ld refused for the platform singularity\n", n, ok, singular);
+  EXPECT_GT(ok, n / 4);
+  EXPECT_GT(singular, n / 20);
 }
 
 TEST(Compensation, BothCommandsTakeTheLengthOffsetsOut) {

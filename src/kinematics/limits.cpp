@@ -46,7 +46,8 @@ bool condition_proven_within(const Model& model, const LegState& state) noexcept
   } else {
     length_jacobian(state, J);
   }
-  return scaled_condition_below(J, model.condition_length(), model.spec().limits.jacobian_condition_max);
+  return scaled_condition_below(J, model.condition_length(), model.condition_reference(),
+                                model.spec().limits.jacobian_condition_max);
 }
 
 }  // namespace detail

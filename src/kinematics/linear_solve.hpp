@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "kinematics/fast_math.hpp"
+#include "hexatwist/kinematics/model.hpp"
 #include "hexatwist/types.hpp"
 
 namespace hexatwist::detail {
@@ -137,81 +138,87 @@ inline double lu6_scaled_condition(const Lu6& lu, const Vector6d& column_sums, d
 /// True only if the condition number that scaled_condition(J, length) computes is proven to be at
 /// most `bound`; false means "not proven" (also for a singular or non-finite J), not "above". A
 /// cheap sufficient test that spares the pivoted LU and its inverse where the pose is well inside
-/// the limit (docs/theory.md §8).
-inline bool scaled_condition_below(const Matrix6d& J, double length, double bound) noexcept {
+/// the limit (docs/theory.md §8): from the model's reference Y0 ~ A^-1 (the inverse at home), the
+/// residual G = I - Y0 A bounds ||A^-1||_1 <= ||Y0||_1 / (1 - ||G||_1); where that is not enough,
+/// once more from Y1 = (I + G) Y0, one Newton-Schulz step.
+inline bool scaled_condition_below(const Matrix6d& J, double length, const ConditionReference& ref,
+                                   double bound) noexcept {
   constexpr int kW = sizeof(lane_v) / sizeof(double);
   constexpr int kP = 8 / kW;  // vectors per row
+  const lane_v zero = {};
+  const auto abs_v = [&](lane_v v) { return v < zero ? -v : v; };
+  const auto load = [](const double* p) {
+    lane_v v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  };
+  const auto lane_max = [](const lane_v (&v)[kP]) {
+    double m = 0.0;
+    for (int q = 0; q < kP; ++q)
+      for (int c = 0; c < kW; ++c)  // padding lanes are 0; a NaN gives inf (nothing is proven)
+        if (!(v[q][c] <= m)) m = v[q][c] > m ? v[q][c] : INFINITY;
+    return m;
+  };
   alignas(64) static constexpr double kIdentity[6][8] = {{1, 0, 0, 0, 0, 0, 0, 0}, {0, 1, 0, 0, 0, 0, 0, 0},
                                                          {0, 0, 1, 0, 0, 0, 0, 0}, {0, 0, 0, 1, 0, 0, 0, 0},
                                                          {0, 0, 0, 0, 1, 0, 0, 0}, {0, 0, 0, 0, 0, 1, 0, 0}};
-  // J's rows, padded with zeros to whole vectors, and the column scale of A = J diag(1, 1, 1, 1/length x 3).
+  alignas(64) static constexpr double kUnit[8] = {1, 1, 1, 0, 0, 0, 0, 0};
+  // A = J diag(1, 1, 1, 1/length x 3) a whole row at a time, padded with zeros.
   alignas(64) double rows[6][8];
   for (int i = 0; i < 6; ++i)
     for (int c = 0; c < 8; ++c) rows[i][c] = c < 6 ? J(i, c) : 0.0;
-  alignas(64) static constexpr double kUnit[8] = {1, 1, 1, 0, 0, 0, 0, 0};
-  lane_v z[6][kP], unit[6][kP], col_scale[kP];
+  lane_v a[6][kP], sum_a[kP] = {};
   for (int q = 0; q < kP; ++q) {
-    lane_v first;
-    std::memcpy(&first, kUnit + q * kW, sizeof first);
-    col_scale[q] = first + (1.0 / length) * (1.0 - first);  // columns 3-5 of A = J / length
+    const lane_v first = load(kUnit + q * kW);
+    const lane_v col_scale = first + (1.0 / length) * (1.0 - first);
     for (int i = 0; i < 6; ++i) {
-      std::memcpy(&z[i][q], &rows[i][q * kW], sizeof(lane_v));
-      std::memcpy(&unit[i][q], &kIdentity[i][q * kW], sizeof(lane_v));
+      a[i][q] = col_scale * load(&rows[i][q * kW]);
+      sum_a[q] += abs_v(a[i][q]);
     }
   }
-  // Z ~ J^-1 by Gauss-Jordan in place on whole rows, without pivoting (no search, no swaps). Its
-  // accuracy is not assumed: the residual below proves what it is worth.
-#pragma GCC unroll 6
-  for (int k = 0; k < 6; ++k) {
-    const double p = z[k][k / kW][k % kW];
-    if (!(std::abs(p) > 0.0)) return false;
-    const double inv = 1.0 / p;
-    lane_v t[kP];
-    for (int q = 0; q < kP; ++q) {
-      z[k][q] = inv * z[k][q] + (inv - 1.0) * unit[k][q];  // row k / p, with 1/p in column k
-      t[q] = z[k][q] + unit[k][q];
-    }
+  const double norm_a = lane_max(sum_a);
+  // G = I - Y A for an approximate inverse Y (rows of 8): 1-norm of G, rounding included. Each
+  // entry of G rounds by less than 8 u (|Y| |A|) (u the unit roundoff); 1e-13 ||Y||_1 ||A||_1
+  // covers it a hundred times over.
+  alignas(64) double g[6][8];
+  const auto residual_norm = [&](const double (&y)[6][8], double norm_y) {
+    lane_v sum_g[kP] = {};
 #pragma GCC unroll 6
     for (int i = 0; i < 6; ++i) {
-      if (i == k) continue;
-      const double f = z[i][k / kW][k % kW];
-      for (int q = 0; q < kP; ++q) z[i][q] -= f * t[q];  // column k becomes -f / p
+      for (int q = 0; q < kP; ++q) {
+        lane_v r = load(&kIdentity[i][q * kW]);
+        for (int k = 0; k < 6; ++k) r -= y[i][k] * a[k][q];
+        std::memcpy(&g[i][q * kW], &r, sizeof r);
+        sum_g[q] += abs_v(r);
+      }
     }
-  }
-  // With F = I - J Z: J^-1 = Z (I - F)^-1, so for ||F||_1 < 1 the scaled inverse
-  // A^-1 = W J^-1 has ||A^-1||_1 <= ||W Z||_1 / (1 - ||F||_1). All 1-norms are column sums, so
-  // they add whole rows and reduce across lanes once. Rounding in F is below 7 u |J| |Z| per entry
-  // (u the unit roundoff); 1e-13 ||J||_1 ||Z||_1 covers it a hundred times over.
-  const lane_v zero = {};
-  const auto abs_v = [&](lane_v v) { return v < zero ? -v : v; };
-  lane_v sum_f[kP] = {}, sum_wz[kP] = {}, sum_z[kP] = {}, sum_j[kP] = {};
+    return lane_max(sum_g) + 1e-13 * norm_y * norm_a;
+  };
+  // A^-1 = (I - G)^-1 Y, so ||A^-1||_1 <= ||Y||_1 / (1 - ||G||_1) for ||G||_1 < 1. The products,
+  // the quotient and the norms' sums round by a few u: 1e-12 of slack. The proof asks for
+  // 1e-9 below the bound, so that the exact number (rounding ~1e-13 relative at a condition of 50)
+  // lies below the bound too, and the verdict is the exact number's.
+  const double target = bound * (1.0 - 1e-9);
+  const auto proven = [&](double norm_y, double norm_g) {
+    return norm_g < 1.0 && norm_a * norm_y / (1.0 - norm_g) * (1.0 + 1e-12) <= target;
+  };
+  const double norm_g = residual_norm(ref.inverse, ref.norm);
+  if (proven(ref.norm, norm_g)) return true;
+  if (!(norm_g < 2.0)) return false;  // the reference is too far (or NaN): one step would not get there
+  // One Newton-Schulz step, Y1 = (I + G) Y: its residual is G^2 in exact arithmetic.
+  alignas(64) double y1[6][8];
+  lane_v sum_y[kP] = {};
 #pragma GCC unroll 6
   for (int i = 0; i < 6; ++i) {
     for (int q = 0; q < kP; ++q) {
-      lane_v f = unit[i][q], row_j;
-      for (int k = 0; k < 6; ++k) f -= rows[i][k] * z[k][q];
-      std::memcpy(&row_j, &rows[i][q * kW], sizeof row_j);
-      sum_f[q] += abs_v(f);
-      sum_wz[q] += (i < 3 ? 1.0 : length) * abs_v(z[i][q]);
-      sum_z[q] += abs_v(z[i][q]);
-      sum_j[q] += abs_v(row_j);
+      lane_v r = load(&ref.inverse[i][q * kW]);
+      for (int k = 0; k < 6; ++k) r += g[i][k] * load(&ref.inverse[k][q * kW]);
+      std::memcpy(&y1[i][q * kW], &r, sizeof r);
+      sum_y[q] += abs_v(r);
     }
   }
-  double norm_f = 0.0, norm_wz = 0.0, norm_z = 0.0, norm_j = 0.0, norm_a = 0.0;
-  for (int q = 0; q < kP; ++q) {
-    const lane_v sum_a = col_scale[q] * sum_j[q];
-    for (int c = 0; c < kW; ++c) {  // padding columns are 0
-      norm_f = std::max(norm_f, sum_f[q][c]);
-      norm_wz = std::max(norm_wz, sum_wz[q][c]);
-      norm_z = std::max(norm_z, sum_z[q][c]);
-      norm_j = std::max(norm_j, sum_j[q][c]);
-      norm_a = std::max(norm_a, sum_a[c]);
-    }
-  }
-  norm_f += 1e-13 * norm_j * norm_z;
-  if (!(norm_f < 0.5)) return false;
-  // The products and quotient round by a few u: 1e-12 of slack.
-  return norm_a * norm_wz / (1.0 - norm_f) * (1.0 + 1e-12) <= bound;
+  const double norm_y1 = lane_max(sum_y);
+  return proven(norm_y1, residual_norm(y1, norm_y1));
 }
 
 /// Condition number of a platform Jacobian J [-, m] (rows [s_i, arm_i x s_i] or the motor-side

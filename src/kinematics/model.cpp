@@ -10,6 +10,7 @@
 #include "hexatwist/error.hpp"
 #include "hexatwist/kinematics/limits.hpp"
 #include "kinematics/geometry.hpp"
+#include "kinematics/twist_internal.hpp"
 
 namespace hexatwist {
 namespace {
@@ -193,6 +194,22 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
       jacobian_condition(*this, home, condition) == Status::PlatformSingularity)
     fail(fmt::format("limits.jacobian_condition_max: the Jacobian's condition number at home is {:.4g}, above the "
                      "limit {:.4g}", condition, lim.jacobian_condition_max));
+  // The cheap condition proof's reference: the scaled Jacobian's inverse at home (left at zero,
+  // with an infinite norm, where home has no regular Jacobian: every proof then fails).
+  Matrix6d J_home = Matrix6d::Zero();
+  const bool regular = inverse_kinematics(*this, Placement{}, home) == Status::Ok &&
+                       (has_twist_ ? detail::motor_length_jacobian(*this, home, J_home) == Status::Ok
+                                   : (length_jacobian(home, J_home), true));
+  const Eigen::PartialPivLU<Matrix6d> lu(J_home);
+  if (regular && std::abs(lu.determinant()) > 0.0) {
+    Matrix6d Y = lu.inverse();
+    Y.bottomRows<3>() *= condition_length_;  // W J0^-1
+    if (Y.allFinite()) {
+      for (int i = 0; i < kLegs; ++i)
+        for (int c = 0; c < kLegs; ++c) condition_reference_.inverse[i][c] = Y(i, c);
+      condition_reference_.norm = Y.cwiseAbs().colwise().sum().maxCoeff();
+    }
+  }
 }
 
 PerLeg<LegSpec> symmetric_legs(const SymmetricSpec& s) {

@@ -1,6 +1,7 @@
 // The immutable, validated description of a six-leg U-P-U lead-screw Stewart platform.
 #pragma once
 
+#include <cmath>
 #include <string>
 
 #include "hexatwist/types.hpp"
@@ -102,6 +103,15 @@ struct LegGeometry {
   LegLanes lanes;              ///< all of the above, padded to eight lanes
 };
 
+/// The reference of the cheap proof that the Jacobian's condition is within the limit
+/// (docs/theory.md §8): Y0 = W J0^-1, the inverse of the scaled Jacobian at home (W = diag(1, 1, 1,
+/// l_c, l_c, l_c), l_c = Model::condition_length()), rows padded with zeros to eight lanes, and
+/// its 1-norm. Any Y0 keeps the proof sound; a good one makes it succeed.
+struct alignas(64) ConditionReference {
+  double inverse[6][8] = {};  ///< Y0 [-]
+  double norm = INFINITY;     ///< ||Y0||_1; inf where home's Jacobian is singular (no proof then) [-]
+};
+
 /// Immutable, validated platform model. Construction throws hexatwist::Error naming the leg and
 /// field at fault; every other function of the library takes a `const Model&` and never throws.
 class Model {
@@ -130,6 +140,8 @@ class Model {
   /// Characteristic length of the platform, the largest distance of a platform joint from the
   /// pivot: the Jacobian's rotation columns are divided by it for its condition number [m].
   double condition_length() const noexcept { return condition_length_; }
+  /// The scaled inverse Jacobian at home, for the cheap condition proof.
+  const ConditionReference& condition_reference() const noexcept { return condition_reference_; }
 
  private:
   ModelSpec spec_;
@@ -140,6 +152,7 @@ class Model {
   double cos_bend_max_ = 1.0;
   double cos2_singularity_margin_ = 1.0;
   double condition_length_ = 1.0;
+  ConditionReference condition_reference_;
   bool has_twist_ = false;
 };
 
