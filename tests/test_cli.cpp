@@ -267,6 +267,17 @@ TEST(Cli, FkWithImpossibleLengthsFailsWithExitThree) {
   EXPECT_TRUE(j["pose"].IsNull());
 }
 
+TEST(Cli, FkOfLengthsOnTheStrokeEndsIsInsideTheLimits) {
+  // Every leg typed on an end of the stroke (1.40 / 2.45 m): FK recomputes 1.4 as
+  // 1.3999999999999997; on a bound is inside it (limits.hpp).
+  const Outcome r = run({"fk", "--lengths=1.4,2.45,1.4,2.45,1.4,2.45", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(json(r)["status"].as<std::string>(), "ok");
+  EXPECT_TRUE(json(r)["limit"].IsNull());
+  const Outcome text = run({"fk", "--lengths=1.4,2.45,1.4,2.45,1.4,2.45"});
+  EXPECT_EQ(text.code, 0) << text.err;
+}
+
 TEST(Cli, FkRejectsFiveLengths) { expect_error(run({"fk", "--lengths=1.9,1.9,1.9,1.9,1.9"}), 2, {"--lengths", "6"}); }
 
 TEST(Cli, FkRejectsLengthsThatAreNotLengths) {
