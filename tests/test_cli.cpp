@@ -1367,6 +1367,20 @@ TEST(CliOptions, FiniteButAbsurdSynthValuesAreRefusedAsOutOfRangeNotAsNonFinite)
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+TEST(CliOptions, FiniteButAbsurdStreamAndSettleValuesAreRefusedNamingTheirRange) {
+  const std::string none;
+  expect_error(run({"stream", "--max-velocity", "1", "--rate", "1e300"}, &none), 2, {"--rate 1e+300", "at most 1e6 Hz"});
+  expect_error(run({"stream", "--rt-priority", "500"}, &none), 2, {"--rt-priority 500", "SCHED_FIFO priority 1..99"});
+  expect_error(run({"stream", "--rt-priority", "-1"}, &none), 2, {"--rt-priority -1", "or 0 for none"});
+  const std::string tracker = std::string(HEXATWIST_SOURCE_DIR) + "/examples/tracker_Rz.csv";
+  for (const char* command : {"measure", "identify"}) {
+    const Outcome r = run({command, "--points", tracker, "--test", "Rz", "--settle", "1e9", "--out",
+                           (temp_dir() / "settle-out").string()});
+    expect_error(r, 2, {"--settle 1000000000", "shorter than the run"});
+  }
+  EXPECT_FALSE(std::filesystem::exists(temp_dir() / "settle-out"));
+}
+
 TEST(CliSimulate, ATrajectoryTooLongToSampleNamesTheOptionAndFileNotTheRoutine) {
   const std::string csv = write_file("eon.csv", "t,x,y,z,roll,pitch,yaw\n0,0,0,0,0,0,0\n1e9,0,0,0.001,0,0,0\n");
   const Outcome r = run({"simulate", "--trajectory", csv, "--no-figures", "--out", (temp_dir() / "eon").string()});

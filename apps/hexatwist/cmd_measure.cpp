@@ -377,6 +377,9 @@ int run_measure(const MeasureOptions& o) {
   Run run = build_run(config, o.run);
 
   check_option(o.settle >= 0.0, "--settle", o.settle, "a time >= 0 [s]");
+  check_option(o.settle < run.test.trajectory.duration(), "--settle", o.settle,
+               fmt::format("a time shorter than the run ({:g} s): no point can be still for longer [s]",
+                           run.test.trajectory.duration()));
   if (!std::isnan(o.register_until))
     check_option(true, "--register-until", o.register_until, "a time [s]");
   MeasurementOptions mo;
@@ -591,6 +594,9 @@ int run_identify(const IdentifyOptions& o) {
   const PointLogFormat format = log_format(o.log);
   check_option(o.settle >= 0.0, "--settle", o.settle, "a time >= 0 [s]");
   const Run run = build_run(config, o.run);
+  check_option(o.settle < run.test.trajectory.duration(), "--settle", o.settle,
+               fmt::format("a time shorter than the run ({:g} s): no point can be still for longer [s]",
+                           run.test.trajectory.duration()));
   const PointLog log = read_point_log(o.log, format);
   ObservationSet set;
   try {
