@@ -1381,6 +1381,14 @@ TEST(CliOptions, FiniteButAbsurdStreamAndSettleValuesAreRefusedNamingTheirRange)
   EXPECT_FALSE(std::filesystem::exists(temp_dir() / "settle-out"));
 }
 
+TEST(CliOptions, StationsThatCannotBeReachedNameTheOptionOnce) {
+  // A 0.5 deg bend limit: no random station within +-0.25 m and +-15 deg passes it.
+  const std::string stiff = write_file("stiff.yaml", replace_line(kSymmetric, 15, "  bend_max_deg: 0.5"));
+  const Outcome r = run({"synth", "--config", stiff, "--stations", "3", "--out", (temp_dir() / "stiff.csv").string()});
+  expect_error(r, 3, {"--stations: station 1: ", "1000 tries"});
+  EXPECT_EQ(r.err.find("stations: stations:"), std::string::npos) << r.err;
+}
+
 TEST(CliSimulate, ATrajectoryTooLongToSampleNamesTheOptionAndFileNotTheRoutine) {
   const std::string csv = write_file("eon.csv", "t,x,y,z,roll,pitch,yaw\n0,0,0,0,0,0,0\n1e9,0,0,0.001,0,0,0\n");
   const Outcome r = run({"simulate", "--trajectory", csv, "--no-figures", "--out", (temp_dir() / "eon").string()});
