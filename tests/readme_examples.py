@@ -10,9 +10,14 @@ up to the next "$ " line are its expected output. A step whose expected lines al
 Volatile text is not compared:
   - the wall-clock times "in 1.3 s" and "in 3.2 s in all" (any number there matches);
   - in an expected line, "…" matches any text (README.md writes it where output varies).
-A block that needs files the reader makes (high.csv, short.csv ...) is skipped by putting
+A block that needs files the reader makes (high.csv, short.csv ...) makes them first, out of
+sight, with one or more lines
+    <!-- readme-example: setup: BASH COMMAND -->
+just before its opening fence, run in order in the block's scratch folder (examples/ and configs/
+are there). A block that cannot be run here at all (a real-time loop, a build tree) is skipped by
+putting
     <!-- readme-example: skip -->
-on the line just before its opening fence.
+on the line just before its opening fence (or before its setup lines).
 
 Usage: readme_examples.py README.md path/to/hexatwist [--keep]
 """
@@ -24,17 +29,23 @@ import sys
 import tempfile
 
 SKIP = "<!-- readme-example: skip -->"
+SETUP = re.compile(r"^<!-- readme-example: setup: (.*) -->$")
 WALL_TIME = re.compile(r"\bin \d+(\.\d+)? s\b")
 
 
 def blocks(readme):
-    """(line number, [(command, [expected lines])]) of every example block."""
+    """(line number, [setup commands], [(command, [expected lines])]) of every example block."""
     lines = readme.splitlines()
     out = []
     k = 0
     while k < len(lines):
         if lines[k].strip() == "```" and k + 1 < len(lines) and lines[k + 1].startswith("$ "):
-            skip = k > 0 and lines[k - 1].strip() == SKIP
+            setup = []
+            before = k - 1
+            while before >= 0 and SETUP.match(lines[before].strip()):
+                setup.insert(0, SETUP.match(lines[before].strip()).group(1))
+                before -= 1
+            skip = before >= 0 and lines[before].strip() == SKIP
             start = k + 1
             end = start
             while lines[end].strip() != "```":
@@ -46,7 +57,7 @@ def blocks(readme):
                         steps.append((line[2:], []))
                     else:
                         steps[-1][1].append(line)
-                out.append((start + 1, steps))
+                out.append((start + 1, setup, steps))
             k = end + 1
         else:
             k += 1
@@ -72,7 +83,7 @@ def main():
         readme = f.read()
     failures = 0
     checked = 0
-    for line_no, steps in blocks(readme):
+    for line_no, setup, steps in blocks(readme):
         scratch = tempfile.mkdtemp(prefix="hexatwist_readme_")
         try:
             bin_dir = os.path.join(scratch, ".bin")
@@ -81,6 +92,12 @@ def main():
             for d in ("examples", "configs"):
                 os.symlink(os.path.join(root, d), os.path.join(scratch, d))
             env = dict(os.environ, PATH=bin_dir + os.pathsep + os.environ.get("PATH", ""))
+            for command in setup:
+                made = subprocess.run(["bash", "-c", command], cwd=scratch, env=env, stdout=subprocess.PIPE,
+                                      stderr=subprocess.STDOUT, text=True, timeout=600)
+                if made.returncode != 0:
+                    failures += 1
+                    print(f"README.md:{line_no}: setup failed: {command}\n{made.stdout}")
             for command, expected in steps:
                 checked += 1
                 errors_only = bool(expected) and all(e.startswith("hexatwist: ") for e in expected)

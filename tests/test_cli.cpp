@@ -267,6 +267,17 @@ TEST(Cli, FkWithImpossibleLengthsFailsWithExitThree) {
   EXPECT_TRUE(j["pose"].IsNull());
 }
 
+TEST(Cli, FkOfLengthsOnTheStrokeEndsIsInsideTheLimits) {
+  // Every leg typed on an end of the stroke (1.40 / 2.45 m): FK recomputes 1.4 as
+  // 1.3999999999999997; on a bound is inside it (limits.hpp).
+  const Outcome r = run({"fk", "--lengths=1.4,2.45,1.4,2.45,1.4,2.45", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(json(r)["status"].as<std::string>(), "ok");
+  EXPECT_TRUE(json(r)["limit"].IsNull());
+  const Outcome text = run({"fk", "--lengths=1.4,2.45,1.4,2.45,1.4,2.45"});
+  EXPECT_EQ(text.code, 0) << text.err;
+}
+
 TEST(Cli, FkRejectsFiveLengths) { expect_error(run({"fk", "--lengths=1.9,1.9,1.9,1.9,1.9"}), 2, {"--lengths", "6"}); }
 
 TEST(Cli, FkRejectsLengthsThatAreNotLengths) {
@@ -1010,6 +1021,48 @@ TEST(CliIdentify, DataThatCannotDetermineTheParametersExitFiveInOneLine) {
   EXPECT_FALSE(std::filesystem::exists(yaml));
 }
 
+TEST(CliIdentify, AFitFarNoisierThanTheTrackersScatterAtRestExitsFiveAndWritesNothing) {
+  // A 5 % lead seen through the twist only (--lead-effect twist) leaves the travel's centimetres
+  // unexplained: the fit's noise is hundreds of times the tracker's 10 um.
+  const std::string log = (temp_dir() / "lead5.csv").string();
+  ASSERT_EQ(run({"synth", "--stations", "40", "--station-seed", "3", "--lead-error-pct", "5", "--out", log}).code, 0);
+  const std::string yaml = (temp_dir() / "lead5.yaml").string();
+  std::filesystem::remove(yaml);
+  const Outcome r = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--lead-effect", "twist",
+                         "--out", yaml, "--json"});
+  expect_error(r, 5, {"lead5.csv: ", "times the tracker's scatter at rest", "does not explain the data",
+                      "nothing was written"});
+  EXPECT_FALSE(std::filesystem::exists(yaml));
+  const YAML::Node j = json(r);
+  EXPECT_EQ(j["status"].as<std::string>(), "failed");
+  EXPECT_NEAR(j["tracker_noise"].as<double>(), 10e-6, 1e-6);
+  EXPECT_TRUE(j["estimate"].IsNull());
+  EXPECT_TRUE(j["corrected_config"].IsNull());
+  EXPECT_GT(j["noise_ratio"].as<double>(), 100.0);  // measured 539
+  // The same log under the right lead model: the fit's noise is the tracker's (measured 1.00).
+  const Outcome ok = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--out", yaml, "--json"});
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_LT(json(ok)["noise_ratio"].as<double>(), 1.5);
+  EXPECT_GT(json(ok)["noise_ratio"].as<double>(), 0.7);
+}
+
+TEST(CliIdentify, TwoThreadHandsThatFitEquallyWellExitFiveAndWriteNothing) {
+  // 3 mm of tracker noise over 8 stations: the two signs' costs differ by 7 noise variances, 25 needed.
+  const std::string log = (temp_dir() / "tie.csv").string();
+  ASSERT_EQ(run({"synth", "--stations", "8", "--station-seed", "3", "--noise-um", "3000", "--out", log}).code, 0);
+  const std::string yaml = (temp_dir() / "tie.yaml").string();
+  std::filesystem::remove(yaml);
+  const Outcome r = run({"identify", "--points", log, "--stations", "8", "--station-seed", "3", "--out", yaml, "--json"});
+  expect_error(r, 5, {"tie.csv: ", "the two thread hands fit the data equally well", "cost ratio 1.0",
+                      "not decided", "nothing was written"});
+  EXPECT_FALSE(std::filesystem::exists(yaml));
+  const YAML::Node j = json(r);
+  EXPECT_EQ(j["status"].as<std::string>(), "failed");
+  EXPECT_TRUE(j["estimate"].IsNull());
+  EXPECT_LT(j["cost_ratio"].as<double>(), 1.1);  // the fit's numbers say why; the estimate is refused
+  EXPECT_FALSE(j["sigma"].IsNull());
+}
+
 TEST(CliIdentify, BadRunsAndLogsAreOneLineErrors) {
   const std::string log = (temp_dir() / "stations.csv").string();
   if (!std::filesystem::exists(log)) {
@@ -1300,6 +1353,47 @@ TEST(CliOptions, SynthOptionsOutOfTheirRangeAreRefused) {
   expect_error(run({"synth", "--test", "Lz", "--out", out, "--rate", "0"}), 2, {"--rate 0", "> 0"});
   expect_error(run({"synth", "--test", "Lz", "--out", out, "--noise-um", "inf"}), 2, {"--noise-um"});
   EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(CliOptions, FiniteButAbsurdSynthValuesAreRefusedAsOutOfRangeNotAsNonFinite) {
+  const std::string out = (temp_dir() / "absurd-options.csv").string();
+  for (const auto& [option, value] : std::vector<std::pair<std::string, std::string>>{
+           {"--noise-um", "1e9"}, {"--offsets-mm", "1e6"}, {"--offsets-mm", "0,0,0,0,0,2000"},
+           {"--point-offset-mm", "0,0,1e9"}}) {
+    const Outcome r = run({"synth", "--test", "Lz", "--out", out, option, value});
+    expect_error(r, 2, {option + " ", "below the stroke"});
+    EXPECT_EQ(r.err.find("finite"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(CliOptions, FiniteButAbsurdStreamAndSettleValuesAreRefusedNamingTheirRange) {
+  const std::string none;
+  expect_error(run({"stream", "--max-velocity", "1", "--rate", "1e300"}, &none), 2, {"--rate 1e+300", "at most 1e6 Hz"});
+  expect_error(run({"stream", "--rt-priority", "500"}, &none), 2, {"--rt-priority 500", "SCHED_FIFO priority 1..99"});
+  expect_error(run({"stream", "--rt-priority", "-1"}, &none), 2, {"--rt-priority -1", "or 0 for none"});
+  const std::string tracker = std::string(HEXATWIST_SOURCE_DIR) + "/examples/tracker_Rz.csv";
+  for (const char* command : {"measure", "identify"}) {
+    const Outcome r = run({command, "--points", tracker, "--test", "Rz", "--settle", "1e9", "--out",
+                           (temp_dir() / "settle-out").string()});
+    expect_error(r, 2, {"--settle 1000000000", "shorter than the run"});
+  }
+  EXPECT_FALSE(std::filesystem::exists(temp_dir() / "settle-out"));
+}
+
+TEST(CliOptions, StationsThatCannotBeReachedNameTheOptionOnce) {
+  // A 0.5 deg bend limit: no random station within +-0.25 m and +-15 deg passes it.
+  const std::string stiff = write_file("stiff.yaml", replace_line(kSymmetric, 15, "  bend_max_deg: 0.5"));
+  const Outcome r = run({"synth", "--config", stiff, "--stations", "3", "--out", (temp_dir() / "stiff.csv").string()});
+  expect_error(r, 3, {"--stations: station 1: ", "1000 tries"});
+  EXPECT_EQ(r.err.find("stations: stations:"), std::string::npos) << r.err;
+}
+
+TEST(CliSimulate, ATrajectoryTooLongToSampleNamesTheOptionAndFileNotTheRoutine) {
+  const std::string csv = write_file("eon.csv", "t,x,y,z,roll,pitch,yaw\n0,0,0,0,0,0,0\n1e9,0,0,0.001,0,0,0\n");
+  const Outcome r = run({"simulate", "--trajectory", csv, "--no-figures", "--out", (temp_dir() / "eon").string()});
+  expect_error(r, 2, {"--trajectory: ", "eon.csv: ", "1e+09 s", "samples"});
+  EXPECT_EQ(r.err.find("resample"), std::string::npos) << r.err;
 }
 
 TEST(CliMeasure, TwoColumnNamesForTheSameColumnAreRefused) {

@@ -1,6 +1,7 @@
 // Limits: stroke, bend, U-joint and platform singularity, each reported with the right leg and value.
 #include <Eigen/LU>
 #include <Eigen/SVD>
+#include <iomanip>
 
 #include "support.hpp"
 
@@ -104,6 +105,144 @@ TEST(Limits, CommandStrokeCheckNamesTheLeg) {
   cmd[2] = std::nan("");
   EXPECT_EQ(check_stroke(seed_model(), cmd, r), Status::NonFiniteInput);
   EXPECT_EQ(r.leg, 2);
+}
+
+// ---- boundaries: on a limit is inside it (limits.hpp, kLimitTolerance) ------------------------
+
+// What every path decides for `p`: the scalar check after inverse kinematics, and the real-time
+// path (vectorised lanes, then the naming fallback) for the conventional command; with
+// `commands`, the compensated real-time command and compute_commands too (they add a stroke
+// check of the compensated command, which a stroke-bound test would trip on its own).
+std::vector<Status> decisions(const Model& model, const Pose& p, bool commands) {
+  LegState st;
+  EXPECT_EQ(inverse_kinematics(model, p, st), Status::Ok);
+  LimitReport r;
+  std::vector<Status> out{check_limits(model, st, r)};
+  Vector6d cmd;
+  out.push_back(motor_commands(model, p, Strategy::Conventional, cmd, r));
+  if (commands) {
+    out.push_back(motor_commands(model, p, Strategy::Compensated, cmd, r));
+    CommandReport rep;
+    out.push_back(compute_commands(model, p, rep));
+  }
+  return out;
+}
+
+// The limit that `set` writes is put on the pose's own value of it (`value`), then 1 ulp past
+// it (the value outside the bound by 1 ulp: inside the tolerance) and 1e-12 relative past it.
+// `upper`: the value must stay at or below the bound. Every path accepts the first two and
+// refuses the third with `refused`.
+template <class Set>
+void expect_on_the_bound_is_inside(const Pose& p, double value, bool upper, Set set, Status refused, bool commands) {
+  const double toward = upper ? -INFINITY : INFINITY;
+  const double past = upper ? value * (1.0 - 1e-12) : value * (1.0 + 1e-12);
+  for (const double bound : {value, std::nextafter(value, toward), past}) {
+    ModelSpec spec = seed_model().spec();
+    set(spec, bound);
+    const Model model(spec);
+    const Status expected = bound == past ? refused : Status::Ok;
+    SCOPED_TRACE(::testing::Message() << std::setprecision(17) << str(p) << " value " << value << " bound " << bound);
+    for (const Status s : decisions(model, p, commands)) EXPECT_EQ(s, expected) << to_string(s);
+  }
+}
+
+Pose pose_of(double x, double y, double z, double roll_deg, double pitch_deg, double yaw_deg) {
+  return Pose::from_vector((Vector6d() << x, y, z, deg2rad(roll_deg), deg2rad(pitch_deg), deg2rad(yaw_deg)).finished());
+}
+
+TEST(Limits, AStrokeEndIsInsideOnEveryPathAndPastItOutside) {
+  const Pose up = pose_of(0.05, -0.02, 0.25, 2, -3, 5);
+  LegState st;
+  ASSERT_EQ(inverse_kinematics(seed_model(), up, st), Status::Ok);
+  expect_on_the_bound_is_inside(up, st.length.maxCoeff(), true, [](ModelSpec& s, double b) { s.limits.length_max = b; },
+                                Status::StrokeAboveMax, false);
+  const Pose down = pose_of(-0.04, 0.03, -0.2, -2, 1, -6);
+  ASSERT_EQ(inverse_kinematics(seed_model(), down, st), Status::Ok);
+  expect_on_the_bound_is_inside(down, st.length.minCoeff(), false, [](ModelSpec& s, double b) { s.limits.length_min = b; },
+                                Status::StrokeBelowMin, false);
+}
+
+TEST(Limits, ABendOnItsLimitIsInsideOnEveryPathAndPastItOutside) {
+  for (const Pose& p : {pose_of(0.1, 0, 0, 0, -20, 0), pose_of(0.05, 0.05, 0, 8, 5, 10)}) {
+    LegState st;
+    ASSERT_EQ(inverse_kinematics(seed_model(), p, st), Status::Ok);
+    Vector6d bb, bp;
+    bend_angles(seed_model(), st, bb, bp);
+    const Status refused = bb.maxCoeff() >= bp.maxCoeff() ? Status::BendBase : Status::BendPlatform;
+    expect_on_the_bound_is_inside(p, std::max(bb.maxCoeff(), bp.maxCoeff()), true,
+                                  [](ModelSpec& s, double b) { s.limits.bend_max = b; }, refused, true);
+  }
+}
+
+TEST(Limits, ASingularityMarginMetExactlyIsInsideOnEveryPathAndPastItOutside) {
+  // The margin must stay below the angle at home (the model checks home): a pose that closes it.
+  const auto smallest = [](const Model& model, const LegState& st, Status& which) {
+    double angle = kPi;
+    for (int i = 0; i < kLegs; ++i) {
+      const Vector3d s = st.s_B.row(i).transpose();
+      const Vector3d axes[2] = {model.leg(i).axis_base_B, st.axis_platform_B.row(i).transpose()};
+      for (int j = 0; j < 2; ++j) {
+        const double a = std::atan2(s.cross(axes[j]).norm(), std::abs(s.dot(axes[j])));
+        if (a < angle) {
+          angle = a;
+          which = j == 0 ? Status::SingularBase : Status::SingularPlatform;
+        }
+      }
+    }
+    return angle;
+  };
+  LegState home;
+  ASSERT_EQ(inverse_kinematics(seed_model(), Pose{}, home), Status::Ok);
+  Status which = Status::Ok;
+  const double at_home = smallest(seed_model(), home, which);
+  int tested = 0;
+  for (const Pose& p : {pose_of(0.1, 0, 0, 0, 0, 15), pose_of(0, 0.1, 0, 0, 0, -15), pose_of(0.05, 0.05, 0.1, 5, 5, 20),
+                        pose_of(0, 0, 0, 0, 0, 30)}) {
+    LegState st;
+    ASSERT_EQ(inverse_kinematics(seed_model(), p, st), Status::Ok);
+    const double angle = smallest(seed_model(), st, which);
+    if (!(angle < at_home - 1e-6)) continue;
+    expect_on_the_bound_is_inside(p, angle, false, [](ModelSpec& s, double b) { s.limits.singularity_margin = b; },
+                                  which, true);
+    ++tested;
+  }
+  EXPECT_GT(tested, 0);
+}
+
+TEST(Limits, AConditionNumberOnItsLimitIsInsideOnEveryPathAndPastItOutside) {
+  const Pose p = pose_of(0, 0, 0.1, 0, 0, 30);  // kappa 9.06, above home's 8.87
+  LegState st;
+  ASSERT_EQ(inverse_kinematics(seed_model(), p, st), Status::Ok);
+  double condition;
+  ASSERT_EQ(jacobian_condition(seed_model(), st, condition), Status::Ok);
+  expect_on_the_bound_is_inside(p, condition, true, [](ModelSpec& s, double b) { s.limits.jacobian_condition_max = b; },
+                                Status::PlatformSingularity, true);
+}
+
+TEST(Limits, CommandsOnTheStrokeEndsAndWithinTheToleranceAreInsideBeyondOutside) {
+  const Model& m = seed_model();
+  const double lo = m.spec().limits.length_min, hi = m.spec().limits.length_max;
+  EXPECT_EQ(m.length_max_accepted(), accepted_max(hi));
+  EXPECT_EQ(m.length_min_accepted(), accepted_min(lo));
+  EXPECT_GT(accepted_max(hi), std::nextafter(std::nextafter(hi, INFINITY), INFINITY));  // a few ulp, not one
+  EXPECT_LT(accepted_max(hi), hi * (1.0 + 1e-15));
+  LimitReport r;
+  for (int leg = 0; leg < kLegs; ++leg) {
+    SCOPED_TRACE(leg);
+    Vector6d cmd = m.length_home();
+    for (const double inside : {hi, std::nextafter(hi, INFINITY), accepted_max(hi), lo, std::nextafter(lo, 0.0),
+                                accepted_min(lo)}) {
+      cmd[leg] = inside;
+      EXPECT_EQ(check_stroke(m, cmd, r), Status::Ok) << std::setprecision(17) << inside;
+    }
+    cmd[leg] = std::nextafter(accepted_max(hi), INFINITY);
+    EXPECT_EQ(check_stroke(m, cmd, r), Status::StrokeAboveMax);
+    EXPECT_EQ(r.leg, leg);
+    EXPECT_EQ(r.bound, hi);  // the configured bound, not the widened one
+    cmd[leg] = std::nextafter(accepted_min(lo), 0.0);
+    EXPECT_EQ(check_stroke(m, cmd, r), Status::StrokeBelowMin);
+    EXPECT_EQ(r.leg, leg);
+  }
 }
 
 // ---- platform (Jacobian) singularity --------------------------------------------------------

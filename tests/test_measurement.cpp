@@ -407,7 +407,7 @@ TEST(Measurement, StationsRefuseBadSpecsInOneLine) {
   // Far outside the workspace: within +-30 m, a draw inside the seed's +-0.5 m has odds of 1e-5.
   spec.translation = 30.0;
   test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
-                          "stations: station 1:", {"1000 tries", "smaller ranges"});
+                          "station 1:", {"1000 tries", "smaller ranges"});
 }
 
 // A stations run of the real platform (lead 5 % long, the other thread hand, offsets within

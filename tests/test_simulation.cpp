@@ -2,7 +2,9 @@
 // limit check before anything runs, and what each option changes.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
+#include <iomanip>
 
 #include "hexatwist/io/config.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
@@ -144,6 +146,53 @@ TEST(Simulation, NothingRunsFasterThanTheMotors) {
   EXPECT_EQ(issue.index, 49u);  // the central difference at 49 sees the jump first
   EXPECT_GT(issue.limit.value, rig.servo().max_speed);
   EXPECT_EQ(issue.limit.bound, rig.servo().max_speed);
+}
+
+TEST(Simulation, AMotorSpeedOrHoldingTorqueOnItsLimitIsInsideAndPastItOutside) {
+  // The limit put on the trajectory's own value, 1 ulp below it (inside the tolerance of
+  // limits.hpp) and 1e-12 relative below it.
+  const Rig& seed_rig = seed().rig;
+  Trajectory t = still(Pose{}, 0.1);
+  t.poses[50].position.z() = 0.01;
+  SimulationIssue issue;
+  ServoSpec fast = seed_rig.servo();
+  fast.max_speed = 1e5;
+  ASSERT_EQ(check_trajectory(Rig(seed_rig.model(), fast, seed_rig.load(), seed_rig.simulation()), t, issue), Status::Ok);
+  ServoSpec at = seed_rig.servo();
+  ASSERT_EQ(check_trajectory(seed_rig, t, issue), Status::MotorSpeedAboveMax);
+  double speed = 0.0;  // the largest over the legs and ticks: raise the limit to each one reported
+  for (double limit = issue.limit.value;; limit = issue.limit.value) {
+    at.max_speed = limit;
+    if (check_trajectory(Rig(seed_rig.model(), at, seed_rig.load(), seed_rig.simulation()), t, issue) == Status::Ok) {
+      speed = limit;
+      break;
+    }
+    ASSERT_EQ(issue.status, Status::MotorSpeedAboveMax);
+  }
+  for (const double bound : {speed, std::nextafter(speed, 0.0), speed * (1.0 - 1e-12)}) {
+    at.max_speed = bound;
+    const Status s = check_trajectory(Rig(seed_rig.model(), at, seed_rig.load(), seed_rig.simulation()), t, issue);
+    EXPECT_EQ(s, bound == speed * (1.0 - 1e-12) ? Status::MotorSpeedAboveMax : Status::Ok) << std::setprecision(17) << bound;
+  }
+  ServoSpec weak;
+  weak.torque_limit = 3.0;
+  weak.peak_torque_at_max_speed = weak.continuous_torque = 2.0;
+  ASSERT_EQ(check_trajectory(Rig(seed_rig.model(), weak, LoadSpec{}, SimulationSpec{}), still(Pose{}, 0.01), issue),
+            Status::TorqueAboveMax);
+  double hold = 0.0;  // the largest over the legs: the first leg reported may not hold the most
+  for (double limit = issue.limit.value;; limit = issue.limit.value) {
+    weak.torque_limit = limit;
+    if (check_trajectory(Rig(seed_rig.model(), weak, LoadSpec{}, SimulationSpec{}), still(Pose{}, 0.01), issue) ==
+        Status::Ok) {
+      hold = limit;
+      break;
+    }
+  }
+  for (const double bound : {hold, std::nextafter(hold, 0.0), hold * (1.0 - 1e-12)}) {
+    weak.torque_limit = bound;
+    const Status s = check_trajectory(Rig(seed_rig.model(), weak, LoadSpec{}, SimulationSpec{}), still(Pose{}, 0.01), issue);
+    EXPECT_EQ(s, bound == hold * (1.0 - 1e-12) ? Status::TorqueAboveMax : Status::Ok) << std::setprecision(17) << bound;
+  }
 }
 
 TEST(Simulation, NothingRunsIfAMotorCannotHoldTheLoad) {

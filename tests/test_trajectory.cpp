@@ -425,13 +425,13 @@ TEST(Trajectory, BadSweepArgumentsAreErrors) {
   const auto expect = [](const std::string& msg, std::string_view part) {
     EXPECT_NE(msg.find(part), std::string::npos) << msg;
   };
-  expect(error_of([&] { sweep_trajectory(6, 0.1, l, 1.0, 0.01); }), "coordinate must be 0..5");
+  expect(error_of([&] { sweep_trajectory(6, 0.1, l, 1.0, 0.01); }), "coordinate: expected 0..5");
   expect(error_of([&] { sweep_trajectory(-1, 0.1, l, 1.0, 0.01); }), "got -1");
-  expect(error_of([&] { sweep_trajectory(0, 0.0, l, 1.0, 0.01); }), "amplitude must be finite and > 0, got 0");
+  expect(error_of([&] { sweep_trajectory(0, 0.0, l, 1.0, 0.01); }), "amplitude: expected a finite number > 0, got 0");
   expect(error_of([&] { sweep_trajectory(0, -0.1, l, 1.0, 0.01); }), "amplitude");
   expect(error_of([&] { sweep_trajectory(0, nan, l, 1.0, 0.01); }), "amplitude");
-  expect(error_of([&] { sweep_trajectory(0, 0.1, l, -1.0, 0.01); }), "dwell must be finite and >= 0 s, got -1");
-  expect(error_of([&] { sweep_trajectory(0, 0.1, l, 1.0, 0.0); }), "dt must be finite and > 0 s, got 0");
+  expect(error_of([&] { sweep_trajectory(0, 0.1, l, -1.0, 0.01); }), "dwell: expected a finite time >= 0 s, got -1");
+  expect(error_of([&] { sweep_trajectory(0, 0.1, l, 1.0, 0.0); }), "dt: expected a finite period > 0 s, got 0");
   expect(error_of([&] { sweep_trajectory(0, 0.1, l, 1.0, nan); }), "dt");
   expect(error_of([&] {
            sweep_trajectory(0, 0.1, {1.0, -2.0, 1.0}, 1.0, 0.01);
@@ -709,7 +709,7 @@ TEST(Trajectory, BadResampleInputsAreErrors) {
   const auto expect = [](const std::string& msg, std::string_view part) {
     EXPECT_NE(msg.find(part), std::string::npos) << msg;
   };
-  expect(error_of([&] { (void)resample(good, 0.0); }), "dt must be finite and > 0 s, got 0");
+  expect(error_of([&] { (void)resample(good, 0.0); }), "dt: expected a finite period > 0 s, got 0");
   expect(error_of([&] { (void)resample(good, -1.0); }), "got -1");
   expect(error_of([&] { (void)resample(good, std::numeric_limits<double>::quiet_NaN()); }), "dt");
   expect(error_of([&] { (void)resample(polynomial_samples({0.0}, 1), 0.1); }), "at least 2 samples, got 1");
@@ -767,7 +767,7 @@ TEST(Trajectory, WaypointMovesAreStraightJerkLimitedAndHeld) {
   EXPECT_NEAR(tr.duration(), t, dt);
   expect(error_of([&] { (void)waypoint_trajectory(std::span(w).first(1), limits, dwell, dt); }), "at least 2");
   w[1][2] = std::numeric_limits<double>::quiet_NaN();
-  expect(error_of([&] { (void)waypoint_trajectory(w, limits, dwell, dt); }), "pose 2 is not finite");
+  expect(error_of([&] { (void)waypoint_trajectory(w, limits, dwell, dt); }), "waypoint 2 is not finite");
 }
 
 TEST(Trajectory, InterpolateIsTheResampledCurveAtAnyTime) {
@@ -792,7 +792,7 @@ TEST(Trajectory, InterpolateIsTheResampledCurveAtAnyTime) {
   const TimedPoses tp = polynomial_samples({0.0, 1.0, 2.0}, 1);
   const std::vector<double> outside{0.5, 2.5};
   expect(error_of([&] { (void)interpolate(tp, outside); }),
-         "time 2.5 (number 2) is outside the samples' span [0, 2] s");
+         "time 2.5 s (number 2) is outside the samples' span [0, 2] s");
   EXPECT_EQ(timed_poses(resample(tp, 0.5)).t, (std::vector<double>{0.0, 0.5, 1.0, 1.5, 2.0}));
 }
 

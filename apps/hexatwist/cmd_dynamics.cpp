@@ -131,9 +131,9 @@ std::string summary_json(const Rig& rig, const DynamicsOptions& o, const Traject
     j.field("peak_usage_time", m.peak_usage_time);
     j.field("speed_usage", m.speed_usage);
     j.field("rms_usage", m.rms_usage);
-    j.field("speed_ok", m.speed_usage <= 1.0);
-    j.field("peak_torque_ok", m.peak_usage <= 1.0);
-    j.field("continuous_torque_ok", m.rms_usage <= 1.0);
+    j.field("speed_ok", m.speed_usage <= accepted_max(1.0));  // on the limit is inside it
+    j.field("peak_torque_ok", m.peak_usage <= accepted_max(1.0));
+    j.field("continuous_torque_ok", m.rms_usage <= accepted_max(1.0));
     j.key("first_violation");
     violation_json(j, m.violation);
     j.end_object();

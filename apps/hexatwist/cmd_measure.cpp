@@ -186,7 +186,14 @@ int run_synth(const SynthOptions& o) {
   const std::filesystem::path csv(out);
   const std::string truth = (csv.parent_path() / (csv.stem().string() + ".truth.json")).string();
   check_distinct_outputs({{"--out", out}, {"the truth beside --out", truth}, {"--run-out", o.run_out}});
+  // Finite but absurd values are refused too: a noise, an offset or a point error as large as the
+  // whole stroke leaves nothing in the log to measure or identify.
+  const double stroke_um = 1e6 * (rig.model().spec().limits.length_max - rig.model().spec().limits.length_min);
   check_option(o.noise_um >= 0.0, "--noise-um", o.noise_um, "a standard deviation >= 0 [um]");
+  check_option(o.noise_um < stroke_um, "--noise-um", o.noise_um,
+               fmt::format("a standard deviation below the stroke ({:g} um, limits.length_max - limits.length_min): "
+                           "this one would drown every motion",
+                           stroke_um));
   check_option(o.rate > 0.0, "--rate", o.rate, "a sample rate > 0 [Hz]");
   check_option(o.lead_error_pct > -100.0 && o.lead_error_pct < 1e4, "--lead-error-pct", o.lead_error_pct,
                "a lead error above -100 % (-100 % is a zero lead) and below 1e4 %");
@@ -200,12 +207,20 @@ int run_synth(const SynthOptions& o) {
   if (o.offsets_mm.find(',') == std::string::npos) {
     const double bound = parse_numbers(o.offsets_mm, 1, "--offsets-mm", "a bound [mm], or six offsets [mm]")[0];
     check_option(bound >= 0.0, "--offsets-mm", bound, "a bound >= 0 [mm], or six offsets [mm]");
+    check_option(bound < 1e-3 * stroke_um, "--offsets-mm", bound,
+                 fmt::format("a bound below the stroke ({:g} mm) [mm]", 1e-3 * stroke_um));
     so.errors.zero_offset = random_zero_offsets(bound / 1e3, o.seed);
   } else
     for (int i = 0;
-         const double v : parse_numbers(o.offsets_mm, 6, "--offsets-mm", "a bound [mm], or six offsets [mm]"))
+         const double v : parse_numbers(o.offsets_mm, 6, "--offsets-mm", "a bound [mm], or six offsets [mm]")) {
+      check_option(std::abs(v) < 1e-3 * stroke_um, "--offsets-mm", v,
+                   fmt::format("offsets below the stroke ({:g} mm) in magnitude [mm]", 1e-3 * stroke_um));
       so.errors.zero_offset[i++] = v / 1e3;
+    }
   const std::vector<double> point = parse_numbers(o.point_offset_mm, 3, "--point-offset-mm", "x,y,z [mm]");
+  for (const double v : point)
+    check_option(std::abs(v) < 1e-3 * stroke_um, "--point-offset-mm", v,
+                 fmt::format("offsets below the stroke ({:g} mm) in magnitude [mm]", 1e-3 * stroke_um));
   so.errors.observation_offset_P = Vector3d(point[0], point[1], point[2]) / 1e3;
 
   SimulationIssue issue;
@@ -362,6 +377,9 @@ int run_measure(const MeasureOptions& o) {
   Run run = build_run(config, o.run);
 
   check_option(o.settle >= 0.0, "--settle", o.settle, "a time >= 0 [s]");
+  check_option(o.settle < run.test.trajectory.duration(), "--settle", o.settle,
+               fmt::format("a time shorter than the run ({:g} s): no point can be still for longer [s]",
+                           run.test.trajectory.duration()));
   if (!std::isnan(o.register_until))
     check_option(true, "--register-until", o.register_until, "a time [s]");
   MeasurementOptions mo;
@@ -476,11 +494,40 @@ std::vector<ParameterRow> parameter_rows(const Model& nominal, const Identificat
   return rows;
 }
 
+// The tracker's own noise per coordinate: the scatter of the points at rest about the mean of
+// their pose (runs of one commanded pose), pooled over the poses; NaN without repeats [m]. It
+// needs no model, so it is what the fit's sigma is compared with.
+double scatter_at_rest(const ObservationSet& set) {
+  const std::vector<Observation>& obs = set.observations;
+  double sum = 0.0;
+  std::size_t dof = 0;
+  for (std::size_t a = 0; a < obs.size();) {
+    std::size_t b = a + 1;
+    while (b < obs.size() && (obs[b].motor - obs[a].motor).cwiseAbs().maxCoeff() <= 1e-9) ++b;
+    Vector3d mean = Vector3d::Zero();
+    for (std::size_t k = a; k < b; ++k) mean += obs[k].p_T;
+    mean /= static_cast<double>(b - a);
+    for (std::size_t k = a; k < b; ++k) sum += (obs[k].p_T - mean).squaredNorm();
+    dof += 3 * (b - a - 1);
+    a = b;
+  }
+  return dof >= 3 ? std::sqrt(sum / static_cast<double>(dof)) : std::numeric_limits<double>::quiet_NaN();
+}
+
+// The fit's noise may exceed the tracker's scatter at rest by this factor before the model is
+// said not to explain the data (identify exits 5); the scatter counts as at least
+// kTrackerNoiseFloor (a log's rounding and the servo's settling are below it).
+constexpr double kNoiseRatioMax = 100.0;
+constexpr double kTrackerNoiseFloor = 1e-6;  // [m]
+
 // The JSON of identify. `failure` empty: the run succeeded and wrote `o.out`. Otherwise its
 // one-line reason; the estimate and what follows from it are null unless the identification
-// itself succeeded (`status` Ok, e.g. only the output failed).
+// itself succeeded (`status` Ok, e.g. only the output failed). `fitted`: the solver converged, so
+// the fit's numbers (residuals, sigma, the cost ratio) are known even where the estimate is
+// refused (thread hands tied, a fit far noisier than the tracker): they say why.
 std::string identify_json(const Model& nominal, const IdentifyOptions& o, const ObservationSet& set,
-                          const PointLog& log, const Identification& id, Status status, const std::string& failure) {
+                          const PointLog& log, const Identification& id, Status status, bool fitted,
+                          const std::string& failure) {
   const bool solved = status == Status::Ok;
   const auto number = [](JsonWriter& w, std::string_view key, double v, bool known) {
     w.key(key);
@@ -493,14 +540,17 @@ std::string identify_json(const Model& nominal, const IdentifyOptions& o, const 
   j.field("log_points", static_cast<int>(log.points_T.size())).field("observations", id.count);
   j.field("poses", static_cast<int>(set.poses)).field("settle", set.settle).field("strategy", o.run.strategy).field("lead_effect", o.lead_effect);
   number(j, "rms_before", id.rms_before, true);
-  number(j, "rms_after", id.rms_after, solved);
-  number(j, "max_after", id.max_after, solved);
+  number(j, "rms_after", id.rms_after, fitted);
+  number(j, "max_after", id.max_after, fitted);
   j.key("max_after_line");
-  solved && id.max_after_index >= 0 ? j.value(log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]])
+  fitted && id.max_after_index >= 0 ? j.value(log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]])
                                     : j.null();
-  number(j, "sigma", id.sigma, solved);
+  number(j, "sigma", id.sigma, fitted);
+  const double scatter = scatter_at_rest(set);
+  number(j, "tracker_noise", scatter, true);
+  number(j, "noise_ratio", id.sigma / std::max(scatter, kTrackerNoiseFloor), fitted);
   number(j, "condition", id.condition, true);
-  number(j, "cost_ratio", id.cost_ratio, solved);
+  number(j, "cost_ratio", id.cost_ratio, fitted);
   j.key("fits").begin_array(true);
   for (const SignFit& f : id.fits) {
     j.begin_object().field("twist_sign", f.twist_sign).field("status", describe(f.status));
@@ -544,6 +594,9 @@ int run_identify(const IdentifyOptions& o) {
   const PointLogFormat format = log_format(o.log);
   check_option(o.settle >= 0.0, "--settle", o.settle, "a time >= 0 [s]");
   const Run run = build_run(config, o.run);
+  check_option(o.settle < run.test.trajectory.duration(), "--settle", o.settle,
+               fmt::format("a time shorter than the run ({:g} s): no point can be still for longer [s]",
+                           run.test.trajectory.duration()));
   const PointLog log = read_point_log(o.log, format);
   ObservationSet set;
   try {
@@ -558,7 +611,7 @@ int run_identify(const IdentifyOptions& o) {
   const Status status = identify(model, set.observations, id, io);
   // A failure still prints the JSON (with the reason, and null where there is no value) when asked.
   const auto fail = [&](const ExitError& e, Status solved) {
-    if (o.json) write_stdout(identify_json(model, o, set, log, id, solved, e.what()) + "\n");
+    if (o.json) write_stdout(identify_json(model, o, set, log, id, solved, status == Status::Ok, e.what()) + "\n");
     throw e;
   };
   if (status != Status::Ok) {
@@ -571,6 +624,19 @@ int run_identify(const IdentifyOptions& o) {
                                set.poses == 1 ? "" : "s", what, id.reason)),
          status);
   }
+
+  // The fit must explain the data about as well as the tracker measures: a residual noise far
+  // above the scatter of the points at rest means a model that does not describe the machine
+  // (another configuration, log or run), whose lead and thread would mean nothing.
+  if (const double scatter = scatter_at_rest(set), floor = std::max(scatter, kTrackerNoiseFloor);
+      !(id.sigma <= kNoiseRatioMax * floor))
+    fail(ExitError(kExitNotIdentified,
+                   fmt::format("{}: the fit leaves a noise of {:.4g} mm per axis, {:.3g} times the tracker's scatter at "
+                               "rest ({:.4g} mm, at least {:g} mm counted; {:g} times allowed): the model does not "
+                               "explain the data (another configuration, log or run?); nothing was written",
+                               printable(o.log.points), 1e3 * id.sigma, id.sigma / floor, 1e3 * scatter,
+                               1e3 * kTrackerNoiseFloor, kNoiseRatioMax)),
+         Status::NotIdentifiable);
 
   // The thread hand is decided only if the other sign fits worse by more than the noise explains:
   // twice the cost difference over sigma^2 is a chi-square of one degree of freedom; ask 25 (5 sd).
@@ -610,7 +676,7 @@ int run_identify(const IdentifyOptions& o) {
     fail(e, status);
   }
   if (o.json) {
-    write_stdout_or_withdraw(identify_json(model, o, set, log, id, status, std::string()) + "\n", {o.out});
+    write_stdout_or_withdraw(identify_json(model, o, set, log, id, status, true, std::string()) + "\n", {o.out});
     return kExitOk;
   }
 
@@ -630,9 +696,10 @@ int run_identify(const IdentifyOptions& o) {
                       id.estimate.twist_sign > 0.0 ? "right" : "left", id.cost_ratio);
   text += fmt::format(
       "residual: rms {:.4f} mm before (nominal model, tracker frame by Kabsch), {:.4f} mm after, largest {:.4f} mm "
-      "(line {}); noise {:.4f} mm per axis; condition {:.3g}\n",
+      "(line {}); noise {:.4f} mm per axis (the tracker's scatter at rest {:.4f} mm); condition {:.3g}\n",
       1e3 * id.rms_before, 1e3 * id.rms_after, 1e3 * id.max_after,
-      log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]], 1e3 * id.sigma, id.condition);
+      log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]], 1e3 * id.sigma,
+      1e3 * scatter_at_rest(set), id.condition);
   text += fmt::format("{:<12} {:>12} {:>12} {:>10} {:>12}\n", "parameter", "nominal", "estimate", "sd", "change");
   for (const ParameterRow& r : parameter_rows(model, id)) {
     const std::string change = r.name == "lead" ? fmt::format("{:+.4f} %", 100.0 * (r.estimate / r.nominal - 1.0))

@@ -379,6 +379,14 @@ Command make_stream_command(CLI::App& root) {
                                              "their limits assume)");
             if (!(o->rate > 0) || !std::isfinite(o->rate))
               throw ExitError(kExitBadInput, "--rate: expected a positive rate [Hz]");
+            // Finite but absurd: no input arrives (or is parsed) faster than every microsecond.
+            if (o->rate > 1e6)
+              throw ExitError(kExitBadInput, fmt::format("--rate {:g}: expected at most 1e6 Hz (one input per "
+                                                         "microsecond) [Hz]", o->rate));
+            if (o->rt_priority < 0 || o->rt_priority > sched_get_priority_max(SCHED_FIFO))
+              throw ExitError(kExitBadInput, fmt::format("--rt-priority {}: expected a SCHED_FIFO priority {}..{}, or 0 "
+                                                         "for none", o->rt_priority, sched_get_priority_min(SCHED_FIFO),
+                                                         sched_get_priority_max(SCHED_FIFO)));
             if (o->max_velocity < 0 || o->max_acceleration < 0 || !std::isfinite(o->max_velocity) ||
                 !std::isfinite(o->max_acceleration))
               throw ExitError(kExitBadInput, "--max-velocity, --max-acceleration: expected a positive limit, or 0 for none");

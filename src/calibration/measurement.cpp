@@ -229,7 +229,7 @@ Trajectory stations_trajectory(const Model& model, Strategy strategy, const Stat
   for (int i = 0; i < spec.count; ++i) {
     for (int draw = 0;; ++draw) {
       if (draw == kMaxDraws)
-        throw Error(fmt::format("stations: station {}: no pose within ±{} m and ±{} rad drawn in {} tries is "
+        throw Error(fmt::format("station {}: no pose within ±{} m and ±{} rad drawn in {} tries is "
                                 "reachable inside the limits; give smaller ranges",
                                 i + 1, spec.translation, spec.rotation, kMaxDraws));
       Vector6d q;

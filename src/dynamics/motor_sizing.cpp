@@ -53,18 +53,19 @@ void summarize(const Rig& rig, const std::vector<MotorSample>& samples, double d
     for (int t = 0; t < kTorqueTerms; ++t) sum_term2[t] += s.terms[t][leg] * s.terms[t][leg];
 
     // The pointwise checks, speed first: beyond max_speed the peak torque is 0 and means nothing more.
-    if (abs_w > servo.max_speed) {
+    // On a bound is inside it, with the tolerance of limits.hpp.
+    if (abs_w > accepted_max(servo.max_speed)) {
       if (m.violation.check == EnvelopeCheck::None)
         m.violation = {EnvelopeCheck::Speed, leg, k, s.time, abs_w, servo.max_speed};
       continue;
     }
-    const double peak = peak_torque_at(servo, abs_w);
+    const double peak = peak_torque_at(servo, std::min(abs_w, servo.max_speed));
     const double usage = peak > 0.0 ? abs_tau / peak : (abs_tau > 0.0 ? INFINITY : 0.0);
     if (usage > m.peak_usage) {
       m.peak_usage = usage;
       m.peak_usage_time = s.time;
     }
-    if (abs_tau > peak && m.violation.check == EnvelopeCheck::None)
+    if (abs_tau > accepted_max(peak) && m.violation.check == EnvelopeCheck::None)
       m.violation = {EnvelopeCheck::PeakTorque, leg, k, s.time, abs_tau, peak};
   }
   const double n = static_cast<double>(samples.size());
@@ -73,7 +74,7 @@ void summarize(const Rig& rig, const std::vector<MotorSample>& samples, double d
     m.share[t] = m.rms_torque > 0.0 ? std::sqrt(sum_term2[t] / n) / m.rms_torque : 0.0;
   m.speed_usage = m.peak_speed / servo.max_speed;
   m.rms_usage = m.rms_torque / servo.continuous_torque;
-  if (m.rms_torque > servo.continuous_torque && m.violation.check == EnvelopeCheck::None)
+  if (m.rms_torque > accepted_max(servo.continuous_torque) && m.violation.check == EnvelopeCheck::None)
     m.violation = {EnvelopeCheck::ContinuousTorque, leg,        samples.size() - 1, samples.back().time,
                    m.rms_torque,                    servo.continuous_torque};
 }

@@ -154,7 +154,7 @@ Status forward_kinematics_tracked(const Model& model, const Vector6d& lengths, L
   if (tracker.valid && out.det_sign != tracker.det_sign) return Status::AssemblyModeChanged;
   // Past the condition limit the lengths of a pose beyond a singularity can have a solution on
   // this side of it (a fold): refuse it rather than follow (docs/theory.md §5).
-  if (!(out.condition <= model.spec().limits.jacobian_condition_max)) return Status::PlatformSingularity;
+  if (!(out.condition <= model.condition_max_accepted())) return Status::PlatformSingularity;
   tracker = FkTracker{out.placement, out.det_sign, true};
   return Status::Ok;
 }

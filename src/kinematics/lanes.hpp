@@ -142,20 +142,20 @@ inline LimitTerms limit_terms(const Model& model, const Matrix3d& R_BP, const la
   return {length, scale, dot(u, home), dot(u, rotate(R_BP, home)), dot_a, dot_d};
 }
 
-/// Lanes within every pose limit. NaN fails. With scale = 1 the tests are exactly those of
-/// unit vectors.
+/// Lanes within every pose limit, bounds included with the tolerance of limits.hpp (the Model's
+/// accepted bounds: check_limits compares the same numbers). NaN fails. With scale = 1 the tests
+/// are exactly those of unit vectors.
 inline lane_m within_limits(const Model& model, const LimitTerms& t) noexcept {
-  const LimitSpec& lim = model.spec().limits;
   const lane_v cos_bend = model.cos_bend_max() * t.scale;
   const lane_v cos2_margin = model.cos2_singularity_margin() * (t.scale * t.scale);
-  return (t.length >= lim.length_min) & (t.length <= lim.length_max) & (t.cos_base >= cos_bend) &
+  return (t.length >= model.length_min_accepted()) & (t.length <= model.length_max_accepted()) & (t.cos_base >= cos_bend) &
          (t.cos_platform >= cos_bend) & (t.dot_a * t.dot_a <= cos2_margin) & (t.dot_d * t.dot_d <= cos2_margin);
 }
 
-/// Lanes whose command is within the stroke. NaN fails.
+/// Lanes whose command is within the stroke, ends included with the tolerance of limits.hpp. NaN
+/// fails.
 inline lane_m within_stroke(const Model& model, lane_v command) noexcept {
-  const LimitSpec& lim = model.spec().limits;
-  return (command >= lim.length_min) & (command <= lim.length_max);
+  return (command >= model.length_min_accepted()) & (command <= model.length_max_accepted());
 }
 
 /// The twist terms of each leg: the coordinates of docs/theory.md §3, theta = atan2(y, x), and

@@ -34,7 +34,7 @@ Status jacobian_condition(const Model& model, const LegState& state, double& con
   }
   double det_sign;
   condition = detail::scaled_condition(J, model.condition_length(), det_sign);
-  return condition <= model.spec().limits.jacobian_condition_max ? Status::Ok : Status::PlatformSingularity;
+  return condition <= model.condition_max_accepted() ? Status::Ok : Status::PlatformSingularity;
 }
 
 namespace detail {
@@ -47,7 +47,7 @@ bool condition_proven_within(const Model& model, const LegState& state) noexcept
     length_jacobian(state, J);
   }
   return scaled_condition_below(J, model.condition_length(), model.condition_reference(),
-                                model.spec().limits.jacobian_condition_max);
+                                model.condition_max_accepted());
 }
 
 }  // namespace detail
@@ -105,8 +105,10 @@ Status check_limits(const Model& model, const LegState& state, LimitReport& r) n
   for (int i = 0; i < kLegs; ++i) {
     const Vector3d si = s.row(i).transpose();
     if (!std::isfinite(len[i])) return report_violation(r, Status::NonFiniteInput, i, len[i], 0.0);
-    if (len[i] < lim.length_min) return report_violation(r, Status::StrokeBelowMin, i, len[i], lim.length_min);
-    if (len[i] > lim.length_max) return report_violation(r, Status::StrokeAboveMax, i, len[i], lim.length_max);
+    if (len[i] < model.length_min_accepted())
+      return report_violation(r, Status::StrokeBelowMin, i, len[i], lim.length_min);
+    if (len[i] > model.length_max_accepted())
+      return report_violation(r, Status::StrokeAboveMax, i, len[i], lim.length_max);
     if (!(cos_base[i] >= cos_bend))
       return report_violation(r, Status::BendBase, i, angle_between(si, model.leg(i).s_home_B), lim.bend_max);
     if (!(cos_platform[i] >= cos_bend))
@@ -165,8 +167,10 @@ Status check_stroke(const Model& model, const Vector6d& command, LimitReport& r)
   if (detail::all_lanes(ok)) return Status::Ok;
   for (int i = 0; i < kLegs; ++i) {
     if (!std::isfinite(command[i])) return report_violation(r, Status::NonFiniteInput, i, command[i], 0.0);
-    if (command[i] < lim.length_min) return report_violation(r, Status::StrokeBelowMin, i, command[i], lim.length_min);
-    if (command[i] > lim.length_max) return report_violation(r, Status::StrokeAboveMax, i, command[i], lim.length_max);
+    if (command[i] < model.length_min_accepted())
+      return report_violation(r, Status::StrokeBelowMin, i, command[i], lim.length_min);
+    if (command[i] > model.length_max_accepted())
+      return report_violation(r, Status::StrokeAboveMax, i, command[i], lim.length_max);
   }
   return Status::Ok;
 }

@@ -65,8 +65,12 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
   require_finite(spec.observation_P, "observation_point");
   require_finite(spec.pivot_P, "pivot");
 
-  cos_bend_max_ = std::cos(lim.bend_max);
-  cos2_singularity_margin_ = std::cos(lim.singularity_margin) * std::cos(lim.singularity_margin);
+  // The bounds as every limit check compares them, with the tolerance of limits.hpp.
+  cos_bend_max_ = std::cos(lim.bend_max) - kLimitTolerance;
+  cos2_singularity_margin_ = std::cos(lim.singularity_margin) * std::cos(lim.singularity_margin) + kLimitTolerance;
+  length_min_accepted_ = accepted_min(lim.length_min);
+  length_max_accepted_ = accepted_max(lim.length_max);
+  condition_max_accepted_ = accepted_max(lim.jacobian_condition_max);
   const Vector3d home_B(0.0, 0.0, spec.home_height);
   pivot_home_B_ = home_B + spec.pivot_P;
 
@@ -90,7 +94,7 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
     leg.length_home = L0.norm();
     if (!(leg.length_home > 0.0)) fail(fmt::format("{}: base and platform joints coincide at home", who));
     leg.s_home_B = L0 / leg.length_home;
-    if (leg.length_home < lim.length_min || leg.length_home > lim.length_max)
+    if (leg.length_home < length_min_accepted_ || leg.length_home > length_max_accepted_)
       fail(fmt::format("{}: home length {:.6f} m is outside the stroke [{}, {}] m", who, leg.length_home,
                        lim.length_min, lim.length_max));
 
@@ -101,7 +105,8 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
                        lim.length_max - lim.length_min, ls.length_offset));
     leg.length_offset = ls.length_offset;
     // The motor must reach home: its command there, real length minus offset, inside the stroke.
-    if (const double command = leg.length_home - ls.length_offset; command < lim.length_min || command > lim.length_max)
+    if (const double command = leg.length_home - ls.length_offset;
+        command < length_min_accepted_ || command > length_max_accepted_)
       fail(fmt::format("{}: length_offset: {} m puts the home command {:.6f} m outside the stroke [{}, {}] m", who,
                        ls.length_offset, command, lim.length_min, lim.length_max));
 

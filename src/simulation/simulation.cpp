@@ -60,7 +60,7 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
     if (const Status s = inverse_dynamics(rig, rest, still); s != Status::Ok) return fail(issue, s, k, trajectory);
     for (int i = 0; i < kLegs; ++i) {
       const double hold = std::abs(still.gravity[i]);
-      if (hold > torque_limit) {
+      if (hold > accepted_max(torque_limit)) {  // on the limit is inside it (limits.hpp)
         LimitReport limit;
         limit.status = Status::TorqueAboveMax;
         limit.leg = i;
@@ -85,7 +85,7 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
     if (k > 0 && k + 1 < n)
       r.acceleration = (command[k + 1] - 2.0 * command[k] + command[k - 1]).cwiseProduct(inv_gain) / (T * T);
     for (int i = 0; i < kLegs; ++i)
-      if (std::abs(r.speed[i]) > rig.servo().max_speed) {
+      if (std::abs(r.speed[i]) > accepted_max(rig.servo().max_speed)) {
         LimitReport limit;
         limit.status = Status::MotorSpeedAboveMax;
         limit.leg = i;

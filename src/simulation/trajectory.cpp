@@ -147,9 +147,9 @@ double Trajectory::duration() const noexcept {
 namespace {
 
 // Straight-line jerk-limited moves through `waypoints` with `dwell` before, between and after
-// them (see waypoint_trajectory); `what` names the caller in messages.
-Trajectory through_waypoints(std::span<const Vector6d> waypoints, const MotionLimits& limits, double dwell, double dt,
-                             const char* what) {
+// them (see waypoint_trajectory). Messages name no routine: the caller names its option or field.
+Trajectory through_waypoints(std::span<const Vector6d> waypoints, const MotionLimits& limits, double dwell,
+                             double dt) {
   struct Stage {
     JerkLimitedMove move;
     double start_time;  // [s]
@@ -170,7 +170,8 @@ Trajectory through_waypoints(std::span<const Vector6d> waypoints, const MotionLi
   // Rounded up, but a total that is a whole number of dt up to rounding is not pushed one further.
   const double steps = std::ceil(total / dt - 1e-9);
   if (!(steps + 1.0 <= kMaxSamples))
-    throw Error(fmt::format("{}: {} s at dt = {} s is more than {:.0f} samples", what, total, dt, kMaxSamples));
+    throw Error(fmt::format("the motion takes {:g} s: at a period of {:g} s that is more than {:.0f} samples", total, dt,
+                            kMaxSamples));
   const auto n = static_cast<std::size_t>(std::max(steps, 1.0));
 
   Trajectory traj;
@@ -189,34 +190,34 @@ Trajectory through_waypoints(std::span<const Vector6d> waypoints, const MotionLi
   return traj;
 }
 
-void check_dwell_and_period(double dwell, double dt, const char* what) {
+void check_dwell_and_period(double dwell, double dt) {
   if (!std::isfinite(dwell) || dwell < 0.0)
-    throw Error(fmt::format("{}: dwell must be finite and >= 0 s, got {}", what, dwell));
-  if (!std::isfinite(dt) || dt <= 0.0) throw Error(fmt::format("{}: dt must be finite and > 0 s, got {}", what, dt));
+    throw Error(fmt::format("dwell: expected a finite time >= 0 s, got {}", dwell));
+  if (!std::isfinite(dt) || dt <= 0.0) throw Error(fmt::format("dt: expected a finite period > 0 s, got {}", dt));
 }
 
 }  // namespace
 
 Trajectory sweep_trajectory(int coordinate, double amplitude, const MotionLimits& limits, double dwell, double dt) {
   if (coordinate < 0 || coordinate > 5)
-    throw Error(fmt::format("sweep: coordinate must be 0..5 (x, y, z, roll, pitch, yaw), got {}", coordinate));
+    throw Error(fmt::format("coordinate: expected 0..5 (x, y, z, roll, pitch, yaw), got {}", coordinate));
   if (!std::isfinite(amplitude) || amplitude <= 0.0)
-    throw Error(fmt::format("sweep: amplitude must be finite and > 0, got {}", amplitude));
-  check_dwell_and_period(dwell, dt, "sweep");
+    throw Error(fmt::format("amplitude: expected a finite number > 0, got {}", amplitude));
+  check_dwell_and_period(dwell, dt);
   // Three moves: 0 -> +a, +a -> -a, -a -> 0.
   std::array<Vector6d, 4> waypoints{Vector6d::Zero(), Vector6d::Zero(), Vector6d::Zero(), Vector6d::Zero()};
   waypoints[1][coordinate] = amplitude;
   waypoints[2][coordinate] = -amplitude;
-  return through_waypoints(waypoints, limits, dwell, dt, "sweep");
+  return through_waypoints(waypoints, limits, dwell, dt);
 }
 
 Trajectory waypoint_trajectory(std::span<const Vector6d> waypoints, const MotionLimits& limits, double dwell,
                                double dt) {
-  if (waypoints.size() < 2) throw Error(fmt::format("waypoints: expected at least 2 poses, got {}", waypoints.size()));
+  if (waypoints.size() < 2) throw Error(fmt::format("expected at least 2 waypoints, got {}", waypoints.size()));
   for (std::size_t k = 0; k < waypoints.size(); ++k)
-    if (!waypoints[k].allFinite()) throw Error(fmt::format("waypoints: pose {} is not finite", k + 1));
-  check_dwell_and_period(dwell, dt, "waypoints");
-  return through_waypoints(waypoints, limits, dwell, dt, "waypoints");
+    if (!waypoints[k].allFinite()) throw Error(fmt::format("waypoint {} is not finite", k + 1));
+  check_dwell_and_period(dwell, dt);
+  return through_waypoints(waypoints, limits, dwell, dt);
 }
 
 // ---- CSV ------------------------------------------------------------------------------------
@@ -336,20 +337,21 @@ TimedPoses parse_trajectory_csv(std::string_view text, std::string_view source) 
 namespace {
 
 // The monotone piecewise-cubic Hermite interpolant of Fritsch and Carlson ("PCHIP") through
-// the samples, per coordinate; `what` names the caller in messages.
+// the samples, per coordinate. Messages name the sample (line), not this routine: the caller
+// names the option or file (resample, interpolate).
 class Pchip {
  public:
-  Pchip(const TimedPoses& samples, const char* what) : samples_(samples), t_(samples.t), what_(what) {
+  explicit Pchip(const TimedPoses& samples) : samples_(samples), t_(samples.t) {
     const std::size_t m = t_.size();
-    if (m != samples.poses.size()) throw Error(fmt::format("{}: {} times but {} poses", what, m, samples.poses.size()));
-    if (m < 2) throw Error(fmt::format("{}: need at least 2 samples, got {}", what, m));
+    if (m != samples.poses.size()) throw Error(fmt::format("{} times but {} poses", m, samples.poses.size()));
+    if (m < 2) throw Error(fmt::format("need at least 2 samples, got {}", m));
     const auto at = [&](std::size_t i) { return where(i); };
     q_.resize(m);
     for (std::size_t i = 0; i < m; ++i) {
-      if (!std::isfinite(t_[i])) throw Error(fmt::format("{}: {}: time is not finite ({})", what, at(i), t_[i]));
+      if (!std::isfinite(t_[i])) throw Error(fmt::format("{}: time is not finite ({})", at(i), t_[i]));
       if (i > 0 && !(t_[i] > t_[i - 1]))
-        throw Error(fmt::format("{}: {}: time {} s is not after {} s", what, at(i), t_[i], t_[i - 1]));
-      if (!samples.poses[i].is_finite()) throw Error(fmt::format("{}: {}: pose is not finite", what, at(i)));
+        throw Error(fmt::format("{}: time {} s is not after {} s", at(i), t_[i], t_[i - 1]));
+      if (!samples.poses[i].is_finite()) throw Error(fmt::format("{}: pose is not finite", at(i)));
       q_[i] = samples.poses[i].to_vector();
     }
 
@@ -400,8 +402,8 @@ class Pchip {
     // Finite samples whose differences or rates overflow a double (1e308 m next to 0 m) give an
     // infinite slope: no pose can be interpolated there.
     if (!q.allFinite())
-      throw Error(fmt::format("{}: between {} and {}: the interpolation overflows a double (a value or its rate of "
-                              "change beyond 1e308)", what_, where(i), where(i + 1)));
+      throw Error(fmt::format("between {} and {}: the interpolation overflows a double (a value or its rate of "
+                              "change beyond 1e308)", where(i), where(i + 1)));
     return Pose::from_vector(q);
   }
 
@@ -414,22 +416,21 @@ class Pchip {
 
   const TimedPoses& samples_;
   const std::vector<double>& t_;
-  const char* what_;
   std::vector<Vector6d> q_, slope_;
 };
 
 }  // namespace
 
 Trajectory resample(const TimedPoses& samples, double dt) {
-  if (!std::isfinite(dt) || dt <= 0.0) throw Error(fmt::format("resample: dt must be finite and > 0 s, got {}", dt));
-  const Pchip curve(samples, "resample");
+  if (!std::isfinite(dt) || dt <= 0.0) throw Error(fmt::format("dt: expected a finite period > 0 s, got {}", dt));
+  const Pchip curve(samples);
   const std::vector<double>& t = samples.t;
   const double span = t.back() - t.front();
   // The grid covers the whole span: a last time between two ticks is reached on the next tick
   // (which holds the last pose) instead of being dropped.
   const double steps = std::ceil(span / dt - 1e-9);
   if (!(steps + 1.0 <= kMaxSamples))
-    throw Error(fmt::format("resample: {} s at dt = {} s is more than {:.0f} samples", span, dt, kMaxSamples));
+    throw Error(fmt::format("its {:g} s at a period of {:g} s are more than {:.0f} samples", span, dt, kMaxSamples));
   const auto n = static_cast<std::size_t>(steps);
 
   Trajectory traj;
@@ -443,14 +444,14 @@ Trajectory resample(const TimedPoses& samples, double dt) {
 }
 
 std::vector<Pose> interpolate(const TimedPoses& samples, std::span<const double> times) {
-  const Pchip curve(samples, "interpolate");
+  const Pchip curve(samples);
   std::vector<Pose> poses;
   poses.reserve(times.size());
   std::size_t i = 0;
   for (std::size_t k = 0; k < times.size(); ++k) {
     const double tk = times[k];
     if (!(tk >= samples.t.front() && tk <= samples.t.back()))
-      throw Error(fmt::format("interpolate: time {} (number {}) is outside the samples' span [{}, {}] s", tk, k + 1,
+      throw Error(fmt::format("time {} s (number {}) is outside the samples' span [{}, {}] s", tk, k + 1,
                               samples.t.front(), samples.t.back()));
     poses.push_back(curve.at(tk, 0.0, i));
   }

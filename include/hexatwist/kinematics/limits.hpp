@@ -6,6 +6,12 @@
 
 namespace hexatwist {
 
+// Boundaries (docs/theory.md §6): a value on a limit is inside it. Every check below, and the
+// vectorised real-time path, compares against the bounds widened by kLimitTolerance (model.hpp:
+// 4 ulp, 8.9e-16 relative to the bound; to 1 for the cosines of the bend and singularity tests),
+// so that rounding on the way (fk's 1.4 m coming back as 1.3999999999999997 m) cannot refuse a
+// pose that lies on a limit. A LimitReport's `bound` is the configured limit, not the widened one.
+
 /// Which leg broke which limit, by how much.
 struct LimitReport {
   Status status = Status::Ok;  ///< Ok, or the limit status (see is_limit)

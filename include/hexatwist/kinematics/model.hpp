@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "hexatwist/types.hpp"
@@ -29,6 +30,16 @@ struct LegSpec {
 
 /// Default of LimitSpec::jacobian_condition_max (docs/theory.md §6: chosen on the seed platform).
 inline constexpr double kDefaultJacobianConditionMax = 50.0;
+
+/// Tolerance of every limit check (limits.hpp, docs/theory.md §6): a value on a bound, or within
+/// 4 ulp of it (relative, 4 * 2^-52 = 8.9e-16 of the bound), is inside the limit. Rounding on the
+/// way (1.4 m typed, 1.3999999999999997 m recomputed by forward kinematics) cannot move a value
+/// across a bound; anything further away is decided exactly.
+inline constexpr double kLimitTolerance = 4.0 * std::numeric_limits<double>::epsilon();
+/// The largest value accepted under the upper bound `bound` [unit of bound].
+constexpr double accepted_max(double bound) noexcept { return bound + kLimitTolerance * (bound < 0 ? -bound : bound); }
+/// The smallest value accepted above the lower bound `bound` [unit of bound].
+constexpr double accepted_min(double bound) noexcept { return bound - kLimitTolerance * (bound < 0 ? -bound : bound); }
 
 /// Motion limits (unvalidated).
 struct LimitSpec {
@@ -133,10 +144,16 @@ class Model {
   const Vector6d& length_home() const noexcept { return length_home_; }
   /// The legs one per row (the same numbers as leg(i), laid out for vectorised code).
   const LegGeometry& geometry() const noexcept { return geometry_; }
-  /// cos(bend_max), precomputed for the limit check.
+  /// cos(bend_max), precomputed for the limit check, less kLimitTolerance (a cosine of unit
+  /// vectors: the tolerance is relative to 1) [-].
   double cos_bend_max() const noexcept { return cos_bend_max_; }
-  /// cos(singularity_margin)^2, precomputed for the limit check.
+  /// cos(singularity_margin)^2, precomputed for the limit check, plus kLimitTolerance [-].
   double cos2_singularity_margin() const noexcept { return cos2_singularity_margin_; }
+  /// The stroke and condition bounds as the checks compare them, widened by kLimitTolerance
+  /// (accepted_min, accepted_max) [m, m, -].
+  double length_min_accepted() const noexcept { return length_min_accepted_; }
+  double length_max_accepted() const noexcept { return length_max_accepted_; }
+  double condition_max_accepted() const noexcept { return condition_max_accepted_; }
   /// Characteristic length of the platform, the largest distance of a platform joint from the
   /// pivot: the Jacobian's rotation columns are divided by it for its condition number [m].
   double condition_length() const noexcept { return condition_length_; }
@@ -151,6 +168,9 @@ class Model {
   Vector6d length_home_;
   double cos_bend_max_ = 1.0;
   double cos2_singularity_margin_ = 1.0;
+  double length_min_accepted_ = 0.0;
+  double length_max_accepted_ = 0.0;
+  double condition_max_accepted_ = 0.0;
   double condition_length_ = 1.0;
   ConditionReference condition_reference_;
   bool has_twist_ = false;
