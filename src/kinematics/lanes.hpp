@@ -10,6 +10,7 @@
 #include <cstring>
 
 #include "kinematics/fast_math.hpp"
+#include "kinematics/linear_solve.hpp"
 #include "hexatwist/kinematics/kinematics.hpp"
 #include "hexatwist/kinematics/model.hpp"
 
@@ -193,5 +194,66 @@ inline lane_v twist_angle(const Model& model, lane_v x, lane_v y, bool relative,
   const lane_v s0 = relative ? load_lanes(g.sin_theta_home, k) : splat<lane_v>(0.0);
   return atan2(y * c0 - x * s0, x * c0 + y * s0) * load_lanes(g.has_axes, k);
 }
+
+/// The rows of packet k of the twist Jacobian (motor = false) or of the motor-side length
+/// Jacobian [s^T, (arm x s)^T] - twist_gain * (twist Jacobian) (motor = true), docs/theory.md §5,
+/// as six column vectors (lane i: leg i's row). From the unit leg direction s, 1/|L|, the arm, the
+/// joint axes ja, jd, ja.s, jd.s and the twist terms of s (twist_terms with u = s, u2 = 1). Where
+/// a leg is near a U-joint singularity (twist_regular fails) its row is unspecified.
+inline void jacobian_columns(const Model& model, const lanes3& s, lane_v inv_length, const lanes3& arm, const lanes3& ja,
+                             const lanes3& jd, lane_v ja_s, lane_v jd_s, const TwistTerms& t, bool motor, int k,
+                             lane_v (&col)[6]) noexcept {
+  const LegLanes& g = model.geometry().lanes;
+  const lane_v mask = load_lanes(g.has_axes, k);
+  // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2), with the partials of y and x in s and jd:
+  // dy/ds = ja x jd, dx/ds = -(jd.s) ja - (ja.s) jd, dy/djd = s x ja, dx/djd = ja - (ja.s) s.
+  // Legs without axes have x = y = 0: give them n2 = 1 and mask their rows to zero.
+  const lane_v n2 = t.x * t.x + t.y * t.y + (1.0 - mask);
+  const lane_v fx = mask * t.x / n2, fy = mask * t.y / n2;
+  const lanes3 dx_ds = (-jd_s) * ja - ja_s * jd;
+  const lanes3 g_s = fx * t.ja_x_jd - fy * dx_ds;
+  const lanes3 g_jd = fx * cross(s, ja) - fy * (ja - ja_s * s);
+  // s = L/|L|: ds = (I - s s^T) dL / |L|; dL = dt + dw x arm; djd = dw x jd.
+  const lanes3 a = inv_length * (g_s - dot(g_s, s) * s);
+  const lanes3 b = cross(arm, a) + cross(jd, g_jd);
+  const lane_v twist_col[6] = {a.x, a.y, a.z, b.x, b.y, b.z};
+  if (!motor) {
+    for (int c = 0; c < 6; ++c) col[c] = twist_col[c];
+    return;
+  }
+  const lane_v gain = load_lanes(g.twist_gain, k);
+  const lanes3 arm_x_s = cross(arm, s);
+  const lane_v length_col[6] = {s.x, s.y, s.z, arm_x_s.x, arm_x_s.y, arm_x_s.z};
+  for (int c = 0; c < 6; ++c) col[c] = length_col[c] - gain * twist_col[c];
+}
+
+/// A 6x6 matrix gathered packet by packet as columns (lane i: row i, as jacobian_columns gives
+/// them), read out as padded rows (linear_solve.hpp): kept in registers and transposed there with
+/// one eight-lane packet, else through its column-major storage.
+class ColumnPackets {
+ public:
+  void set(int k, const lane_v (&col)[6]) noexcept {
+#if HEXATWIST_LANE_WIDTH == 8
+    (void)k;  // one packet
+    for (int c = 0; c < 6; ++c) cols_[c] = col[c];
+#else
+    for (int c = 0; c < 6; ++c) store6(m_.data() + kLegs * c, col[c], k);
+#endif
+  }
+  void rows(PaddedRows& out) const noexcept {
+#if HEXATWIST_LANE_WIDTH == 8
+    padded_rows(cols_, out);
+#else
+    padded_rows(m_, out);
+#endif
+  }
+
+ private:
+#if HEXATWIST_LANE_WIDTH == 8
+  v8d cols_[6];
+#else
+  Matrix6d m_;
+#endif
+};
 
 }  // namespace hexatwist::detail

@@ -135,16 +135,83 @@ inline double lu6_scaled_condition(const Lu6& lu, const Vector6d& column_sums, d
   return norm_a * norm_inv;
 }
 
+/// Vectors per row of eight doubles (six entries and two zeros of padding).
+inline constexpr int kRowVectors = 8 * sizeof(double) / sizeof(lane_v);
+/// The rows of a 6x6 matrix, each padded with zeros to eight doubles.
+using PaddedRows = lane_v[6][kRowVectors];
+
+/// The padded rows of J from its column-major storage.
+inline void padded_rows(const Matrix6d& J, PaddedRows& rows) noexcept {
+  alignas(64) double r[6][8];
+  for (int i = 0; i < 6; ++i)
+    for (int c = 0; c < 8; ++c) r[i][c] = c < 6 ? J(i, c) : 0.0;
+  std::memcpy(rows, r, sizeof r);
+}
+
+#if HEXATWIST_LANE_WIDTH == 8
+/// The padded rows of a matrix from its six columns, each one eight-lane vector whose lanes 0-5 are
+/// the column (lanes 6 and 7 are dropped): an 8x8 transpose in registers, three rounds of
+/// shuffles, where the copy through memory stalled on store forwarding.
+inline void padded_rows(const v8d (&cols)[6], PaddedRows& rows) noexcept {
+  const v8d zero = {};
+  const auto pairs = [](v8d a, v8d b, v8d& even, v8d& odd) {
+    even = __builtin_shufflevector(a, b, 0, 8, 2, 10, 4, 12, 6, 14);
+    odd = __builtin_shufflevector(a, b, 1, 9, 3, 11, 5, 13, 7, 15);
+  };
+  const auto quads = [](v8d a, v8d b, v8d& low, v8d& high) {
+    low = __builtin_shufflevector(a, b, 0, 1, 8, 9, 4, 5, 12, 13);
+    high = __builtin_shufflevector(a, b, 2, 3, 10, 11, 6, 7, 14, 15);
+  };
+  v8d t0, t1, t2, t3, t4, t5, u0, u1, u2, u3, u4, u5, u6, u7;
+  pairs(cols[0], cols[1], t0, t1);  // t0: lanes 0, 2, 4, 6 of columns 0 and 1; t1: lanes 1, 3, 5, 7
+  pairs(cols[2], cols[3], t2, t3);
+  pairs(cols[4], cols[5], t4, t5);
+  quads(t0, t2, u0, u2);  // u0: lanes 0 and 4 of columns 0-3; u2: lanes 2 and 6
+  quads(t1, t3, u1, u3);
+  quads(t4, zero, u4, u6);  // columns 4, 5 and the zero padding columns
+  quads(t5, zero, u5, u7);
+  rows[0][0] = __builtin_shufflevector(u0, u4, 0, 1, 2, 3, 8, 9, 10, 11);
+  rows[1][0] = __builtin_shufflevector(u1, u5, 0, 1, 2, 3, 8, 9, 10, 11);
+  rows[2][0] = __builtin_shufflevector(u2, u6, 0, 1, 2, 3, 8, 9, 10, 11);
+  rows[3][0] = __builtin_shufflevector(u3, u7, 0, 1, 2, 3, 8, 9, 10, 11);
+  rows[4][0] = __builtin_shufflevector(u0, u4, 4, 5, 6, 7, 12, 13, 14, 15);
+  rows[5][0] = __builtin_shufflevector(u1, u5, 4, 5, 6, 7, 12, 13, 14, 15);
+}
+#endif
+
+/// The largest lane of v[0..kRowVectors), or inf if a lane is NaN.
+inline double max_lane(const lane_v (&v)[kRowVectors]) noexcept {
+  lane_v m = v[0];
+  for (int q = 1; q < kRowVectors; ++q) m = m > v[q] ? m : v[q];
+  const lane_v inf = splat<lane_v>(INFINITY);
+  for (int q = 0; q < kRowVectors; ++q) m = v[q] == v[q] ? m : inf;  // NaN anywhere: inf
+#if HEXATWIST_LANE_WIDTH == 8
+  const v4d m4 = __builtin_shufflevector(m, m, 0, 1, 2, 3) > __builtin_shufflevector(m, m, 4, 5, 6, 7)
+                     ? __builtin_shufflevector(m, m, 0, 1, 2, 3)
+                     : __builtin_shufflevector(m, m, 4, 5, 6, 7);
+  const v2d m2 = __builtin_shufflevector(m4, m4, 0, 1) > __builtin_shufflevector(m4, m4, 2, 3)
+                     ? __builtin_shufflevector(m4, m4, 0, 1)
+                     : __builtin_shufflevector(m4, m4, 2, 3);
+#elif HEXATWIST_LANE_WIDTH == 4
+  const v2d m2 = __builtin_shufflevector(m, m, 0, 1) > __builtin_shufflevector(m, m, 2, 3)
+                     ? __builtin_shufflevector(m, m, 0, 1)
+                     : __builtin_shufflevector(m, m, 2, 3);
+#else
+  const v2d m2 = m;
+#endif
+  return m2[0] > m2[1] ? m2[0] : m2[1];
+}
+
 /// True only if the condition number that scaled_condition(J, length) computes is proven to be at
 /// most `bound`; false means "not proven" (also for a singular or non-finite J), not "above". A
 /// cheap sufficient test that spares the pivoted LU and its inverse where the pose is well inside
 /// the limit (docs/theory.md §8): from the model's reference Y0 ~ A^-1 (the inverse at home), the
 /// residual G = I - Y0 A bounds ||A^-1||_1 <= ||Y0||_1 / (1 - ||G||_1); where that is not enough,
-/// once more from Y1 = (I + G) Y0, one Newton-Schulz step.
-inline bool scaled_condition_below(const Matrix6d& J, double length, const ConditionReference& ref,
+/// once more from Y1 = (I + G) Y0, one Newton-Schulz step. J comes as its padded rows.
+inline bool scaled_condition_below(const PaddedRows& rows, double length, const ConditionReference& ref,
                                    double bound) noexcept {
   constexpr int kW = sizeof(lane_v) / sizeof(double);
-  constexpr int kP = 8 / kW;  // vectors per row
+  constexpr int kP = kRowVectors;
   const lane_v zero = {};
   const auto abs_v = [&](lane_v v) { return v < zero ? -v : v; };
   const auto load = [](const double* p) {
@@ -152,55 +219,51 @@ inline bool scaled_condition_below(const Matrix6d& J, double length, const Condi
     std::memcpy(&v, p, sizeof v);
     return v;
   };
-  const auto lane_max = [](const lane_v (&v)[kP]) {
-    double m = 0.0;
-    for (int q = 0; q < kP; ++q)
-      for (int c = 0; c < kW; ++c)  // padding lanes are 0; a NaN gives inf (nothing is proven)
-        if (!(v[q][c] <= m)) m = v[q][c] > m ? v[q][c] : INFINITY;
-    return m;
-  };
   alignas(64) static constexpr double kIdentity[6][8] = {{1, 0, 0, 0, 0, 0, 0, 0}, {0, 1, 0, 0, 0, 0, 0, 0},
                                                          {0, 0, 1, 0, 0, 0, 0, 0}, {0, 0, 0, 1, 0, 0, 0, 0},
                                                          {0, 0, 0, 0, 1, 0, 0, 0}, {0, 0, 0, 0, 0, 1, 0, 0}};
   alignas(64) static constexpr double kUnit[8] = {1, 1, 1, 0, 0, 0, 0, 0};
-  // A = J diag(1, 1, 1, 1/length x 3) a whole row at a time, padded with zeros.
-  alignas(64) double rows[6][8];
-  for (int i = 0; i < 6; ++i)
-    for (int c = 0; c < 8; ++c) rows[i][c] = c < 6 ? J(i, c) : 0.0;
+  // A = J diag(1, 1, 1, 1/length x 3) a whole row at a time.
   lane_v a[6][kP], sum_a[kP] = {};
   for (int q = 0; q < kP; ++q) {
     const lane_v first = load(kUnit + q * kW);
     const lane_v col_scale = first + (1.0 / length) * (1.0 - first);
     for (int i = 0; i < 6; ++i) {
-      a[i][q] = col_scale * load(&rows[i][q * kW]);
+      a[i][q] = col_scale * rows[i][q];
       sum_a[q] += abs_v(a[i][q]);
     }
   }
-  const double norm_a = lane_max(sum_a);
+  const double norm_a = max_lane(sum_a);
   // G = I - Y A for an approximate inverse Y (rows of 8): 1-norm of G, rounding included. Each
   // entry of G rounds by less than 8 u (|Y| |A|) (u the unit roundoff); 1e-13 ||Y||_1 ||A||_1
   // covers it a hundred times over.
   alignas(64) double g[6][8];
   const auto residual_norm = [&](const double (&y)[6][8], double norm_y) {
-    lane_v sum_g[kP] = {};
+    lane_v abs_g[6][kP];
 #pragma GCC unroll 6
     for (int i = 0; i < 6; ++i) {
       for (int q = 0; q < kP; ++q) {
-        lane_v r = load(&kIdentity[i][q * kW]);
-        for (int k = 0; k < 6; ++k) r -= y[i][k] * a[k][q];
+        // Two chains of three products, then their sum: half the latency of one chain of six.
+        lane_v r0 = load(&kIdentity[i][q * kW]), r1 = zero;
+        for (int k = 0; k < 3; ++k) r0 -= y[i][k] * a[k][q];
+        for (int k = 3; k < 6; ++k) r1 -= y[i][k] * a[k][q];
+        const lane_v r = r0 + r1;
         std::memcpy(&g[i][q * kW], &r, sizeof r);
-        sum_g[q] += abs_v(r);
+        abs_g[i][q] = abs_v(r);
       }
     }
-    return lane_max(sum_g) + 1e-13 * norm_y * norm_a;
+    lane_v sum_g[kP];
+    for (int q = 0; q < kP; ++q) sum_g[q] = (abs_g[0][q] + abs_g[1][q]) + (abs_g[2][q] + abs_g[3][q]) + (abs_g[4][q] + abs_g[5][q]);
+    return max_lane(sum_g) + 1e-13 * norm_y * norm_a;
   };
   // A^-1 = (I - G)^-1 Y, so ||A^-1||_1 <= ||Y||_1 / (1 - ||G||_1) for ||G||_1 < 1. The products,
-  // the quotient and the norms' sums round by a few u: 1e-12 of slack. The proof asks for
+  // 1 - ||G||_1 and the norms' sums round by a few u: 1e-12 of slack. The proof asks for
   // 1e-9 below the bound, so that the exact number (rounding ~1e-13 relative at a condition of 50)
   // lies below the bound too, and the verdict is the exact number's.
   const double target = bound * (1.0 - 1e-9);
   const auto proven = [&](double norm_y, double norm_g) {
-    return norm_g < 1.0 && norm_a * norm_y / (1.0 - norm_g) * (1.0 + 1e-12) <= target;
+    // norm_a norm_y / (1 - norm_g) <= target, multiplied out (no division on the critical path).
+    return norm_g < 1.0 && norm_a * norm_y * (1.0 + 1e-12) <= target * (1.0 - norm_g);
   };
   const double norm_g = residual_norm(ref.inverse, ref.norm);
   if (proven(ref.norm, norm_g)) return true;
@@ -217,8 +280,16 @@ inline bool scaled_condition_below(const Matrix6d& J, double length, const Condi
       sum_y[q] += abs_v(r);
     }
   }
-  const double norm_y1 = lane_max(sum_y);
+  const double norm_y1 = max_lane(sum_y);
   return proven(norm_y1, residual_norm(y1, norm_y1));
+}
+
+/// scaled_condition_below for J in its column-major storage.
+inline bool scaled_condition_below(const Matrix6d& J, double length, const ConditionReference& ref,
+                                   double bound) noexcept {
+  PaddedRows rows;
+  padded_rows(J, rows);
+  return scaled_condition_below(rows, length, ref, bound);
 }
 
 /// Condition number of a platform Jacobian J [-, m] (rows [s_i, arm_i x s_i] or the motor-side

@@ -93,43 +93,22 @@ Status twist_continued(const Model& model, const LegState& state, const Vector6d
 
 namespace {
 
-// The twist Jacobian (twist_jacobian), or, with kMotor, the motor-side length Jacobian
-// [s^T, (arm x s)^T] - twist_gain * (twist Jacobian), all rows at once. Where a leg is near a
-// U-joint singularity its row is unspecified and the result names the joint.
+// The twist Jacobian (twist_jacobian), or, with kMotor, the motor-side length Jacobian, all rows
+// at once (lanes.hpp jacobian_columns). Where a leg is near a U-joint singularity its row is
+// unspecified and the result names the joint.
 template <bool kMotor>
 Status jacobian(const Model& model, const LegState& state, Matrix6d& J) noexcept {
   using namespace detail;
-  const LegLanes& g = model.geometry().lanes;
   lane_m regular = all_set();
   #pragma GCC unroll 4
   for (int k = 0; k < kPackets; ++k) {
     const LegTwist l = leg_twist(model, state, k);
     const TwistTerms t = terms_of(l);
     regular &= twist_regular(model, t.x, t.y, splat<lane_v>(1.0), k);
-    const lane_v mask = load_lanes(g.has_axes, k);
-    // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2), with the partials of y and x in s and jd:
-    // dy/ds = ja x jd, dx/ds = -(jd.s) ja - (ja.s) jd, dy/djd = s x ja, dx/djd = ja - (ja.s) s.
-    // Legs without axes have x = y = 0: give them n2 = 1 and mask their rows to zero.
-    const lane_v n2 = t.x * t.x + t.y * t.y + (1.0 - mask);
-    const lane_v fx = mask * t.x / n2, fy = mask * t.y / n2;
-    const lanes3 dx_ds = (-l.jd_s) * l.ja - l.ja_s * l.jd;
-    const lanes3 g_s = fx * t.ja_x_jd - fy * dx_ds;
-    const lanes3 g_jd = fx * cross(l.s, l.ja) - fy * (l.ja - l.ja_s * l.s);
-    // s = L/|L|: ds = (I - s s^T) dL / |L|; dL = dt + dw x arm; djd = dw x jd.
-    const lane_v inv_length = 1.0 / load6(state.length.data(), k);
-    const lanes3 a = inv_length * (g_s - dot(g_s, l.s) * l.s);
-    const lanes3 arm = load6(state.arm_B, k);
-    const lanes3 b = cross(arm, a) + cross(l.jd, g_jd);
-    const lane_v col[6] = {a.x, a.y, a.z, b.x, b.y, b.z};
-    if constexpr (kMotor) {
-      // J = length Jacobian - twist_gain * twist Jacobian (docs/theory.md §5).
-      const lane_v gain = load_lanes(g.twist_gain, k);
-      const lanes3 arm_x_s = cross(arm, l.s);
-      const lane_v length_col[6] = {l.s.x, l.s.y, l.s.z, arm_x_s.x, arm_x_s.y, arm_x_s.z};
-      for (int c = 0; c < 6; ++c) store6(J.data() + kLegs * c, length_col[c] - gain * col[c], k);
-    } else {
-      for (int c = 0; c < 6; ++c) store6(J.data() + kLegs * c, col[c], k);
-    }
+    lane_v col[6];
+    jacobian_columns(model, l.s, 1.0 / load6(state.length.data(), k), load6(state.arm_B, k), l.ja, l.jd, l.ja_s, l.jd_s,
+                     t, kMotor, k, col);
+    for (int c = 0; c < 6; ++c) store6(J.data() + kLegs * c, col[c], k);
   }
   return all_lanes(regular) ? Status::Ok : singular_joint(model, state);
 }
