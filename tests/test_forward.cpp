@@ -432,6 +432,39 @@ TEST(Forward, HomeLengthsGiveHomeWithoutIterating) {
   EXPECT_LT(r.pose.to_vector().cwiseAbs().maxCoeff(), 1e-15);
 }
 
+// From home the first Newton step takes the model's inverse at home (no elimination). The same
+// solve from a guess one ulp away eliminates: both reach the pose, with the condition number and
+// determinant sign of the Jacobian there -- also where one step from home is already the solution
+// (no elimination then to read them from).
+TEST(Forward, TheFirstStepFromHomeMatchesAnEliminatedOne) {
+  const Model& model = seed_model();
+  Placement beside;
+  beside.t.x() = std::nextafter(0.0, 1.0);
+  for (const double offset : {1e-7, 1e-3, 0.2}) {
+    Pose p;
+    p.position = {offset, -0.5 * offset, 0.3 * offset};
+    p.rpy = {0.2 * offset, 0.1 * offset, -0.4 * offset};
+    CommandReport c;
+    ASSERT_EQ(compute_commands(model, p, c), Status::Ok);
+    double condition;
+    ASSERT_EQ(jacobian_condition(model, c.legs, condition), Status::Ok);
+    Matrix6d J;
+    ASSERT_EQ(length_jacobian(model, c.legs, LengthKind::Motor, J), Status::Ok);
+    const double det_sign = J.determinant() > 0.0 ? 1.0 : -1.0;
+    FkResult home, near;
+    ASSERT_EQ(forward_kinematics(model, c.compensated, LengthKind::Motor, Placement{}, home), Status::Ok) << offset;
+    ASSERT_EQ(forward_kinematics(model, c.compensated, LengthKind::Motor, beside, near), Status::Ok) << offset;
+    if (offset == 1e-7) EXPECT_EQ(home.iterations, 1);
+    EXPECT_EQ(home.iterations, near.iterations) << offset;
+    for (const FkResult* r : {&home, &near}) {
+      EXPECT_LT(pose_error(r->placement, placement_from_pose(p)).position, 1e-12) << offset;
+      EXPECT_LT(pose_error(r->placement, placement_from_pose(p)).rotation, 1e-12) << offset;
+      EXPECT_NEAR(r->condition, condition, 1e-6 * condition) << offset;
+      EXPECT_EQ(r->det_sign, det_sign) << offset;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace hexatwist::test
 

@@ -1,6 +1,8 @@
 // The internal kernels of the real-time path: vectorised sin/cos and atan2 (src/kinematics/fast_math.hpp)
-// against libm, and the fixed-size 6x6 solver (src/kinematics/linear_solve.hpp) against Eigen.
+// against libm, the fixed-size 6x6 LU and condition proof (src/kinematics/linear_solve.hpp) and the
+// Gauss-Jordan inverse on lane columns (src/kinematics/gauss_jordan.hpp) against Eigen.
 #include "kinematics/fast_math.hpp"
+#include "kinematics/gauss_jordan.hpp"
 #include "kinematics/linear_solve.hpp"
 #include "kinematics/twist_internal.hpp"
 #include "hexatwist/hexatwist.hpp"
@@ -98,50 +100,114 @@ TEST(FastMath, SmallAnglesSkipTheReductionWithTheSameResult) {
   EXPECT_LT(worst, 1.2e-15);
 }
 
-TEST(LinearSolve, MatchesEigenFullPivotingOnRandomSystems) {
+// A matrix as the lanes hold it: column c, packet k, lane l = row k * kWidth + l; the padding
+// rows repeat row 0, as the legs' lanes do.
+Columns columns_of(const Matrix6d& A) {
+  Columns out;
+  for (int c = 0; c < 6; ++c)
+    for (int k = 0; k < kPackets; ++k)
+      for (int l = 0; l < kWidth; ++l) {
+        const int row = k * kWidth + l;
+        out.c[c][k][l] = A(row < 6 ? row : 0, c);
+      }
+  return out;
+}
+
+// J^-1 from gauss_jordan's result (row k is row pivot_row[k] of X; X's columns in pivot order).
+Matrix6d inverse_of(const Inverse6& inv) {
+  Matrix6d X;
+  for (int k = 0; k < 6; ++k)
+    for (int i = 0; i < 6; ++i) X(i, inv.pivot_row[k]) = inv.x.c[k][i / kWidth][i % kWidth];
+  Matrix6d J_inv;
+  for (int k = 0; k < 6; ++k) J_inv.row(k) = X.row(inv.pivot_row[k]);
+  return J_inv;
+}
+
+TEST(GaussJordan, MatchesEigenOnRandomMatrices) {
+  // Inverse, solve, determinant sign, pivot ratio (LU's, the same pivots) and the 1-norm condition
+  // number, against Eigen's full-pivoting LU and lu6_factor.
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  double worst = 0.0;
+  double worst_backward = 0.0, worst_inverse = 0.0, worst_condition = 0.0;
   for (int n = 0; n < 20000; ++n) {
     Matrix6d A;
     Vector6d b;
     for (int i = 0; i < 36; ++i) A.data()[i] = u(rng);
     for (int i = 0; i < 6; ++i) b[i] = u(rng);
-    Vector6d x;
-    Lu6 lu;
-    const double ratio = lu6_factor(A, lu);
-    lu6_solve(lu, b, x);
+    Inverse6 inv;
+    const double ratio = gauss_jordan(columns_of(A), inv);
     ASSERT_GT(ratio, 0.0);
-    const Vector6d ref = A.fullPivLu().solve(b);
+    Lu6 lu;
+    EXPECT_NEAR(ratio, lu6_factor(A, lu), 1e-12 * ratio) << A;
+    const Eigen::FullPivLU<Matrix6d> ref(A);
+    EXPECT_EQ(inv.det_sign, ref.determinant() > 0.0 ? 1.0 : -1.0) << A;
+    Vector6d x;
+    gj_solve(inv, b, x);
     // Normwise backward error |Ax - b| / (|A| |x| + |b|): a few eps for a stable elimination.
-    const double backward = (A * x - b).norm() / (A.norm() * x.norm() + b.norm());
-    worst = std::max(worst, backward);
-    if (ratio > 1e-3) {
-      EXPECT_LT((x - ref).norm(), 1e-9 * (1.0 + ref.norm())) << A;
-    }
+    worst_backward = std::max(worst_backward, (A * x - b).norm() / (A.norm() * x.norm() + b.norm()));
+    const Matrix6d A_inv = ref.inverse();
+    const double cond = A.cwiseAbs().colwise().sum().maxCoeff() * A_inv.cwiseAbs().colwise().sum().maxCoeff();
+    worst_inverse = std::max(worst_inverse, (inverse_of(inv) - A_inv).norm() / (A_inv.norm() * cond));
+    worst_condition = std::max(worst_condition, std::abs(gj_condition(columns_of(A), inv) / cond - 1.0) / cond);
   }
-  EXPECT_LT(worst, 2e-15);  // measured 1.7e-16
+  std::printf("  backward error %.2g, inverse %.2g, condition %.2g\n", worst_backward, worst_inverse, worst_condition);
+  // Gauss-Jordan's backward error is larger than LU's (1.7e-16 on these matrices) by up to about the
+  // condition number; its forward error is LU's.
+  EXPECT_LT(worst_backward, 2e-14);   // measured 1.9e-15
+  EXPECT_LT(worst_inverse, 1e-15);    // measured 5.7e-17 (relative to cond * |A^-1|)
+  EXPECT_LT(worst_condition, 1e-15);  // measured 8e-17 (relative error over cond)
 }
 
-TEST(LinearSolve, ReportsSingularAndNearSingularMatrices) {
+TEST(GaussJordan, ReportsSingularNonFiniteAndPermutedMatrices) {
   Matrix6d A = Matrix6d::Identity();
+  Inverse6 inv;
   A(5, 5) = 0.0;
-  Vector6d x;
-  Lu6 lu;
-  EXPECT_EQ(lu6_factor(A, lu), 0.0);
+  EXPECT_EQ(gauss_jordan(columns_of(A), inv), 0.0);
+  EXPECT_EQ(inv.det_sign, 0.0);
   A(5, 5) = 1e-14;
-  EXPECT_NEAR(lu6_factor(A, lu), 1e-14, 1e-20);
-  // Rows pivoted in the wrong order still solve.
+  EXPECT_NEAR(gauss_jordan(columns_of(A), inv), 1e-14, 1e-20);
+  A(5, 5) = NAN;
+  EXPECT_EQ(gauss_jordan(columns_of(A), inv), 0.0);
+  A = Matrix6d::Zero();
+  EXPECT_EQ(gauss_jordan(columns_of(A), inv), 0.0);
+  // Rows pivoted in the wrong order still solve, with the permutation's sign: the anti-diagonal
+  // reverses six rows, three transpositions.
   Matrix6d P = Matrix6d::Zero();
   for (int i = 0; i < 6; ++i) P(i, 5 - i) = i + 1.0;
   const Vector6d b = (Vector6d() << 1, 2, 3, 4, 5, 6).finished();
-  ASSERT_GT(lu6_factor(P, lu), 0.1);
-  lu6_solve(lu, b, x);
-  EXPECT_LT((P * x - b).norm(), 1e-15);
-  // One factorisation, several right-hand sides.
+  ASSERT_GT(gauss_jordan(columns_of(P), inv), 0.1);
+  EXPECT_EQ(inv.det_sign, -1.0);
+  Vector6d x;
+  gj_solve(inv, b, x);
+  EXPECT_LT((P * x - b).norm(), 2e-14);  // measured 2.2e-15 (the reciprocals 1/(i+1) round)
+  // One inverse, several right-hand sides.
   const Vector6d c = (Vector6d() << -3, 0, 2, 7, 1, 1).finished();
-  lu6_solve(lu, c, x);
-  EXPECT_LT((P * x - c).norm(), 1e-14);
+  gj_solve(inv, c, x);
+  EXPECT_LT((P * x - c).norm(), 2e-14);
+  EXPECT_NEAR(gj_condition(columns_of(P), inv), 6.0 / 1.0, 1e-15);
+}
+
+TEST(GaussJordan, ColumnPacketsTransposeLikeTheMatrix) {
+  // The in-register transpose (eight lanes) or the copy through memory gives J's padded rows.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int n = 0; n < 100; ++n) {
+    Matrix6d A;
+    for (int i = 0; i < 36; ++i) A.data()[i] = u(rng);
+    const Columns cols = columns_of(A);
+    ColumnPackets packets;
+    for (int k = 0; k < kPackets; ++k) {
+      lane_v col[6];
+      for (int c = 0; c < 6; ++c) col[c] = cols.c[c][k];
+      packets.set(k, col);
+    }
+    PaddedRows rows, expected;
+    packets.rows(rows);
+    padded_rows(A, expected);
+    for (int i = 0; i < 6; ++i)
+      for (int q = 0; q < kRowVectors; ++q)
+        for (int l = 0; l < kWidth; ++l) ASSERT_EQ(rows[i][q][l], expected[i][q][l]) << i << " " << q << " " << l;
+  }
 }
 
 TEST(LinearSolve, CheapConditionProofNeverAcceptsAboveTheExactCondition) {

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "hexatwist/kinematics/twist.hpp"
+#include "kinematics/gauss_jordan.hpp"
 #include "kinematics/geometry.hpp"
 #include "kinematics/linear_solve.hpp"
 #include "kinematics/twist_internal.hpp"
@@ -27,6 +28,73 @@ Status residual(const Model& model, const Placement& x, const Vector6d& lengths,
   Vector6d dtheta;
   if (const Status s = twist(model, legs, dtheta); s != Status::Ok) return s;
   f -= model.geometry().twist_gain.cwiseProduct(dtheta);
+  return Status::Ok;
+}
+
+// The Cayley retraction, the rotation (I - W/2)^-1 (I + W/2) = I + c W + (c/2) W^2 with
+// c = 4 / (4 + |w|^2), W = [w]x: a rotation by 2 atan(|w|/2) about w, equal to exp(W) to second
+// order, so Newton's steps converge as with exp_so3, without its sine and cosine on the chain
+// from step to step (docs/theory.md §5).
+Matrix3d cayley(const Vector3d& w) noexcept {
+  const double x = w.x(), y = w.y(), z = w.z();
+  const double A = 4.0 / (4.0 + (x * x + y * y + z * z)), B = 0.5 * A;
+  Matrix3d R;
+  R(0, 0) = 1.0 - B * (y * y + z * z);
+  R(1, 1) = 1.0 - B * (x * x + z * z);
+  R(2, 2) = 1.0 - B * (x * x + y * y);
+  R(0, 1) = -A * z + B * (x * y);
+  R(1, 0) = A * z + B * (x * y);
+  R(0, 2) = A * y + B * (x * z);
+  R(2, 0) = -A * y + B * (x * z);
+  R(1, 2) = -A * x + B * (y * z);
+  R(2, 1) = A * x + B * (y * z);
+  return R;
+}
+
+// The residual f and the Jacobian of g at x in one pass over the legs (lanes.hpp): the kernels of
+// inverse_kinematics (into `legs`), twist and length_jacobian from the same registers, with the
+// same operations, so that f is residual()'s. A zero-length leg or a singular joint goes to
+// residual(), which names it (`regular` collects both).
+Status evaluate(const Model& model, const Placement& x, const Vector6d& lengths, LengthKind kind, LegState& legs,
+                Vector6d& f, detail::Columns& J) noexcept {
+  using namespace detail;
+  if (!all_finite(x.t) || !all_finite(x.R_BP)) return Status::NonFiniteInput;
+  const LegLanes& g = model.geometry().lanes;
+  const bool motor = kind == LengthKind::Motor;
+  const bool twisted = motor && model.has_twist();
+  legs.R_BP = x.R_BP;
+  lane_m regular = all_set();
+#pragma GCC unroll 4
+  for (int k = 0; k < kPackets; ++k) {
+    const LegsAt at = legs_at(model, x.R_BP, x.t, k);
+    store6(legs.arm_B, at.arm, k);
+    store6(legs.axis_platform_B, at.axis_platform, k);
+    store6(legs.leg_B, at.leg, k);
+    store6(legs.length.data(), at.length, k);
+    regular &= at.length > 0.0;  // NaN fails
+    const lane_v inv_length = 1.0 / at.length;
+    const lanes3 s = inv_length * at.leg;
+    store6(legs.s_B, s, k);
+    lane_v f_k = at.length - load6(lengths.data(), k);
+    if (motor) f_k -= load_lanes(g.length_offset, k);
+    lane_v col[6];
+    if (twisted) {
+      // Motor-side length m = |L| - length_offset - twist_gain * dtheta (docs/theory.md §4-5).
+      const lanes3 ja = load_lanes(g.axis_base_B, k);
+      const lanes3& jd = at.axis_platform;
+      const lane_v ja_s = dot(s, ja), jd_s = dot(s, jd);
+      const TwistTerms t = twist_terms(s, ja, jd, ja_s, jd_s, splat<lane_v>(1.0));
+      regular &= twist_regular(model, t.x, t.y, splat<lane_v>(1.0), k);
+      f_k -= load_lanes(g.twist_gain, k) * twist_angle(model, t.x, t.y, true, k);
+      jacobian_columns(model, s, inv_length, at.arm, ja, jd, ja_s, jd_s, t, true, k, col);
+    } else {
+      const lanes3 arm_x_s = cross(at.arm, s);
+      col[0] = s.x, col[1] = s.y, col[2] = s.z, col[3] = arm_x_s.x, col[4] = arm_x_s.y, col[5] = arm_x_s.z;
+    }
+    store6(f.data(), f_k, k);
+    for (int c = 0; c < 6; ++c) J.c[c][k] = col[c];
+  }
+  if (!all_lanes(regular)) return residual(model, x, lengths, kind, legs, f);
   return Status::Ok;
 }
 
@@ -61,6 +129,9 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
   LegState legs_try;
   LegState* legs = &out.legs;
   LegState* trial = &legs_try;
+  detail::Columns J_a, J_b;  // the Jacobian at the iterate and at the trial point, likewise
+  detail::Columns* J = &J_a;
+  detail::Columns* J_trial = &J_b;
   const auto finish = [&](Status status) noexcept {
     if (legs != &out.legs) out.legs = *legs;
     return status;
@@ -68,52 +139,76 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
 
   Placement x = guess;
   Vector6d f;
-  if (const Status s = residual(model, x, lengths, kind, *legs, f); s != Status::Ok) return s;
+  if (const Status s = evaluate(model, x, lengths, kind, *legs, f, *J); s != Status::Ok) return s;
 
   Placement x_try;
   Vector6d f_try, step;
-  Matrix6d J;
-  detail::Lu6 lu;
+  detail::Columns A;  // the scaled Jacobian of the last Newton step, and its inverse
+  detail::Inverse6 inverse;
   double det_sign_guess = 0.0;  // 0: not computed yet
+  bool have_inverse = false;    // `inverse` is that of the last step's A
+  const ConditionReference& ref = model.condition_reference();
+  const bool home_inverse = ref.det_sign != 0.0 && (kind == LengthKind::Motor || !model.has_twist()) &&
+                            guess.t == Vector3d::Zero() && guess.R_BP == Matrix3d::Identity();
   for (;;) {
     out.placement = x;
     out.residual = f.cwiseAbs().maxCoeff();
     if (out.residual <= options.tolerance) {
       out.pose = pose_from_placement(x);
-      // The assembly mode and condition at the solution (theory §5), taken from the factors of the
-      // last Newton step's Jacobian: that iterate lies one step (|J^-1 f|, f the residual before
+      // The assembly mode and condition at the solution (theory §5), taken from the last Newton
+      // step's Jacobian and its inverse: that iterate lies one step (|J^-1 f|, f the residual before
       // the step) from the solution, so the condition differs from the solution's by a relative
       // O(condition * step / condition_length) -- about 1e-8 from a warm start -- and the sign of
       // det J cannot differ unless J is singular within that step, which a condition below half the
       // limit rules out. Nearer the limit, or with no step taken, the Jacobian is formed at the
       // solution, so that which poses pass the limit is decided exactly as before.
       const double bound = model.spec().limits.jacobian_condition_max;
-      if (out.iterations > 0) {
-        out.det_sign = detail::lu6_det_sign(lu);
-        out.condition = detail::lu6_scaled_condition(lu, J.cwiseAbs().colwise().sum().transpose(),
-                                                     1.0 / model.condition_length());
+      if (have_inverse) {
+        out.det_sign = inverse.det_sign;
+        out.condition = detail::gj_condition(A, inverse);
       }
-      if (out.iterations == 0 || !(out.condition <= 0.5 * bound)) {
-        if (const Status s = length_jacobian(model, *legs, kind, J); s != Status::Ok) return finish(s);
-        out.condition = detail::scaled_condition(J, model.condition_length(), out.det_sign);
+      if (!have_inverse || !(out.condition <= 0.5 * bound)) {
+        Matrix6d J_exact;
+        if (const Status s = length_jacobian(model, *legs, kind, J_exact); s != Status::Ok) return finish(s);
+        out.condition = detail::scaled_condition(J_exact, model.condition_length(), out.det_sign);
       }
       if (det_sign_guess == 0.0) det_sign_guess = out.det_sign;  // no step taken: the guess is the solution
       return finish(out.det_sign == det_sign_guess ? Status::Ok : Status::AssemblyModeChanged);
     }
     if (out.iterations >= options.max_iterations) return finish(Status::NoConvergence);
 
-    // Newton step on R^3 x SO(3): J [dt; dw] = -f, then t += dt, R = exp(dw) R. The Jacobian is
-    // formed only here, so the converged last iterate never pays for one. (Reusing it for chord
-    // steps was measured: more iterations, no gain, since two Newton steps usually suffice.)
-    if (const Status s = length_jacobian(model, *legs, kind, J); s != Status::Ok) return finish(s);
-    if (!(detail::lu6_factor(J, lu) > options.singular_ratio)) return finish(Status::SingularJacobian);
-    if (det_sign_guess == 0.0) det_sign_guess = detail::lu6_det_sign(lu);
-    detail::lu6_solve(lu, -f, step);
+    // Newton step on R^3 x SO(3): J [dt; dw] = -f, then t += dt, R = cay(dw) R. It is solved with
+    // the inverse of the scaled Jacobian A = J diag(1, 1, 1, s, s, s), s = 1/condition_length (the
+    // matrix whose condition the limit bounds), by Gauss-Jordan elimination (gauss_jordan.hpp):
+    // A y = -f, [dt; dw] = diag(1, 1, 1, s, s, s) y. (Reusing J for chord steps was measured: more
+    // iterations, no gain, since two Newton steps usually suffice.)
+    // From home, the usual cold start, the model holds A's inverse already (the condition proof's
+    // reference, Model::condition_reference), which spares the first elimination.
+    const double s = 1.0 / model.condition_length();
+    if (out.iterations == 0 && home_inverse) {
+      for (int i = 0; i < 6; ++i) {
+        double y = 0.0;
+        for (int c = 0; c < 6; ++c) y -= ref.inverse[i][c] * f[c];
+        step[i] = y;
+      }
+      det_sign_guess = ref.det_sign;
+      have_inverse = false;  // no elimination to read the condition from
+    } else {
+      for (int c = 0; c < 6; ++c)
+        for (int k = 0; k < detail::kPackets; ++k) A.c[c][k] = c < 3 ? J->c[c][k] : s * J->c[c][k];
+      if (!(detail::gauss_jordan(A, inverse) > options.singular_ratio)) return finish(Status::SingularJacobian);
+      if (det_sign_guess == 0.0) det_sign_guess = inverse.det_sign;
+      have_inverse = true;
+      detail::gj_solve(inverse, -f, step);
+    }
+    step.tail<3>() *= s;
     // Step cap: near a singularity, or far from the solution, the Newton step can be far longer
     // than the platform; shorten it (direction kept) to a length the linear model can be trusted over.
-    const double dt = step.head<3>().norm(), dw = step.tail<3>().norm();
-    if (dt > options.max_step_translation || dw > options.max_step_rotation)
-      step *= std::min(options.max_step_translation / dt, options.max_step_rotation / dw);
+    // (Squared lengths first: no square root on the way to the trial point when nothing is capped.)
+    const double dt2 = step.head<3>().squaredNorm(), dw2 = step.tail<3>().squaredNorm();
+    if (dt2 > options.max_step_translation * options.max_step_translation ||
+        dw2 > options.max_step_rotation * options.max_step_rotation)
+      step *= std::min(options.max_step_translation / std::sqrt(dt2), options.max_step_rotation / std::sqrt(dw2));
 
     // Backtracking: accept the first fraction of the step that lowers |f| (and stays away from
     // singular joints), so a far guess cannot throw the iterate to another assembly mode.
@@ -122,8 +217,8 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
     bool accepted = false;
     for (int h = 0; h <= kMaxHalvings && !accepted; ++h, alpha *= 0.5) {
       x_try.t = x.t + alpha * step.head<3>();
-      x_try.R_BP = exp_so3(alpha * step.tail<3>()) * x.R_BP;
-      if (residual(model, x_try, lengths, kind, *trial, f_try) != Status::Ok) continue;
+      x_try.R_BP = cayley(alpha * step.tail<3>()) * x.R_BP;
+      if (evaluate(model, x_try, lengths, kind, *trial, f_try, *J_trial) != Status::Ok) continue;
       accepted = f_try.squaredNorm() < norm_f;
     }
     ++out.iterations;
@@ -131,6 +226,7 @@ Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKin
     x = x_try;
     f = f_try;
     std::swap(legs, trial);
+    std::swap(J, J_trial);
   }
 }
 

@@ -209,7 +209,8 @@ inline void jacobian_columns(const Model& model, const lanes3& s, lane_v inv_len
   // dy/ds = ja x jd, dx/ds = -(jd.s) ja - (ja.s) jd, dy/djd = s x ja, dx/djd = ja - (ja.s) s.
   // Legs without axes have x = y = 0: give them n2 = 1 and mask their rows to zero.
   const lane_v n2 = t.x * t.x + t.y * t.y + (1.0 - mask);
-  const lane_v fx = mask * t.x / n2, fy = mask * t.y / n2;
+  const lane_v weight = mask / n2;  // one division for both
+  const lane_v fx = weight * t.x, fy = weight * t.y;
   const lanes3 dx_ds = (-jd_s) * ja - ja_s * jd;
   const lanes3 g_s = fx * t.ja_x_jd - fy * dx_ds;
   const lanes3 g_jd = fx * cross(s, ja) - fy * (ja - ja_s * s);

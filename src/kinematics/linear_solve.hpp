@@ -66,24 +66,6 @@ inline double lu6_factor(const Matrix6d& A, Lu6& lu) noexcept {
   return pivot_min / pivot_max;
 }
 
-/// Solves A x = b with the factors of lu6_factor.
-inline void lu6_solve(const Lu6& lu, const Vector6d& b, Vector6d& x) noexcept {
-  const auto& a = lu.a;
-  double y[6];
-#pragma GCC unroll 6
-  for (int k = 0; k < 6; ++k) {
-    double s = b[lu.perm[k]];
-    for (int j = 0; j < k; ++j) s -= lu.l[k][j] * y[j];
-    y[k] = s;
-  }
-#pragma GCC unroll 6
-  for (int k = 5; k >= 0; --k) {
-    double s = y[k];
-    for (int j = k + 1; j < 6; ++j) s -= a[k][j] * x[j];
-    x[k] = s / a[k][k];
-  }
-}
-
 /// Sign of det(A) from its factors: the product of the pivots' signs and the permutation's parity.
 inline double lu6_det_sign(const Lu6& lu) noexcept {
   double sign = 1.0;

@@ -213,6 +213,7 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
       for (int i = 0; i < kLegs; ++i)
         for (int c = 0; c < kLegs; ++c) condition_reference_.inverse[i][c] = Y(i, c);
       condition_reference_.norm = Y.cwiseAbs().colwise().sum().maxCoeff();
+      condition_reference_.det_sign = lu.determinant() > 0.0 ? 1.0 : -1.0;
     }
   }
 }

@@ -16,11 +16,13 @@ enum class LengthKind {
 struct FkOptions {
   int max_iterations = 30;     ///< Newton iterations before NoConvergence
   double tolerance = 1e-12;    ///< max |residual| accepted [m]
-  double singular_ratio = 1e-12;  ///< smallest |pivot| ratio of the LU before SingularJacobian
+  /// Smallest min |pivot| / max |pivot| of the elimination of the scaled Jacobian (its columns
+  /// in m per m, docs/theory.md §6) before SingularJacobian.
+  double singular_ratio = 1e-12;
   /// Step cap (docs/theory.md §5): a Newton step whose translation |dt| or rotation |dw| is
   /// longer than these is shortened, direction kept, before the line search.
   double max_step_translation = 0.5;  ///< longest translation of one step [m]
-  double max_step_rotation = 0.5;     ///< largest rotation of one step [rad]
+  double max_step_rotation = 0.5;     ///< largest |dw| of one step (a rotation by 2 atan(|dw|/2) <= |dw|) [rad]
 };
 
 /// Result of forward kinematics (caller-owned).

@@ -121,6 +121,7 @@ struct LegGeometry {
 struct alignas(64) ConditionReference {
   double inverse[6][8] = {};  ///< Y0 [-]
   double norm = INFINITY;     ///< ||Y0||_1; inf where home's Jacobian is singular (no proof then) [-]
+  double det_sign = 0.0;      ///< sign of det J0; 0 where Y0 is not set [-]
 };
 
 /// Immutable, validated platform model. Construction throws hexatwist::Error naming the leg and
