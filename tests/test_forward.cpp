@@ -454,7 +454,9 @@ TEST(Forward, TheFirstStepFromHomeMatchesAnEliminatedOne) {
     FkResult home, near;
     ASSERT_EQ(forward_kinematics(model, c.compensated, LengthKind::Motor, Placement{}, home), Status::Ok) << offset;
     ASSERT_EQ(forward_kinematics(model, c.compensated, LengthKind::Motor, beside, near), Status::Ok) << offset;
-    if (offset == 1e-7) EXPECT_EQ(home.iterations, 1);
+    if (offset == 1e-7) {
+      EXPECT_EQ(home.iterations, 1);
+    }
     EXPECT_EQ(home.iterations, near.iterations) << offset;
     for (const FkResult* r : {&home, &near}) {
       EXPECT_LT(pose_error(r->placement, placement_from_pose(p)).position, 1e-12) << offset;

@@ -26,10 +26,16 @@ Matrix3d rotation_from_rpy(const Vector3d& rpy) noexcept { return detail::rotati
 Vector3d rpy_from_rotation(const Matrix3d& R) noexcept {
   // roll = atan2(R21, R22), pitch = atan2(-R20, |(R00, R10)|), yaw = atan2(R10, R00), as one
   // vectorised call (fast_math.hpp; 2 ulp).
-  // (One 4-lane call rather than two 2-lane ones: the forward kinematics ends with it.)
   const double c5 = std::sqrt(R(0, 0) * R(0, 0) + R(1, 0) * R(1, 0));
+#if HEXATWIST_LANE_WIDTH >= 4
+  // One 4-lane call where the target has them: the forward kinematics ends with it.
   const detail::v4d a = detail::atan2(detail::v4d{R(2, 1), -R(2, 0), R(1, 0), 0.0}, detail::v4d{R(2, 2), c5, R(0, 0), 1.0});
   return {a[0], a[1], a[2]};
+#else
+  const detail::v2d a = detail::atan2(detail::v2d{R(2, 1), -R(2, 0)}, detail::v2d{R(2, 2), c5});
+  const detail::v2d b = detail::atan2(detail::v2d{R(1, 0), 0.0}, detail::v2d{R(0, 0), 1.0});
+  return {a[0], a[1], b[0]};
+#endif
 }
 
 Matrix3d exp_so3(const Vector3d& w) noexcept {
