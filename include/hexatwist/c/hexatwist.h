@@ -91,7 +91,7 @@ typedef struct hexatwist_fk_options {
   int max_iterations;          /**< Newton iterations before HEXATWIST_NO_CONVERGENCE */
   double tolerance;            /**< largest |length residual| accepted [m] */
   double max_step_translation; /**< largest translation of one Newton step [m] */
-  double max_step_rotation;    /**< largest rotation of one Newton step [rad] */
+  double max_step_rotation;    /**< largest rotation vector |dw| of one Newton step [rad] */
 } hexatwist_fk_options;
 
 /** Outcome of forward kinematics. */
