@@ -3,9 +3,11 @@
 // Gauss-Jordan inverse on lane columns (src/kinematics/gauss_jordan.hpp) against Eigen.
 #include "kinematics/fast_math.hpp"
 #include "kinematics/gauss_jordan.hpp"
+#include "kinematics/lanes.hpp"
 #include "kinematics/linear_solve.hpp"
 #include "kinematics/twist_internal.hpp"
 #include "hexatwist/hexatwist.hpp"
+#include "support.hpp"
 
 #include <Eigen/LU>
 
@@ -14,10 +16,13 @@
 #include <bit>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <random>
 
 namespace hexatwist::detail {
 namespace {
+
+using namespace hexatwist::test;
 
 TEST(FastMath, Atan2MatchesLibmOverAllQuadrantsAndScales) {
   // Measured worst difference 4.4e-16 rad (2 ulp of pi); bound 10x.
@@ -251,6 +256,132 @@ TEST(LinearSolve, CheapConditionProofNeverAcceptsAboveTheExactCondition) {
   }
   std::printf("  proven within twice the exact condition from a near reference: %d of %d\n", proven, total);
   EXPECT_GE(proven, total * 99 / 100);
+}
+
+TEST(LinearSolve, CheapConditionProofWithAPerturbationHoldsForEveryMatrixWithinIt) {
+  // scaled_condition_below(J, ..., bound, p) proves the bound for every A + E with ||E||_1 <= p
+  // (A = J W^-1, the scaled J): checked with E random and with E pushing A towards singularity
+  // (-p times the SVD's last pair, scaled to ||E||_1 = p), at bounds and perturbations around the
+  // proof's edge.
+  std::mt19937_64 rng(4242);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), scale(-3.0, 0.0), len(0.3, 3.0);
+  int proven = 0;
+  double worst = 0.0;  // the largest exact condition over its bound among proven cases
+  for (int n = 0; n < 4000; ++n) {
+    Matrix6d J;
+    for (int i = 0; i < 36; ++i) J(i) = u(rng);
+    const Vector6d v = Vector6d::NullaryExpr([&] { return u(rng); }).normalized();
+    J -= (1.0 - std::pow(10.0, scale(rng))) * (J * v) * v.transpose();
+    const double length = len(rng);
+    Vector6d w_inv;
+    w_inv << 1, 1, 1, 1 / length, 1 / length, 1 / length;
+    const Matrix6d A = J * w_inv.asDiagonal();
+    Matrix6d E0;
+    for (int i = 0; i < 36; ++i) E0(i) = u(rng);
+    Matrix6d Y = (J + 1e-3 * E0).inverse();
+    Y.bottomRows<3>() *= length;
+    ConditionReference ref;
+    for (int i = 0; i < 6; ++i)
+      for (int c = 0; c < 6; ++c) ref.inverse[i][c] = Y(i, c);
+    ref.norm = Y.cwiseAbs().colwise().sum().maxCoeff();
+    double sign;
+    const double exact = scaled_condition(J, length, sign);
+    if (!(exact < 1e4)) continue;
+    const double norm_a = A.cwiseAbs().colwise().sum().maxCoeff();
+    const Eigen::JacobiSVD<Matrix6d> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Matrix6d toward = -svd.matrixU().col(5) * svd.matrixV().col(5).transpose();
+    toward /= toward.cwiseAbs().colwise().sum().maxCoeff();
+    for (const double rel : {1e-3, 1e-2, 3e-2, 0.1}) {
+      const double p = rel * norm_a / exact;  // rel of the way to the nearest singular matrix, about
+      for (const double factor : {1.2, 2.0, 5.0}) {
+        const double bound = factor * exact;
+        if (!scaled_condition_below(J, length, ref, bound, p)) continue;
+        ++proven;
+        Matrix6d random;
+        for (int i = 0; i < 36; ++i) random(i) = u(rng);
+        random /= random.cwiseAbs().colwise().sum().maxCoeff();
+        for (const Matrix6d& E : {Matrix6d(p * toward), Matrix6d(p * random), Matrix6d(-p * toward)}) {
+          const Matrix6d J_e = (A + E) * w_inv.cwiseInverse().asDiagonal();
+          const double kappa = scaled_condition(J_e, length, sign);
+          worst = std::max(worst, kappa / bound);
+          ASSERT_LE(kappa, bound) << "p " << p << " bound " << bound << "\n" << J;
+        }
+      }
+    }
+    // Never proven where the perturbation alone could make A singular.
+    EXPECT_FALSE(scaled_condition_below(J, length, ref, 1e300, 1.01 * norm_a));
+    EXPECT_FALSE(scaled_condition_below(J, length, ref, 1e300, std::nan("")));
+    EXPECT_FALSE(scaled_condition_below(J, length, ref, 1e300, INFINITY));
+  }
+  std::printf("  proven: %d; largest condition within the perturbation over its bound: %.3f\n", proven, worst);
+  EXPECT_GT(proven, 10000);
+}
+
+TEST(Lanes, TwistShareBoundCoversTheMotorSideJacobiansTwistRows) {
+  // twist_share_bound summed over the legs bounds ||A_m - A_g||_1, the twist's share of the scaled
+  // motor-side Jacobian, on the seed platform, on random asymmetric ones (either thread hand and
+  // driven side, one leg without axes), and near the U-joint singularity margin (the seed with a
+  // 1 deg margin and wide stroke and bend limits); and it is not loose by more than a small factor.
+  std::mt19937_64 rng(99);
+  ModelSpec near_spec = seed_model().spec();
+  near_spec.limits.singularity_margin = deg2rad(1.0);
+  near_spec.limits.length_min = 0.5;
+  near_spec.limits.length_max = 4.0;
+  near_spec.limits.bend_max = deg2rad(89);
+  std::vector<std::unique_ptr<Model>> models;
+  models.push_back(std::make_unique<Model>(seed_model().spec()));
+  models.push_back(std::make_unique<Model>(near_spec));
+  for (int m = 0; m < 6; ++m) models.push_back(std::make_unique<Model>(random_platform(rng).spec()));
+  ModelSpec no_axes = models.back()->spec();
+  no_axes.legs[2].axis_base_B.setZero();
+  no_axes.legs[2].axis_platform_P.setZero();
+  no_axes.legs[2].lead = 0.0;
+  models.push_back(std::make_unique<Model>(no_axes));
+  double worst_ratio = 0.0, largest_share = 0.0;
+  std::vector<double> ratios;
+  for (std::size_t m = 0; m < models.size(); ++m) {
+    const Model& model = *models[m];
+    const LegLanes& g = model.geometry().lanes;
+    Vector6d d;
+    d << 1, 1, 1, 1 / model.condition_length(), 1 / model.condition_length(), 1 / model.condition_length();
+    for (int n = 0; n < 3000; ++n) {
+      const Pose p = m == 1 ? random_valid_pose(model, rng, 0.8, deg2rad(80)) : random_valid_pose(model, rng, 0.4, deg2rad(30));
+      LegState st;
+      ASSERT_EQ(inverse_kinematics(model, p, st), Status::Ok);
+      Matrix6d Jm, Jg;
+      ASSERT_EQ(motor_length_jacobian(model, st, Jm), Status::Ok);
+      length_jacobian(st, Jg);
+      const double share = ((Jm - Jg) * d.asDiagonal()).cwiseAbs().colwise().sum().maxCoeff();
+      const Matrix6d share_rows = (Jm - Jg) * d.asDiagonal();
+      lane_v sum = {};
+      for (int k = 0; k < kPackets; ++k) {
+        const lanes3 leg = load6(st.leg_B, k), ja = load_lanes(g.axis_base_B, k), jd = load6(st.axis_platform_B, k);
+        const lane_v length = load6(st.length.data(), k), dot_a = dot(leg, ja), dot_d = dot(leg, jd);
+        const lane_v length2 = length * length;
+        const TwistTerms t = twist_terms(leg, ja, jd, dot_a, dot_d, length2);
+        const lane_v leg_bound = twist_share_bound(model, t.x, length * t.y, dot_a, dot_d, length, length2, 1.0 / length, k);
+        sum += leg_bound;
+        // Leg by leg, the bound is on the larger of the two halves' Euclidean norms.
+        for (int l = 0; l < kWidth && k * kWidth + l < kLegs; ++l) {
+          const int i = k * kWidth + l;
+          const double row = std::max(share_rows.row(i).head<3>().norm(), share_rows.row(i).tail<3>().norm());
+          ASSERT_LE(row, leg_bound[l] * (1.0 + 1e-6) + 1e-13) << "model " << m << " leg " << i << " " << str(p);
+        }
+      }
+      const double bound = sum_lanes(sum);
+      // With the allowances for rounding that the command adds (compensation.cpp): the rows differ
+      // by rounding even where the twist adds nothing (a leg without axes: 1e-16).
+      ASSERT_LE(share, bound * (1.0 + 1e-6) + 1e-13) << "model " << m << " " << str(p);
+      largest_share = std::max(largest_share, share);
+      if (share > 0.0) ratios.push_back(bound / share);
+    }
+  }
+  std::sort(ratios.begin(), ratios.end());
+  worst_ratio = ratios.back();
+  std::printf("  ||A_m - A_g||_1 up to %.3g; bound over it: median %.2f, worst %.2f\n", largest_share,
+              ratios[ratios.size() / 2], worst_ratio);
+  EXPECT_LT(ratios[ratios.size() / 2], 5.0);
+  EXPECT_LT(worst_ratio, 20.0);
 }
 
 TEST(LinearSolve, CheapConditionProofHoldsOverTheSeedWorkspace) {

@@ -45,9 +45,10 @@ namespace {
 // and with the leg vectors L_i in place of the unit s_i, which spares a division on the
 // critical path (the tests and the twist's atan2 are homogeneous in the leg's scale). True,
 // with `command` written, if every test passes; false leaves the naming of the limit or joint
-// to the full path. The two decide alike except within rounding of a bound. The platform
-// Jacobian is formed from the same registers, bit for bit as limits.cpp forms it from a
-// LegState, for the condition limit's proof after the loop.
+// to the full path. The two decide alike except within rounding of a bound. The condition limit
+// is proven after the loop (limits.hpp: once every leg passed) for the motor-side Jacobian from
+// the geometric one, formed from the same registers, and a bound on the twist's share of it
+// (docs/theory.md §8): the twist's own Jacobian costs as much as the proof.
 bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, Vector6d& command) noexcept {
   using namespace detail;
   const LegLanes& g = model.geometry().lanes;
@@ -56,6 +57,8 @@ bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, V
   lane_m ok = all_set();
   Vector6d out;
   ColumnPackets J;
+  lane_v twist_share = {};
+  const lane_v inv_condition_length = splat<lane_v>(1.0 / model.condition_length());
 #pragma GCC unroll 4
   for (int k = 0; k < kPackets; ++k) {
     const LegsAt legs = legs_at(model, R, pose.position, k);
@@ -64,35 +67,35 @@ bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, V
     const lane_v dot_a = dot(legs.leg, ja), dot_d = dot(legs.leg, jd);
     ok &= within_limits(model, limit_terms(model, R, legs.leg, legs.length, legs.length, dot_a, dot_d, k));
     lane_v command_k = legs.length - load_lanes(g.length_offset, k);
-    if (compensated) {
+    const lane_v inv_length = 1.0 / legs.length;
+    if (twist_model) {
       // x scales with |L|^2 and y with |L|: one more |L| on y puts both on the same scale.
       const TwistTerms t = twist_terms(legs.leg, ja, jd, dot_a, dot_d, legs.length2);
       const lane_v y = legs.length * t.y;
-      command_k -= load_lanes(g.twist_gain, k) * twist_angle(model, t.x, y, true, k);  // Eq. (12)
-      ok &= twist_regular(model, t.x, y, legs.length2 * legs.length2, k) & within_stroke(model, command_k);
+      ok &= twist_regular(model, t.x, y, legs.length2 * legs.length2, k);
+      twist_share += twist_share_bound(model, t.x, y, dot_a, dot_d, legs.length, legs.length2, inv_length, k);
+      if (compensated) {
+        command_k -= load_lanes(g.twist_gain, k) * twist_angle(model, t.x, y, true, k);  // Eq. (12)
+        ok &= within_stroke(model, command_k);
+      }
     }
     store6(out.data(), command_k, k);
-    // The Jacobian's rows from the unit s_i, as limits.cpp has them (detail::condition_proven_within).
-    const lane_v inv_length = 1.0 / legs.length;
+    // The geometric Jacobian's rows from the unit s_i, as limits.cpp has them, its rotation
+    // columns divided by the condition length (A of limits.hpp).
     const lanes3 s = inv_length * legs.leg;
-    lane_v col[6];
-    if (twist_model) {
-      const lane_v ja_s = dot(s, ja), jd_s = dot(s, jd);
-      const TwistTerms t = twist_terms(s, ja, jd, ja_s, jd_s, splat<lane_v>(1.0));
-      ok &= twist_regular(model, t.x, t.y, splat<lane_v>(1.0), k);
-      jacobian_columns(model, s, inv_length, legs.arm, ja, jd, ja_s, jd_s, t, true, k, col);
-    } else {
-      const lanes3 arm_x_s = cross(legs.arm, s);
-      col[0] = s.x, col[1] = s.y, col[2] = s.z, col[3] = arm_x_s.x, col[4] = arm_x_s.y, col[5] = arm_x_s.z;
-    }
-    J.set(k, col);
+    const lanes3 arm_x_s = inv_condition_length * cross(legs.arm, s);
+    J.set(k, {s.x, s.y, s.z, arm_x_s.x, arm_x_s.y, arm_x_s.z});
   }
   if (!all_lanes(ok)) return false;
   // The platform singularity last, once every leg passed (limits.hpp): a cheap proof that the
-  // condition is inside the limit, which holds for nearly every pose; else the full path.
+  // condition is inside the limit, which holds for nearly every pose; else the full path. The
+  // bound on ||A_m - A_g||_1 gets a factor 1 + 1e-6 for the rounding of the bound and of the
+  // twist's rows, and 1e-13 for the rounding of A_m's entries, which are at most 2 + |gain| ... in
+  // magnitude (theory §8).
   PaddedRows rows;
   J.rows(rows);
-  if (!scaled_condition_below(rows, model.condition_length(), model.condition_reference(), model.condition_max_accepted()))
+  const double perturbation = sum_lanes(twist_share) * (1.0 + 1e-6) + 1e-13;
+  if (!condition_below(rows, model.condition_reference(), model.condition_max_accepted(), perturbation))
     return false;
   command = out;
   return true;

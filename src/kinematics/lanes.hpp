@@ -228,6 +228,38 @@ inline void jacobian_columns(const Model& model, const lanes3& s, lane_v inv_len
   for (int c = 0; c < 6; ++c) col[c] = length_col[c] - gain * twist_col[c];
 }
 
+/// Per leg, a bound on what the twist adds to the scaled motor-side Jacobian, for the condition
+/// proof (docs/theory.md §8): with A_m = A_g - E (A_g the geometric rows [s^T, (arm x s)^T / l_c],
+/// E = diag(twist_gain) (twist Jacobian) diag(1, 1, 1, 1/l_c x 3)), ||E||_1 <= the sum of the lanes.
+/// From the twist terms of the leg vector L (twist_terms with u = L: x, and y already multiplied by
+/// |L|, both then scaled by |L|^2), L.ja, L.jd, |L|, |L|^2 and 1/|L|; the triangle inequality on
+/// jacobian_columns' terms, without forming them. Near a U-joint singularity it grows like
+/// 1/(x^2 + y^2); NaN stays NaN. Lanes 6 and 7 give 0.
+inline lane_v twist_share_bound(const Model& model, lane_v x, lane_v y, lane_v dot_a, lane_v dot_d, lane_v length,
+                                lane_v length2, lane_v inv_length, int k) noexcept {
+  const LegLanes& g = model.geometry().lanes;
+  const lane_v ax = vabs(x), ay = vabs(y);
+  // With w = 1/(x^2 + y^2) (legs without axes: 1, and a zero gain): |a| <= |L| w (|x| + |y| (|ja.s| +
+  // |jd.s|)) for the translation part a, |g_jd| <= |L|^2 w (|x| + |y|), |b| <= |arm| |a| + |g_jd|.
+  const lane_v w = 1.0 / ((x * x + y * y) + (1.0 - load_lanes(g.has_axes, k)));
+  const lane_v a = length * w * (ax + ay * ((vabs(dot_a) + vabs(dot_d)) * inv_length));
+  const lane_v b_scaled = load_lanes(g.arm_ratio, k) * a + (length2 * w * (ax + ay)) * (1.0 / model.condition_length());
+  return load_lanes(g.twist_gain_bound, k) * (a > b_scaled ? a : b_scaled);
+}
+
+/// The sum of the lanes.
+inline double sum_lanes(lane_v v) noexcept {
+#if HEXATWIST_LANE_WIDTH == 8
+  const v4d v4 = __builtin_shufflevector(v, v, 0, 1, 2, 3) + __builtin_shufflevector(v, v, 4, 5, 6, 7);
+  const v2d v2 = __builtin_shufflevector(v4, v4, 0, 1) + __builtin_shufflevector(v4, v4, 2, 3);
+#elif HEXATWIST_LANE_WIDTH == 4
+  const v2d v2 = __builtin_shufflevector(v, v, 0, 1) + __builtin_shufflevector(v, v, 2, 3);
+#else
+  const v2d v2 = v;
+#endif
+  return v2[0] + v2[1];
+}
+
 /// A 6x6 matrix gathered packet by packet as columns (lane i: row i, as jacobian_columns gives
 /// them), read out as padded rows (linear_solve.hpp): kept in registers and transposed there with
 /// one eight-lane packet, else through its column-major storage.

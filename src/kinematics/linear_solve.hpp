@@ -103,12 +103,11 @@ inline double lu6_scaled_condition(const Lu6& lu, const Vector6d& column_sums, d
   for (int k = 5; k >= 0; --k) {
     const double inv = 1.0 / lu.a[k][k];
     const double w = k < 3 ? 1.0 : 1.0 / s;
-    const lane_v zero = {};
     for (int q = 0; q < kP; ++q) {
       for (int j = k + 1; j < 6; ++j) x[k][q] -= lu.a[k][j] * x[j][q];
       x[k][q] *= inv;
       const lane_v v = x[k][q];
-      sum[q] += w * (v < zero ? -v : v);
+      sum[q] += w * vabs(v);
     }
   }
   double norm_inv = 0.0;
@@ -184,18 +183,21 @@ inline double max_lane(const lane_v (&v)[kRowVectors]) noexcept {
   return m2[0] > m2[1] ? m2[0] : m2[1];
 }
 
-/// True only if the condition number that scaled_condition(J, length) computes is proven to be at
-/// most `bound`; false means "not proven" (also for a singular or non-finite J), not "above". A
+/// True only if the 1-norm condition number of A = J diag(1, 1, 1, 1/length x 3), the number that
+/// scaled_condition(J, length) computes, is proven to be at most `bound`; false means "not
+/// proven" (also for a singular or non-finite A), not "above". A
 /// cheap sufficient test that spares the pivoted LU and its inverse where the pose is well inside
 /// the limit (docs/theory.md §8): from the model's reference Y0 ~ A^-1 (the inverse at home), the
 /// residual G = I - Y0 A bounds ||A^-1||_1 <= ||Y0||_1 / (1 - ||G||_1); where that is not enough,
-/// once more from Y1 = (I + G) Y0, one Newton-Schulz step. J comes as its padded rows.
-inline bool scaled_condition_below(const PaddedRows& rows, double length, const ConditionReference& ref,
-                                   double bound) noexcept {
+/// once more from Y1 = (I + G) Y0, one Newton-Schulz step. A comes as its padded rows. With
+/// `perturbation` = p > 0 the proof is for every matrix within p of A in the 1-norm (A + E with
+/// ||E||_1 <= p: ||I - Y (A + E)||_1 <= ||G||_1 + ||Y||_1 p and ||A + E||_1 <= ||A||_1 + p); the
+/// command proves the motor-side Jacobian from the geometric one and a bound on the twist's share.
+inline bool condition_below(const PaddedRows& a, const ConditionReference& ref, double bound,
+                            double perturbation = 0.0) noexcept {
   constexpr int kW = sizeof(lane_v) / sizeof(double);
   constexpr int kP = kRowVectors;
   const lane_v zero = {};
-  const auto abs_v = [&](lane_v v) { return v < zero ? -v : v; };
   const auto load = [](const double* p) {
     lane_v v;
     std::memcpy(&v, p, sizeof v);
@@ -204,18 +206,12 @@ inline bool scaled_condition_below(const PaddedRows& rows, double length, const 
   alignas(64) static constexpr double kIdentity[6][8] = {{1, 0, 0, 0, 0, 0, 0, 0}, {0, 1, 0, 0, 0, 0, 0, 0},
                                                          {0, 0, 1, 0, 0, 0, 0, 0}, {0, 0, 0, 1, 0, 0, 0, 0},
                                                          {0, 0, 0, 0, 1, 0, 0, 0}, {0, 0, 0, 0, 0, 1, 0, 0}};
-  alignas(64) static constexpr double kUnit[8] = {1, 1, 1, 0, 0, 0, 0, 0};
-  // A = J diag(1, 1, 1, 1/length x 3) a whole row at a time.
-  lane_v a[6][kP], sum_a[kP] = {};
-  for (int q = 0; q < kP; ++q) {
-    const lane_v first = load(kUnit + q * kW);
-    const lane_v col_scale = first + (1.0 / length) * (1.0 - first);
-    for (int i = 0; i < 6; ++i) {
-      a[i][q] = col_scale * rows[i][q];
-      sum_a[q] += abs_v(a[i][q]);
-    }
-  }
-  const double norm_a = max_lane(sum_a);
+  if (!(perturbation < INFINITY)) return false;  // also NaN
+  // ||A||_1 without a NaN test of its own: a NaN in A reaches every column of G below.
+  lane_v sum_a[kP];
+  for (int q = 0; q < kP; ++q)
+    sum_a[q] = (vabs(a[0][q]) + vabs(a[1][q])) + (vabs(a[2][q]) + vabs(a[3][q])) + (vabs(a[4][q]) + vabs(a[5][q]));
+  const double norm_a = max_lane(sum_a) + perturbation;
   // G = I - Y A for an approximate inverse Y (rows of 8): 1-norm of G, rounding included. Each
   // entry of G rounds by less than 8 u (|Y| |A|) (u the unit roundoff); 1e-13 ||Y||_1 ||A||_1
   // covers it a hundred times over.
@@ -231,12 +227,12 @@ inline bool scaled_condition_below(const PaddedRows& rows, double length, const 
         for (int k = 3; k < 6; ++k) r1 -= y[i][k] * a[k][q];
         const lane_v r = r0 + r1;
         std::memcpy(&g[i][q * kW], &r, sizeof r);
-        abs_g[i][q] = abs_v(r);
+        abs_g[i][q] = vabs(r);
       }
     }
     lane_v sum_g[kP];
     for (int q = 0; q < kP; ++q) sum_g[q] = (abs_g[0][q] + abs_g[1][q]) + (abs_g[2][q] + abs_g[3][q]) + (abs_g[4][q] + abs_g[5][q]);
-    return max_lane(sum_g) + 1e-13 * norm_y * norm_a;
+    return max_lane(sum_g) + norm_y * perturbation + 1e-13 * norm_y * norm_a;
   };
   // A^-1 = (I - G)^-1 Y, so ||A^-1||_1 <= ||Y||_1 / (1 - ||G||_1) for ||G||_1 < 1. The products,
   // 1 - ||G||_1 and the norms' sums round by a few u: 1e-12 of slack. The proof asks for
@@ -259,19 +255,33 @@ inline bool scaled_condition_below(const PaddedRows& rows, double length, const 
       lane_v r = load(&ref.inverse[i][q * kW]);
       for (int k = 0; k < 6; ++k) r += g[i][k] * load(&ref.inverse[k][q * kW]);
       std::memcpy(&y1[i][q * kW], &r, sizeof r);
-      sum_y[q] += abs_v(r);
+      sum_y[q] += vabs(r);
     }
   }
   const double norm_y1 = max_lane(sum_y);
   return proven(norm_y1, residual_norm(y1, norm_y1));
 }
 
+/// condition_below for A = J diag(1, 1, 1, 1/length x 3), J as its padded rows.
+inline bool scaled_condition_below(const PaddedRows& rows, double length, const ConditionReference& ref, double bound,
+                                   double perturbation = 0.0) noexcept {
+  alignas(64) static constexpr double kUnit[8] = {1, 1, 1, 0, 0, 0, 0, 0};
+  PaddedRows a;
+  for (int q = 0; q < kRowVectors; ++q) {
+    lane_v first;
+    std::memcpy(&first, kUnit + q * sizeof(lane_v) / sizeof(double), sizeof first);
+    const lane_v col_scale = first + (1.0 / length) * (1.0 - first);
+    for (int i = 0; i < 6; ++i) a[i][q] = col_scale * rows[i][q];
+  }
+  return condition_below(a, ref, bound, perturbation);
+}
+
 /// scaled_condition_below for J in its column-major storage.
-inline bool scaled_condition_below(const Matrix6d& J, double length, const ConditionReference& ref,
-                                   double bound) noexcept {
+inline bool scaled_condition_below(const Matrix6d& J, double length, const ConditionReference& ref, double bound,
+                                   double perturbation = 0.0) noexcept {
   PaddedRows rows;
   padded_rows(J, rows);
-  return scaled_condition_below(rows, length, ref, bound);
+  return scaled_condition_below(rows, length, ref, bound, perturbation);
 }
 
 /// Condition number of a platform Jacobian J [-, m] (rows [s_i, arm_i x s_i] or the motor-side

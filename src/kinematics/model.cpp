@@ -179,6 +179,8 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
     lanes.twist_gain[lane] = geometry_.twist_gain[i];
     lanes.length_offset[lane] = geometry_.length_offset[i];
     lanes.has_axes[lane] = geometry_.has_axes[i];
+    lanes.twist_gain_bound[lane] = lane < kLegs ? std::abs(geometry_.twist_gain[i]) * geometry_.has_axes[i] : 0.0;
+    lanes.arm_ratio[lane] = geometry_.arm_P.row(i).norm() / condition_length_;
   }
 
   // The six legs must hold the platform: the length Jacobian at home must be well conditioned.

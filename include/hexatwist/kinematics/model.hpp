@@ -97,6 +97,11 @@ struct alignas(64) LegLanes {
   double twist_gain[8];
   double length_offset[8];
   double has_axes[8];
+  /// For the bound on the twist's share of the motor-side Jacobian (docs/theory.md §8): |twist_gain|
+  /// of legs with axes, 0 for the others and in lanes 6 and 7 (so that a sum over lanes counts each
+  /// leg once) [m/rad], and |arm_P| / Model::condition_length() [-].
+  double twist_gain_bound[8];
+  double arm_ratio[8];
 };
 
 /// The legs' precomputed geometry with one leg per row, for code vectorised over legs.
