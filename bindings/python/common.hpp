@@ -53,6 +53,8 @@ LengthKind length_kind_from(const std::string& name);
 
 /// Threads a batch call uses (0 = every core).
 std::atomic<unsigned>& thread_setting() noexcept;
+/// The threads a batch call may use: the setting, or every core.
+unsigned thread_count() noexcept;
 
 /// Runs body(begin, end) over [0, n) in blocks of kBlock poses spread over the cores, with the GIL
 /// released. Small batches run on the calling thread.
@@ -60,9 +62,7 @@ template <class F>
 void parallel_blocks(std::size_t n, F&& body) {
   py::gil_scoped_release release;
   const std::size_t blocks = (n + kBlock - 1) / kBlock;
-  const unsigned setting = thread_setting().load();
-  const std::size_t hw = setting ? setting : std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t workers = std::min(hw, blocks);
+  const std::size_t workers = blocks > 1 ? std::min<std::size_t>(thread_count(), blocks) : 1;
   if (workers <= 1) {
     for (std::size_t b = 0; b < blocks; ++b) body(b * kBlock, std::min(n, (b + 1) * kBlock));
     return;

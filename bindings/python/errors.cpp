@@ -17,6 +17,13 @@ std::atomic<unsigned>& thread_setting() noexcept {
   return n;
 }
 
+unsigned thread_count() noexcept {
+  // glibc reads /sys for hardware_concurrency on every call (about 7 us): once per process.
+  static const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned s = thread_setting().load();
+  return s ? s : cores;
+}
+
 Errors& errors() {
   static Errors e;
   return e;
@@ -143,10 +150,7 @@ void expose_errors(py::module_& m) {
     if (n < 0) raise_input("set_num_threads: expected a count >= 0 (0 = every core)");
     thread_setting() = static_cast<unsigned>(n);
   }, py::arg("n"), "Threads of the batch functions (0, the default: every core). Results do not depend on it.");
-  m.def("get_num_threads", [] {
-    const unsigned s = thread_setting().load();
-    return s ? s : std::max(1u, std::thread::hardware_concurrency());
-  }, "Threads the batch functions use.");
+  m.def("get_num_threads", [] { return thread_count(); }, "Threads the batch functions use.");
   m.def("_input_copies", [] { return input_copies().load(); },
         "Debug counter: inputs the bindings had to copy (never a C-contiguous float64 array).");
 }
