@@ -90,8 +90,8 @@ bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, V
   // The platform singularity last, once every leg passed (limits.hpp): a cheap proof that the
   // condition is inside the limit, which holds for nearly every pose; else the full path. The
   // bound on ||A_m - A_g||_1 gets a factor 1 + 1e-6 for the rounding of the bound and of the
-  // twist's rows, and 1e-13 for the rounding of A_m's entries, which are at most 2 + |gain| ... in
-  // magnitude (theory §8).
+  // twist's rows, and 1e-13 for the rounding of A_m's entries, each by a few u of a magnitude
+  // of about 1, in a column sum of six (theory §8).
   PaddedRows rows;
   J.rows(rows);
   const double perturbation = sum_lanes(twist_share) * (1.0 + 1e-6) + 1e-13;

@@ -262,26 +262,14 @@ inline bool condition_below(const PaddedRows& a, const ConditionReference& ref, 
   return proven(norm_y1, residual_norm(y1, norm_y1));
 }
 
-/// condition_below for A = J diag(1, 1, 1, 1/length x 3), J as its padded rows.
-inline bool scaled_condition_below(const PaddedRows& rows, double length, const ConditionReference& ref, double bound,
-                                   double perturbation = 0.0) noexcept {
-  alignas(64) static constexpr double kUnit[8] = {1, 1, 1, 0, 0, 0, 0, 0};
-  PaddedRows a;
-  for (int q = 0; q < kRowVectors; ++q) {
-    lane_v first;
-    std::memcpy(&first, kUnit + q * sizeof(lane_v) / sizeof(double), sizeof first);
-    const lane_v col_scale = first + (1.0 / length) * (1.0 - first);
-    for (int i = 0; i < 6; ++i) a[i][q] = col_scale * rows[i][q];
-  }
-  return condition_below(a, ref, bound, perturbation);
-}
-
-/// scaled_condition_below for J in its column-major storage.
+/// condition_below for A = J diag(1, 1, 1, 1/length x 3), J in its column-major storage.
 inline bool scaled_condition_below(const Matrix6d& J, double length, const ConditionReference& ref, double bound,
                                    double perturbation = 0.0) noexcept {
-  PaddedRows rows;
-  padded_rows(J, rows);
-  return scaled_condition_below(rows, length, ref, bound, perturbation);
+  Matrix6d A = J;
+  A.rightCols<3>() *= 1.0 / length;
+  PaddedRows a;
+  padded_rows(A, a);
+  return condition_below(a, ref, bound, perturbation);
 }
 
 /// Condition number of a platform Jacobian J [-, m] (rows [s_i, arm_i x s_i] or the motor-side
