@@ -408,6 +408,15 @@ TEST(Measurement, StationsRefuseBadSpecsInOneLine) {
   spec.translation = 30.0;
   test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
                           "station 1:", {"1000 tries", "smaller ranges"});
+  // Finite but astronomically large: the lines to check would have 1e300 points (a count that
+  // overflowed an int before it was checked); refused the same way, and quickly.
+  spec.translation = 1e300;
+  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
+                          "station 1:", {"1000 tries", "smaller ranges"});
+  spec.translation = 0.0;
+  spec.rotation = 1e300;  // any rotation is some pose: the checks along the line refuse it
+  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
+                          "station 1:", {"1000 tries", "smaller ranges"});
 }
 
 // A stations run of the real platform (lead 5 % long, the other thread hand, offsets within

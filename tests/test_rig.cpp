@@ -38,6 +38,13 @@ TEST(Rig, RefusesBadNumbersNamingTheField) {
               s.simulation.plant_step = 0.002;
             }).rfind("simulation.plant_step: 0.002 s is longer", 0),
             0u);
+  // Steps too short for the count of steps per period to fit an int (found by fuzzing: the
+  // conversion came before the check), and just past the allowed count.
+  EXPECT_EQ(error_of([](RigSpec& s) { s.simulation.plant_step = 1e-40; })
+                .rfind("simulation.plant_step: 1e-40 s gives more than 10000 steps per control period", 0),
+            0u);
+  EXPECT_EQ(error_of([](RigSpec& s) { s.simulation.plant_step = 0.99e-7; }).rfind("simulation.plant_step:", 0), 0u);
+  EXPECT_EQ(error_of([](RigSpec& s) { s.simulation.plant_step = 1e-7; }), "");
   EXPECT_EQ(error_of([](RigSpec& s) { s.model.legs[2].lead = 0; }).rfind("leg 3: lead:", 0), 0u);
 }
 

@@ -160,6 +160,17 @@ TEST(Synthesis, BadOptionsThrow) {
   EXPECT_THROW((void)synthesize(config.rig, traj, o, log, issue), Error);
   o.rate = 2000.0;  // faster than the control loop
   EXPECT_THROW((void)synthesize(config.rig, traj, o, log, issue), Error);
+  // A whole ratio too large for the sample divisor (1e303 periods; it would overflow the
+  // conversion, a UBSan error), and the largest one accepted.
+  o.rate = 1e-300;
+  try {
+    (void)synthesize(config.rig, traj, o, log, issue);
+    ADD_FAILURE() << "a rate of 1e-300 Hz was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is below the control rate 1000 Hz / 1e9"), std::string::npos) << e.what();
+  }
+  o.rate = 1e-6;  // one sample in 1e9 control periods: accepted (none falls in the short run)
+  EXPECT_EQ(synthesize(config.rig, traj, o, log, issue), Status::Ok);
   o.rate = 100.0;
   o.noise = -1.0;
   EXPECT_THROW((void)synthesize(config.rig, traj, o, log, issue), Error);

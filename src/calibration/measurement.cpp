@@ -204,7 +204,11 @@ namespace {
 // inside every limit for the commands of `strategy`.
 bool reachable_from(const Model& model, Strategy strategy, const Vector6d& from, const Vector6d& pose) {
   constexpr double kCheckStep = 5e-3;  // [m or rad]
-  const int steps = std::max(1, static_cast<int>(std::ceil((pose - from).norm() / kCheckStep)));
+  // A line of more than 10^6 checks (5 km or 5,000 rad) is no station move: not reachable. The
+  // count is checked in double before the conversion, which would overflow an int.
+  const double checks = std::ceil((pose - from).norm() / kCheckStep);
+  if (!(checks <= 1e6)) return false;
+  const int steps = std::max(1, static_cast<int>(checks));
   Vector6d command;
   LimitReport limit;
   for (int j = 1; j <= steps; ++j) {

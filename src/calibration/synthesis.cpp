@@ -43,6 +43,9 @@ Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisO
                             options.rate, control_rate, control_rate, control_rate / 2.0));
   if (!(std::isfinite(options.noise) && options.noise >= 0.0))
     throw Error(fmt::format("noise: expected a finite standard deviation >= 0 m, got {}", options.noise));
+  // At most 10^9 control periods per sample, so that the divisor converts exactly.
+  if (!(ratio <= 1e9))
+    throw Error(fmt::format("rate: {} Hz is below the control rate {} Hz / 1e9", options.rate, control_rate));
   const Model real = real_model(rig.model(), options.errors);
   const auto every = static_cast<std::size_t>(std::round(ratio));
 

@@ -117,10 +117,12 @@ void Rig::validate_and_derive() {
   if (simulation_.plant_step > control_period_ * (1.0 + 1e-12))
     fail("simulation.plant_step",
          fmt::format("{} s is longer than the control period {} s", simulation_.plant_step, control_period_));
-  substeps_ = static_cast<int>(std::ceil(control_period_ / simulation_.plant_step * (1.0 - 1e-12)));
-  if (substeps_ > 10000)
+  // Counted in double and checked before the conversion: a tiny step (1e-40 s) would overflow an int.
+  const double substeps = std::ceil(control_period_ / simulation_.plant_step * (1.0 - 1e-12));
+  if (!(substeps <= 10000.0))
     fail("simulation.plant_step",
          fmt::format("{} s gives more than 10000 steps per control period", simulation_.plant_step));
+  substeps_ = static_cast<int>(substeps);
 
   for (int i = 0; i < kLegs; ++i) {
     const double lead = model_.leg(i).lead;
