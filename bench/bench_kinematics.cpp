@@ -39,7 +39,8 @@ void BM_TwistAwareFkWarm(benchmark::State& state) {
     iterations += r.iterations;
     if (++k == m.poses.size()) k = 1;
   }
-  state.counters["newton_iterations"] = benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+  state.counters["newton_iterations"] =
+      benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_TwistAwareFkWarm)->Apply(add_statistics);
 
@@ -61,7 +62,8 @@ void BM_TwistAwareFkCold(benchmark::State& state) {
     benchmark::DoNotOptimize(s);
     iterations += r.iterations;
   }
-  state.counters["newton_iterations"] = benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
+  state.counters["newton_iterations"] =
+      benchmark::Counter(static_cast<double>(iterations), benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_TwistAwareFkCold)->Apply(add_statistics);
 

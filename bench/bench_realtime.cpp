@@ -334,7 +334,7 @@ void BM_StreamUdpRoundTrip(benchmark::State& state) {
     for (int c = 0; c < sysconf(_SC_NPROCESSORS_ONLN) && c < CPU_SETSIZE; ++c) CPU_SET(c, &all);
     pthread_setaffinity_np(pthread_self(), sizeof all, &all);
   }
-  state.SetLabel(mode == 2 ? "busy polling: stream on CPU 1, client on CPU 0"
+  state.SetLabel(mode == 2  ? "busy polling: stream on CPU 1, client on CPU 0"
                  : realtime ? "SCHED_FIFO"
                             : "normal scheduling");
 }

@@ -67,11 +67,11 @@ inline const Motion& motion() {
 
 /// Repetitions with the median, the worst (max) and the best (min) repetition.
 inline void add_statistics(benchmark::internal::Benchmark* b) {
-  b->Repetitions(15)->ReportAggregatesOnly(true)->ComputeStatistics("max", [](const std::vector<double>& v) {
-    return *std::max_element(v.begin(), v.end());
-  })->ComputeStatistics("min", [](const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); });
+  b->Repetitions(15)
+      ->ReportAggregatesOnly(true)
+      ->ComputeStatistics("max", [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); })
+      ->ComputeStatistics("min", [](const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); });
 }
-
 
 /// Per-call latencies: each call is timed on its own (the CPU's invariant time-stamp counter on
 /// x86-64, steady_clock elsewhere), the timer's own cost (the median of an empty interval) is

@@ -3,10 +3,10 @@
 // to the drives, and checks its deadline. Nothing inside the loop allocates, locks or prints.
 //
 //   example_03_realtime_loop [SECONDS]      (default 2 s; as root it runs under SCHED_FIFO)
-#include <hexatwist/hexatwist.hpp>
 #include <sched.h>
 #include <sys/mman.h>
 #include <time.h>
+#include <hexatwist/hexatwist.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -19,7 +19,8 @@ void exercise(const Model& model) {
   FkResult fk;
   for (const Pose& pose : {Pose{}, nudge}) {
     if (compute_commands(model, pose, report) != Status::Ok) continue;
-    fuzz::require(report.compensated.allFinite() && report.conventional.allFinite(), "non-finite command with status ok");
+    fuzz::require(report.compensated.allFinite() && report.conventional.allFinite(),
+                  "non-finite command with status ok");
     // Twist-aware FK from home back to the pose: any status, but a finite answer when it is Ok.
     if (forward_kinematics(model, report.compensated, LengthKind::Motor, Placement{}, fk) == Status::Ok)
       fuzz::require(fk.pose.is_finite() && std::isfinite(fk.residual), "non-finite FK solution with status ok");

@@ -22,8 +22,8 @@ StreamSettings settings_from(std::uint8_t flags) {
   s.strategy = flags & 1 ? Strategy::Conventional : Strategy::Compensated;
   s.on_reject = flags & 2 ? RejectPolicy::Skip : RejectPolicy::Hold;
   if (flags & 8) {
-    s.max_velocity = 0.2;       // [m/s]
-    s.max_acceleration = 2.0;   // [m/s^2]
+    s.max_velocity = 0.2;      // [m/s]
+    s.max_acceleration = 2.0;  // [m/s^2]
   }
   return s;
 }
@@ -66,9 +66,9 @@ void check_answer(const Model& model, std::string_view input, AngleUnit unit, co
   }
   fuzz::require((st == Status::Ok) == (out.action == CommandAction::New), "a new command exactly for an accepted pose");
   if (is_limit(st))
-    fuzz::require(out.limit.leg >= 0 && out.limit.leg < kLegs && std::isfinite(out.limit.value) &&
-                      std::isfinite(out.limit.bound),
-                  "a limit without its leg, value and bound");
+    fuzz::require(
+        out.limit.leg >= 0 && out.limit.leg < kLegs && std::isfinite(out.limit.value) && std::isfinite(out.limit.bound),
+        "a limit without its leg, value and bound");
   if (out.action != CommandAction::None) {
     LimitReport report;
     fuzz::require(out.command.allFinite(), "a non-finite command emitted");

@@ -4,6 +4,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <unistd.h>
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <cstdio>
@@ -11,7 +12,6 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
-#include <unistd.h>
 
 #include "hexatwist/hexatwist.hpp"
 
@@ -76,7 +76,8 @@ class MjSim {
       if (d->efc_type[k] != mjCNSTR_EQUALITY) continue;
       const char* name = mj_id2name(m, mjOBJ_EQUALITY, d->efc_id[k]);
       const std::string n = name != nullptr ? name : "";
-      if (!suffix.empty() && (n.size() < suffix.size() || n.compare(n.size() - suffix.size(), suffix.size(), suffix) != 0))
+      if (!suffix.empty() &&
+          (n.size() < suffix.size() || n.compare(n.size() - suffix.size(), suffix.size(), suffix) != 0))
         continue;
       r = std::max(r, std::abs(d->efc_pos[k]));
     }
@@ -92,7 +93,8 @@ class MjSim {
     for (int it = 0; it < iterations; ++it) {
       mj_fwdPosition(m, d);
       const int ne = d->ne;  // the equality rows come first (then dry friction's, which are not positions)
-      const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(d->efc_J, ne, m->nv);
+      const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(d->efc_J, ne,
+                                                                                                       m->nv);
       const Eigen::Map<const Eigen::VectorXd> pos(d->efc_pos, ne);
       r = pos.cwiseAbs().maxCoeff();
       if (r < tolerance) break;

@@ -132,14 +132,14 @@ struct Platform {
 
 enum class Kind { Walk, Jump, OutOfLimit, NonFinite, NearSingular, GoodLine, BadLine, Garbage, kCount };
 constexpr std::array<const char*, static_cast<int>(Kind::kCount)> kKindNames = {
-    "valid walk", "valid jump", "out of limit", "non-finite", "near singularity", "line, well formed",
-    "line, malformed", "line, random bytes"};
+    "valid walk",       "valid jump",        "out of limit",    "non-finite",
+    "near singularity", "line, well formed", "line, malformed", "line, random bytes"};
 
 struct Request {
   Kind kind = Kind::Walk;
-  Pose pose;                   // the pose sent, or the pose the line means
-  bool has_pose = true;        // false for a line that does not parse
-  std::string line;            // for the line kinds
+  Pose pose;             // the pose sent, or the pose the line means
+  bool has_pose = true;  // false for a line that does not parse
+  std::string line;      // for the line kinds
   AngleUnit unit = AngleUnit::Degrees;
   LineError expected_error = LineError::None;  // for BadLine
   int expected_field = -1;                     // for BadLine
@@ -149,10 +149,14 @@ struct Request {
 std::string spell(std::mt19937_64& rng, double& value) {
   char buf[64];
   const int style = static_cast<int>(rng() % 4);
-  if (style == 0) std::snprintf(buf, sizeof buf, "%.17g", value);
-  else if (style == 1) std::snprintf(buf, sizeof buf, "%.6f", value);
-  else if (style == 2) std::snprintf(buf, sizeof buf, "%.9e", value);
-  else std::snprintf(buf, sizeof buf, "%g", value);
+  if (style == 0)
+    std::snprintf(buf, sizeof buf, "%.17g", value);
+  else if (style == 1)
+    std::snprintf(buf, sizeof buf, "%.6f", value);
+  else if (style == 2)
+    std::snprintf(buf, sizeof buf, "%.9e", value);
+  else
+    std::snprintf(buf, sizeof buf, "%g", value);
   value = std::strtod(buf, nullptr);  // what the text means (the C library reads it, not hexatwist)
   static constexpr std::array<const char*, 4> kBlanks = {"", " ", "\t", "  "};
   std::string s = kBlanks[rng() % 4];
@@ -182,12 +186,21 @@ void bad_line(std::mt19937_64& rng, Request& r) {
   std::vector<std::string> fields = {"0.1", "-0.05", "0.2", "1.5", "-2", "30"};
   const int at = static_cast<int>(rng() % 6);
   switch (rng() % 7) {
-    case 0: fields.resize(static_cast<std::size_t>(at));
-            r.expected_error = at == 0 ? LineError::Empty : LineError::MissingFields;
-            r.expected_field = at == 0 ? -1 : at; break;
-    case 1: fields.push_back("0"); r.expected_error = LineError::ExtraFields; r.expected_field = 6; break;
-    case 2: fields[static_cast<std::size_t>(at)] = rng() % 2 ? "" : " \t ";
-            r.expected_error = LineError::EmptyField; r.expected_field = at; break;
+    case 0:
+      fields.resize(static_cast<std::size_t>(at));
+      r.expected_error = at == 0 ? LineError::Empty : LineError::MissingFields;
+      r.expected_field = at == 0 ? -1 : at;
+      break;
+    case 1:
+      fields.push_back("0");
+      r.expected_error = LineError::ExtraFields;
+      r.expected_field = 6;
+      break;
+    case 2:
+      fields[static_cast<std::size_t>(at)] = rng() % 2 ? "" : " \t ";
+      r.expected_error = LineError::EmptyField;
+      r.expected_field = at;
+      break;
     case 3: {
       static constexpr std::array<const char*, 7> kWords = {"abc", "1.2.3", "0x1p3", "1e", "--1", "++1", "1 2"};
       fields[static_cast<std::size_t>(at)] = kWords[rng() % kWords.size()];
@@ -195,13 +208,22 @@ void bad_line(std::mt19937_64& rng, Request& r) {
       r.expected_field = at;
       break;
     }
-    case 4: fields[static_cast<std::size_t>(at)] = rng() % 2 ? "1e999" : "-2e400";
-            r.expected_error = LineError::OutOfRange; r.expected_field = at; break;
-    case 5: r.line = std::string(kMaxLineLength + 1 + rng() % 100, ' ');
-            r.line.replace(0, 11, "0,0,0,0,0,0");
-            r.expected_error = LineError::TooLong; r.expected_field = -1; return;
-    default: r.line = std::string(rng() % 5, ' ') + (rng() % 2 ? "\n" : "");
-             r.expected_error = LineError::Empty; r.expected_field = -1; return;
+    case 4:
+      fields[static_cast<std::size_t>(at)] = rng() % 2 ? "1e999" : "-2e400";
+      r.expected_error = LineError::OutOfRange;
+      r.expected_field = at;
+      break;
+    case 5:
+      r.line = std::string(kMaxLineLength + 1 + rng() % 100, ' ');
+      r.line.replace(0, 11, "0,0,0,0,0,0");
+      r.expected_error = LineError::TooLong;
+      r.expected_field = -1;
+      return;
+    default:
+      r.line = std::string(rng() % 5, ' ') + (rng() % 2 ? "\n" : "");
+      r.expected_error = LineError::Empty;
+      r.expected_field = -1;
+      return;
   }
   for (std::size_t k = 0; k < fields.size(); ++k) {
     if (k) r.line += ',';
@@ -242,16 +264,19 @@ void fail(const Context& c, const StreamOutput& out, const std::string& what) {
   if (g_tally.failures > 10) return;
   const StreamSettings& s = *c.settings;
   std::fprintf(stderr,
-               "FAIL request %" PRIu64 " (seed %" PRIu64 ", %s, %s): %s\n"
+               "FAIL request %" PRIu64 " (seed %" PRIu64
+               ", %s, %s): %s\n"
                "  settings: %s, %s, period %.17g s, vmax %.17g m/s, amax %.17g m/s^2\n"
-               "  pose %s; line '%s'\n  answer: input %" PRIu64 ", status %s, action %s, rate limited %d, "
+               "  pose %s; line '%s'\n  answer: input %" PRIu64
+               ", status %s, action %s, rate limited %d, "
                "command %s, leg %d, value %.17g, bound %.17g\n",
                c.index, c.seed, c.platform->model->spec().name.c_str(), kKindNames[static_cast<int>(c.request->kind)],
                what.c_str(), s.strategy == Strategy::Compensated ? "compensated" : "conventional",
                s.on_reject == RejectPolicy::Hold ? "hold" : "skip", s.period, s.max_velocity, s.max_acceleration,
-               str(c.request->pose).c_str(), c.request->line.c_str(), out.input, std::string(to_string(out.status)).c_str(),
-               std::string(to_string(out.action)).c_str(), out.rate_limited ? 1 : 0,
-               str(Pose::from_vector(out.command)).c_str(), out.limit.leg, out.limit.value, out.limit.bound);
+               str(c.request->pose).c_str(), c.request->line.c_str(), out.input,
+               std::string(to_string(out.status)).c_str(), std::string(to_string(out.action)).c_str(),
+               out.rate_limited ? 1 : 0, str(Pose::from_vector(out.command)).c_str(), out.limit.leg, out.limit.value,
+               out.limit.bound);
 }
 
 double angle_between(const Vector3d& a, const Vector3d& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
@@ -285,12 +310,12 @@ struct Session {
   const Platform* platform = nullptr;
   StreamSettings settings;
   StreamState state;
-  bool had_command = false;          // the stream had a command before this input
-  bool has_previous = false;         // a command was emitted (or started) in this session
-  bool verified = false;             // `previous` was solved and checked here
-  Vector6d previous = Vector6d::Zero();  // the last emitted command [m]
+  bool had_command = false;                   // the stream had a command before this input
+  bool has_previous = false;                  // a command was emitted (or started) in this session
+  bool verified = false;                      // `previous` was solved and checked here
+  Vector6d previous = Vector6d::Zero();       // the last emitted command [m]
   Vector6d previous_rate = Vector6d::Zero();  // its rate of change [m/s]
-  Placement previous_placement;      // the pose it means, as solved here
+  Placement previous_placement;               // the pose it means, as solved here
 };
 
 // Checks an emitted command: finite, inside the stroke, its pose inside every limit.
@@ -337,8 +362,9 @@ void check_answer(const Context& c, Session& s, const StreamOutput& out, Status 
   if (r.kind == Kind::BadLine) {
     if (out.status != Status::MalformedInput) return fail(c, out, "malformed line not rejected as malformed");
     if (out.parse.error != r.expected_error || out.parse.field != r.expected_field)
-      return fail(c, out, "malformed line: wrong error " + std::string(to_string(out.parse.error)) + " field " +
-                              std::to_string(out.parse.field));
+      return fail(c, out,
+                  "malformed line: wrong error " + std::string(to_string(out.parse.error)) + " field " +
+                      std::to_string(out.parse.field));
   }
   if (out.status == Status::MalformedInput) {
     if (r.has_pose) return fail(c, out, "a well-formed line rejected as malformed");
@@ -355,8 +381,8 @@ void check_answer(const Context& c, Session& s, const StreamOutput& out, Status 
   if (!r.pose.is_finite() && r.has_pose && out.status != Status::NonFiniteInput)
     return fail(c, out, "non-finite pose not rejected as such");
   // The platform-singularity limit concerns the whole platform: leg -1.
-  const bool leg_ok = out.status == Status::PlatformSingularity ? out.limit.leg == -1
-                                                                : out.limit.leg >= 0 && out.limit.leg < kLegs;
+  const bool leg_ok =
+      out.status == Status::PlatformSingularity ? out.limit.leg == -1 : out.limit.leg >= 0 && out.limit.leg < kLegs;
   if (is_limit(out.status) && !(leg_ok && std::isfinite(out.limit.value) && std::isfinite(out.limit.bound)))
     return fail(c, out, "limit rejection without a leg, value and bound");
   if (out.status != Status::Ok && expected != Status::Ok && r.has_pose && out.limit.leg != expected_limit.leg)
@@ -367,7 +393,8 @@ void check_answer(const Context& c, Session& s, const StreamOutput& out, Status 
   if ((out.status == Status::Ok) != (out.action == CommandAction::New))
     return fail(c, out, "a new command exactly when the input is accepted");
   if (out.status != Status::Ok && !out.rate_limited) {
-    const CommandAction policy = set.on_reject == RejectPolicy::Skip || !had_command ? CommandAction::None : CommandAction::Held;
+    const CommandAction policy =
+        set.on_reject == RejectPolicy::Skip || !had_command ? CommandAction::None : CommandAction::Held;
     if (out.action != policy) return fail(c, out, "rejection not answered as the policy says");
   }
   if (out.action != CommandAction::None && !had_command && out.action != CommandAction::New)
@@ -403,7 +430,8 @@ void check_answer(const Context& c, Session& s, const StreamOutput& out, Status 
     for (int i = 0; i < kLegs; ++i) {
       if (std::abs(out.command[i] - s.previous[i]) > set.max_velocity * h * (1 + 1e-9) + ulp)
         return fail(c, out, "leg " + std::to_string(i) + ": speed above max_velocity");
-      if (!failed_check_hold && std::abs(rate[i] - s.previous_rate[i]) > set.max_acceleration * h * (1 + 1e-9) + 2 * ulp / h)
+      if (!failed_check_hold &&
+          std::abs(rate[i] - s.previous_rate[i]) > set.max_acceleration * h * (1 + 1e-9) + 2 * ulp / h)
         return fail(c, out, "leg " + std::to_string(i) + ": acceleration above max_acceleration");
     }
     if (failed_check_hold) ++g_tally.holds_after_failed_check;
@@ -418,7 +446,6 @@ void check_answer(const Context& c, Session& s, const StreamOutput& out, Status 
 // ---------------------------------------------------------------------------------------------
 // The run
 // ---------------------------------------------------------------------------------------------
-
 
 StreamSettings random_settings(std::mt19937_64& rng) {
   StreamSettings s;
@@ -435,8 +462,14 @@ Request random_request(std::mt19937_64& rng, const Platform& p, Pose& walk) {
   Request r;
   r.unit = rng() % 2 ? AngleUnit::Degrees : AngleUnit::Radians;
   const double u = uniform(rng, 0, 1);
-  r.kind = u < 0.30 ? Kind::Walk : u < 0.42 ? Kind::Jump : u < 0.54 ? Kind::OutOfLimit : u < 0.64 ? Kind::NonFinite
-         : u < 0.78 ? Kind::NearSingular : u < 0.88 ? Kind::GoodLine : u < 0.94 ? Kind::BadLine : Kind::Garbage;
+  r.kind = u < 0.30   ? Kind::Walk
+           : u < 0.42 ? Kind::Jump
+           : u < 0.54 ? Kind::OutOfLimit
+           : u < 0.64 ? Kind::NonFinite
+           : u < 0.78 ? Kind::NearSingular
+           : u < 0.88 ? Kind::GoodLine
+           : u < 0.94 ? Kind::BadLine
+                      : Kind::Garbage;
   if (r.kind == Kind::NearSingular && p.boundaries.empty()) r.kind = Kind::Walk;
   CommandReport report;
   switch (r.kind) {
@@ -447,8 +480,12 @@ Request random_request(std::mt19937_64& rng, const Platform& p, Pose& walk) {
       if (compute_commands(model, r.pose, report) == Status::Ok) walk = r.pose;
       break;
     }
-    case Kind::Jump: r.pose = walk = random_valid_pose(model, rng, 0.3, deg2rad(20)); break;
-    case Kind::OutOfLimit: r.pose = random_pose(rng, 1.5, deg2rad(90)); break;
+    case Kind::Jump:
+      r.pose = walk = random_valid_pose(model, rng, 0.3, deg2rad(20));
+      break;
+    case Kind::OutOfLimit:
+      r.pose = random_pose(rng, 1.5, deg2rad(90));
+      break;
     case Kind::NonFinite: {
       Vector6d q = random_valid_pose(model, rng, 0.3, deg2rad(20)).to_vector();
       static constexpr std::array<double, 3> kBad = {kNaN, kInf, -kInf};
@@ -459,7 +496,8 @@ Request random_request(std::mt19937_64& rng, const Platform& p, Pose& walk) {
     case Kind::NearSingular: {
       const Boundary& b = p.boundaries[rng() % p.boundaries.size()];
       r.pose = rng() % 2 ? b.inside : b.outside;
-      if (rng() % 2) r.pose = Pose::from_vector(r.pose.to_vector() + log_uniform(rng, 1e-15, 1e-9) * random_direction(rng));
+      if (rng() % 2)
+        r.pose = Pose::from_vector(r.pose.to_vector() + log_uniform(rng, 1e-15, 1e-9) * random_direction(rng));
       break;
     }
     case Kind::GoodLine: {
@@ -475,14 +513,18 @@ Request random_request(std::mt19937_64& rng, const Platform& p, Pose& walk) {
       }
       break;
     }
-    case Kind::BadLine: r.has_pose = false; bad_line(rng, r); break;
+    case Kind::BadLine:
+      r.has_pose = false;
+      bad_line(rng, r);
+      break;
     case Kind::Garbage: {
       r.line = garbage(rng);
       LineParse where;
       r.has_pose = parse_pose_line(r.line, r.unit, r.pose, where);  // the rare line that reads
       break;
     }
-    case Kind::kCount: break;
+    case Kind::kCount:
+      break;
   }
   return r;
 }
@@ -493,7 +535,8 @@ int run(std::uint64_t count, std::uint64_t seed) {
   models.push_back(seed_model());
   for (int k = 0; k < 4; ++k) models.push_back(near_singular_platform(rng));
   std::vector<Platform> platforms;
-  for (const Model& m : models) platforms.push_back({&m, &m == &models[0] ? std::vector<Boundary>{} : singularity_boundaries(m, rng, 48)});
+  for (const Model& m : models)
+    platforms.push_back({&m, &m == &models[0] ? std::vector<Boundary>{} : singularity_boundaries(m, rng, 48)});
   for (std::size_t k = 1; k < platforms.size(); ++k)
     if (platforms[k].boundaries.empty()) {
       std::fprintf(stderr, "FAIL: no singularity boundary found on random platform %zu\n", k);
@@ -508,7 +551,8 @@ int run(std::uint64_t count, std::uint64_t seed) {
     s.settings = random_settings(rng);
     const Model& model = *s.platform->model;
     if (!check_stream_settings(s.settings).empty()) {
-      std::fprintf(stderr, "FAIL: random settings refused: %s\n", std::string(check_stream_settings(s.settings)).c_str());
+      std::fprintf(stderr, "FAIL: random settings refused: %s\n",
+                   std::string(check_stream_settings(s.settings)).c_str());
       return 1;
     }
     Pose walk;
@@ -549,8 +593,10 @@ int run(std::uint64_t count, std::uint64_t seed) {
   print("answers by command:", g_tally.actions);
   std::printf("emitted commands solved by FK and checked: %" PRIu64 "; largest FK residual %.3g m\n", g_tally.fk_checks,
               g_tally.worst_residual);
-  std::printf("closest approach to a limit: %.3g m or rad beyond it (tolerance %.0e)\n", g_tally.worst_excess, kLimitTol);
-  std::printf("limit reports on the limit itself (within tolerance): %" PRIu64 "; holds after a failed check: %" PRIu64 "\n",
+  std::printf("closest approach to a limit: %.3g m or rad beyond it (tolerance %.0e)\n", g_tally.worst_excess,
+              kLimitTol);
+  std::printf("limit reports on the limit itself (within tolerance): %" PRIu64 "; holds after a failed check: %" PRIu64
+              "\n",
               g_tally.boundary_limit_reports, g_tally.holds_after_failed_check);
   std::printf("%s: %" PRIu64 " failed checks\n", g_tally.failures ? "FAILED" : "passed", g_tally.failures);
   return g_tally.failures ? 1 : 0;

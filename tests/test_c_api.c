@@ -10,16 +10,16 @@
 
 static int passed = 0, failed = 0;
 
-#define CHECK(cond, ...)                                   \
-  do {                                                     \
-    if (cond) {                                            \
-      ++passed;                                            \
-    } else {                                               \
-      ++failed;                                            \
+#define CHECK(cond, ...)                                                       \
+  do {                                                                         \
+    if (cond) {                                                                \
+      ++passed;                                                                \
+    } else {                                                                   \
+      ++failed;                                                                \
       fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond); \
-      fprintf(stderr, __VA_ARGS__);                        \
-      fputc('\n', stderr);                                 \
-    }                                                      \
+      fprintf(stderr, __VA_ARGS__);                                            \
+      fputc('\n', stderr);                                                     \
+    }                                                                          \
   } while (0)
 
 #ifndef HEXATWIST_NO_MALLOC_PROBE
@@ -30,9 +30,18 @@ extern void* __libc_calloc(size_t, size_t);
 extern void* __libc_realloc(void*, size_t);
 extern void __libc_free(void*);
 static volatile long allocations = 0;
-void* malloc(size_t n) { ++allocations; return __libc_malloc(n); }
-void* calloc(size_t n, size_t m) { ++allocations; return __libc_calloc(n, m); }
-void* realloc(void* p, size_t n) { ++allocations; return __libc_realloc(p, n); }
+void* malloc(size_t n) {
+  ++allocations;
+  return __libc_malloc(n);
+}
+void* calloc(size_t n, size_t m) {
+  ++allocations;
+  return __libc_calloc(n, m);
+}
+void* realloc(void* p, size_t n) {
+  ++allocations;
+  return __libc_realloc(p, n);
+}
 void free(void* p) { __libc_free(p); }
 #define PROBE 1
 #else
@@ -69,15 +78,18 @@ static void test_models(void) {
   hexatwist_model_home_lengths(m, geometric, motor);
   hexatwist_model_stroke(m, &lo, &hi);
   CHECK(lo == 1.4 && hi == 2.45, "stroke %g..%g", lo, hi);
-  for (int i = 0; i < 6; ++i) CHECK(geometric[i] > lo && geometric[i] < hi && motor[i] == geometric[i], "leg %d", i + 1);
+  for (int i = 0; i < 6; ++i)
+    CHECK(geometric[i] > lo && geometric[i] < hi && motor[i] == geometric[i], "leg %d", i + 1);
   hexatwist_model_free(m);
   hexatwist_model_free(NULL);
 
   /* Errors: one line naming the file, line and field, or the path. */
   m = hexatwist_model_from_yaml("symmetric:\n  Ra: abc\n", "bad.yaml", error, sizeof error);
-  CHECK(m == NULL && strstr(error, "bad.yaml:1:1: field 'screw'") == error && !strchr(error, '\n'), "message '%s'", error);
+  CHECK(m == NULL && strstr(error, "bad.yaml:1:1: field 'screw'") == error && !strchr(error, '\n'), "message '%s'",
+        error);
   m = hexatwist_model_from_file("/nonexistent/platform.yaml", error, sizeof error);
-  CHECK(m == NULL && strstr(error, "/nonexistent/platform.yaml") && strstr(error, "cannot read"), "message '%s'", error);
+  CHECK(m == NULL && strstr(error, "/nonexistent/platform.yaml") && strstr(error, "cannot read"), "message '%s'",
+        error);
   m = hexatwist_model_from_file(NULL, error, sizeof error);
   CHECK(m == NULL && strstr(error, "NULL"), "message '%s'", error);
   char tiny[8];
@@ -123,7 +135,8 @@ static void test_commands_and_fk(const hexatwist_model* m) {
     worst_round_trip = fmax(worst_round_trip, max_abs_diff(fk.pose, pose, 6));
     CHECK(fk.residual <= 1e-12 && fk.iterations > 0, "residual %g", fk.residual);
     CHECK(hexatwist_forward_kinematics(m, report.length, HEXATWIST_GEOMETRIC, pose, NULL, &fk) == HEXATWIST_OK &&
-              max_abs_diff(fk.pose, pose, 6) < 1e-11, "geometric fk from the pose itself");
+              max_abs_diff(fk.pose, pose, 6) < 1e-11,
+          "geometric fk from the pose itself");
   }
   CHECK(worst_round_trip < 1e-11, "worst round trip %g", worst_round_trip);
   printf("C API: worst FK round trip %.2g (m, rad)\n", worst_round_trip);
@@ -139,17 +152,22 @@ static void test_limits(const hexatwist_model* m) {
   CHECK(limit.value > limit.bound && limit.bound == 2.45, "value %g bound %g", limit.value, limit.bound);
   CHECK(command[0] == -1 && command[5] == -1, "no command written outside a limit");
   const double nan_pose[6] = {NAN, 0, 0, 0, 0, 0};
-  CHECK(hexatwist_motor_commands(m, nan_pose, HEXATWIST_COMPENSATED, command, NULL) == HEXATWIST_NON_FINITE_INPUT, "NaN");
-  CHECK(hexatwist_motor_commands(NULL, outside, HEXATWIST_COMPENSATED, command, NULL) == HEXATWIST_INVALID_ARGUMENT, "NULL");
-  CHECK(hexatwist_motor_commands(m, outside, (hexatwist_strategy)7, command, NULL) == HEXATWIST_INVALID_ARGUMENT, "enum");
+  CHECK(hexatwist_motor_commands(m, nan_pose, HEXATWIST_COMPENSATED, command, NULL) == HEXATWIST_NON_FINITE_INPUT,
+        "NaN");
+  CHECK(hexatwist_motor_commands(NULL, outside, HEXATWIST_COMPENSATED, command, NULL) == HEXATWIST_INVALID_ARGUMENT,
+        "NULL");
+  CHECK(hexatwist_motor_commands(m, outside, (hexatwist_strategy)7, command, NULL) == HEXATWIST_INVALID_ARGUMENT,
+        "enum");
   hexatwist_fk_result fk;
-  CHECK(hexatwist_forward_kinematics(m, command, (hexatwist_length_kind)5, NULL, NULL, &fk) == HEXATWIST_INVALID_ARGUMENT,
-        "length kind");
+  CHECK(
+      hexatwist_forward_kinematics(m, command, (hexatwist_length_kind)5, NULL, NULL, &fk) == HEXATWIST_INVALID_ARGUMENT,
+      "length kind");
   CHECK(strcmp(hexatwist_status_name(HEXATWIST_OK), "ok") == 0, "name");
   CHECK(strcmp(hexatwist_status_name(HEXATWIST_PLATFORM_SINGULARITY), "platform_singularity") == 0, "name");
   CHECK(strcmp(hexatwist_status_name(HEXATWIST_INVALID_ARGUMENT), "invalid_argument") == 0, "name");
-  CHECK(hexatwist_status_is_limit(HEXATWIST_PLATFORM_SINGULARITY) && !hexatwist_status_is_limit(HEXATWIST_NO_CONVERGENCE),
-        "is_limit");
+  CHECK(
+      hexatwist_status_is_limit(HEXATWIST_PLATFORM_SINGULARITY) && !hexatwist_status_is_limit(HEXATWIST_NO_CONVERGENCE),
+      "is_limit");
   CHECK(strlen(hexatwist_status_describe(HEXATWIST_BEND_BASE)) > 10, "describe");
 }
 
@@ -173,7 +191,8 @@ static void test_tracking(const hexatwist_model* m) {
   CHECK(!tracker.valid, "reset");
   const double at[6] = {0, 0, 0.05, 0, 0, 10 * kDeg};
   CHECK(hexatwist_fk_tracker_set(m, &tracker, at, HEXATWIST_MOTOR) == HEXATWIST_OK && tracker.valid &&
-            (tracker.det_sign == 1.0 || tracker.det_sign == -1.0), "set");
+            (tracker.det_sign == 1.0 || tracker.det_sign == -1.0),
+        "set");
   hexatwist_fk_options options = hexatwist_fk_default_options();
   CHECK(options.max_iterations > 0 && options.tolerance > 0 && options.max_step_translation > 0, "options");
   options.max_iterations = 0; /* no iteration allowed: the far solve must fail, and say so */
@@ -182,7 +201,8 @@ static void test_tracking(const hexatwist_model* m) {
   CHECK(hexatwist_motor_commands(m, far, HEXATWIST_COMPENSATED, command, NULL) == HEXATWIST_OK, "far pose");
   const hexatwist_fk_tracker before = tracker;
   CHECK(hexatwist_forward_kinematics_tracked(m, command, HEXATWIST_MOTOR, &tracker, &options, &fk) ==
-            HEXATWIST_NO_CONVERGENCE && memcmp(&before, &tracker, sizeof tracker) == 0,
+                HEXATWIST_NO_CONVERGENCE &&
+            memcmp(&before, &tracker, sizeof tracker) == 0,
         "a failed tracked solve leaves the tracker as it was");
 }
 

@@ -544,7 +544,7 @@ TEST(Cli, StudyRunsTheChosenTestsAndRefusesUnknownOnes) {
   // A motor that cannot hold the load: refused before anything runs.
   const std::string weak =
       write_file("weak.yaml", std::string(hexatwist::test::kSymmetricYaml) +
-                                     "servo:\n  torque_limit: 3\n  peak_torque_at_max_speed: 2\n  continuous_torque: 2\n");
+                                  "servo:\n  torque_limit: 3\n  peak_torque_at_max_speed: 2\n  continuous_torque: 2\n");
   // 4.92 N m for the platform, the rest for the legs' own weight.
   expect_error(
       run({"study", "--config", weak, "--out", out.string()}), 3,
@@ -563,8 +563,10 @@ std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
   for (std::string line; std::getline(is, line);) {
     rows.emplace_back(1);
     for (const char c : line) {
-      if (c == ',') rows.back().emplace_back();
-      else rows.back().back() += c;
+      if (c == ',')
+        rows.back().emplace_back();
+      else
+        rows.back().back() += c;
     }
   }
   return rows;
@@ -608,15 +610,15 @@ TEST(CliStream, RejectedLinesNameTheirProblemAndLineAndTheStreamGoesOn) {
   EXPECT_EQ(hold.code, 3);
   const auto rows = csv_rows(hold.out);
   ASSERT_EQ(rows.size(), 7u);
-  const std::vector<std::string> status = {"ok", "stroke_above_max", "malformed_input", "non_finite_input",
-                                           "malformed_input", "malformed_input", "ok"};
+  const std::vector<std::string> status = {
+      "ok", "stroke_above_max", "malformed_input", "non_finite_input", "malformed_input", "malformed_input", "ok"};
   for (std::size_t k = 0; k < rows.size(); ++k) {
     EXPECT_EQ(rows[k][0], std::to_string(k + 1));
     EXPECT_EQ(rows[k][1], status[k]);
     EXPECT_EQ(rows[k][2], k == 0 || k == 6 ? "new" : "held");
     EXPECT_EQ(commands_of(rows[k]), commands_of(rows[0]));  // held = the last valid command
   }
-  EXPECT_EQ(rows[1][9], "1");  // leg 1 ...
+  EXPECT_EQ(rows[1][9], "1");                                 // leg 1 ...
   EXPECT_GT(std::stod(rows[1][10]), std::stod(rows[1][11]));  // ... above its bound
   EXPECT_EQ(rows[2][12], "field 3 (z) at column 5: not a number");
   EXPECT_EQ(rows[4][12], "field 4 (roll) at column 6: missing (a pose has six fields: x y z roll pitch yaw)");
@@ -636,7 +638,8 @@ TEST(CliStream, RejectedLinesNameTheirProblemAndLineAndTheStreamGoesOn) {
 }
 
 TEST(CliStream, RadiansWithSiEqualDegreesAndHeaderComesFirst) {
-  const std::string deg = "0,0,0.05,3,-4,25\n", rad = "0,0,0.05," + numbers({deg2rad(3), deg2rad(-4), deg2rad(25)}) + "\n";
+  const std::string deg = "0,0,0.05,3,-4,25\n",
+                    rad = "0,0,0.05," + numbers({deg2rad(3), deg2rad(-4), deg2rad(25)}) + "\n";
   const auto a = csv_rows(run({"stream", "--header"}, &deg).out);
   const auto b = csv_rows(run({"stream", "--si"}, &rad).out);
   ASSERT_EQ(a.size(), 2u);
@@ -727,8 +730,10 @@ class CliStreamUdp : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(CliStreamUdp, AnswersOneDatagramPerDatagramInOrder) {
   TestSocket answers;
-  const std::string command = shell_quote(HEXATWIST_CLI) + " stream --input=udp://127.0.0.1:0 --output=udp://127.0.0.1:" +
-                              std::to_string(answers.port()) + " --count=4 --idle-timeout=20 " + GetParam() + " 2>&1";
+  const std::string command =
+      shell_quote(HEXATWIST_CLI) +
+      " stream --input=udp://127.0.0.1:0 --output=udp://127.0.0.1:" + std::to_string(answers.port()) +
+      " --count=4 --idle-timeout=20 " + GetParam() + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   ASSERT_NE(pipe, nullptr);
   std::array<char, 512> line{};
@@ -800,8 +805,8 @@ double rotation_error(const YAML::Node& measured, const YAML::Node& truth) {
   double worst = 0.0;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
-      worst = std::max(worst, std::abs(measured["registration"]["R_BT"][i][j].as<double>() -
-                                       truth["X_BT"]["R"][i][j].as<double>()));
+      worst = std::max(
+          worst, std::abs(measured["registration"]["R_BT"][i][j].as<double>() - truth["X_BT"]["R"][i][j].as<double>()));
   std::printf("  measured frame rotation error: %.3g\n", worst);
   return worst;
 }
@@ -971,7 +976,8 @@ TEST(CliIdentify, SynthThenIdentifyRecoversTheTruthAndWritesAConfigThatExplainsT
   ASSERT_EQ(s.code, 0) << s.err;
   const YAML::Node truth = YAML::LoadFile((temp_dir() / "stations.truth.json").string());
   const std::string yaml = (temp_dir() / "identified.yaml").string();
-  const Outcome r = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--out", yaml, "--json"});
+  const Outcome r =
+      run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--out", yaml, "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const YAML::Node j = json(r);
   const YAML::Node e = j["estimate"];
@@ -986,8 +992,8 @@ TEST(CliIdentify, SynthThenIdentifyRecoversTheTruthAndWritesAConfigThatExplainsT
   EXPECT_EQ(e["thread"].as<std::string>(), "left");
   double worst = 0.0;
   for (int i = 0; i < 6; ++i)
-    worst = std::max(worst, std::abs(e["length_offsets"][i].as<double>() -
-                                     truth["errors"]["zero_offset"][i].as<double>()));
+    worst =
+        std::max(worst, std::abs(e["length_offsets"][i].as<double>() - truth["errors"]["zero_offset"][i].as<double>()));
   std::printf("  largest offset error %.3g m\n", worst);
   EXPECT_LT(worst, 20e-6);
   EXPECT_NEAR(e["observation_point"][0].as<double>(), 1.2 + 2e-3, 10e-6);
@@ -1028,10 +1034,10 @@ TEST(CliIdentify, AFitFarNoisierThanTheTrackersScatterAtRestExitsFiveAndWritesNo
   ASSERT_EQ(run({"synth", "--stations", "40", "--station-seed", "3", "--lead-error-pct", "5", "--out", log}).code, 0);
   const std::string yaml = (temp_dir() / "lead5.yaml").string();
   std::filesystem::remove(yaml);
-  const Outcome r = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--lead-effect", "twist",
-                         "--out", yaml, "--json"});
-  expect_error(r, 5, {"lead5.csv: ", "times the tracker's scatter at rest", "does not explain the data",
-                      "nothing was written"});
+  const Outcome r = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--lead-effect",
+                         "twist", "--out", yaml, "--json"});
+  expect_error(
+      r, 5, {"lead5.csv: ", "times the tracker's scatter at rest", "does not explain the data", "nothing was written"});
   EXPECT_FALSE(std::filesystem::exists(yaml));
   const YAML::Node j = json(r);
   EXPECT_EQ(j["status"].as<std::string>(), "failed");
@@ -1040,7 +1046,8 @@ TEST(CliIdentify, AFitFarNoisierThanTheTrackersScatterAtRestExitsFiveAndWritesNo
   EXPECT_TRUE(j["corrected_config"].IsNull());
   EXPECT_GT(j["noise_ratio"].as<double>(), 100.0);  // measured 539
   // The same log under the right lead model: the fit's noise is the tracker's (measured 1.00).
-  const Outcome ok = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--out", yaml, "--json"});
+  const Outcome ok =
+      run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--out", yaml, "--json"});
   ASSERT_EQ(ok.code, 0) << ok.err;
   EXPECT_LT(json(ok)["noise_ratio"].as<double>(), 1.5);
   EXPECT_GT(json(ok)["noise_ratio"].as<double>(), 0.7);
@@ -1052,9 +1059,11 @@ TEST(CliIdentify, TwoThreadHandsThatFitEquallyWellExitFiveAndWriteNothing) {
   ASSERT_EQ(run({"synth", "--stations", "8", "--station-seed", "3", "--noise-um", "3000", "--out", log}).code, 0);
   const std::string yaml = (temp_dir() / "tie.yaml").string();
   std::filesystem::remove(yaml);
-  const Outcome r = run({"identify", "--points", log, "--stations", "8", "--station-seed", "3", "--out", yaml, "--json"});
-  expect_error(r, 5, {"tie.csv: ", "the two thread hands fit the data equally well", "cost ratio 1.0",
-                      "not decided", "nothing was written"});
+  const Outcome r =
+      run({"identify", "--points", log, "--stations", "8", "--station-seed", "3", "--out", yaml, "--json"});
+  expect_error(r, 5,
+               {"tie.csv: ", "the two thread hands fit the data equally well", "cost ratio 1.0", "not decided",
+                "nothing was written"});
   EXPECT_FALSE(std::filesystem::exists(yaml));
   const YAML::Node j = json(r);
   EXPECT_EQ(j["status"].as<std::string>(), "failed");
@@ -1094,16 +1103,16 @@ TEST(CliIdentify, BadRunsAndLogsAreOneLineErrors) {
 TEST(CliIdentify, TheRunWrittenBySynthIdentifiesAsTheStationsDo) {
   // A real platform is driven through the file synth writes; identify then reads it as the run.
   const std::string log = (temp_dir() / "five.csv").string(), file = (temp_dir() / "five-run.csv").string();
-  ASSERT_EQ(run({"synth", "--stations", "8", "--lead-error-pct", "1", "--offsets-mm", "0.5", "--out", log, "--run-out",
-                 file})
-                .code,
-            0);
+  ASSERT_EQ(
+      run({"synth", "--stations", "8", "--lead-error-pct", "1", "--offsets-mm", "0.5", "--out", log, "--run-out", file})
+          .code,
+      0);
   const std::vector<std::string> rows = lines_of(read_file(file));
   EXPECT_EQ(rows[0], "t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad");
-  const Outcome by_stations = run({"identify", "--points", log, "--stations", "8", "--json", "--out",
-                                   (temp_dir() / "a.yaml").string()});
-  const Outcome by_file = run({"identify", "--points", log, "--trajectory", file, "--json", "--out",
-                               (temp_dir() / "b.yaml").string()});
+  const Outcome by_stations =
+      run({"identify", "--points", log, "--stations", "8", "--json", "--out", (temp_dir() / "a.yaml").string()});
+  const Outcome by_file =
+      run({"identify", "--points", log, "--trajectory", file, "--json", "--out", (temp_dir() / "b.yaml").string()});
   ASSERT_EQ(by_stations.code, 0) << by_stations.err;
   ASSERT_EQ(by_file.code, 0) << by_file.err;
   const YAML::Node a = json(by_stations), b = json(by_file);
@@ -1216,7 +1225,8 @@ TEST(CliMjcf, WritesTheMujocoModelToStdoutOrAFileAndNoFileOnBadInput) {
   expect_error(run({"mjcf", "--config", malformed, "--out", bad_out}), 2, {"mjcf_malformed.yaml", "Rb"});
   const std::string plain = write_file("mjcf_plain.yaml", replace_line(kSymmetric, 9, "  lead: 0"));
   expect_error(run({"mjcf", "--config", plain, "--out", bad_out}), 2, {"mjcf_plain.yaml", "lead"});
-  expect_error(run({"mjcf", "--config", (temp_dir() / "missing.yaml").string(), "--out", bad_out}), 2, {"missing.yaml"});
+  expect_error(run({"mjcf", "--config", (temp_dir() / "missing.yaml").string(), "--out", bad_out}), 2,
+               {"missing.yaml"});
   EXPECT_FALSE(std::filesystem::exists(bad_out));
   expect_error(run({"mjcf", "--out", (temp_dir() / "no/such/dir/x.xml").string()}), 4, {"x.xml"});
 }
@@ -1295,8 +1305,7 @@ TEST(CliOutputs, AReusedFolderSaysSoAndItsSummaryListsOnlyThisRunsFiles) {
   EXPECT_EQ(first.err, "");
   EXPECT_TRUE(std::filesystem::exists(out / "reused_compensated.csv"));
   write_file("reused-out/notes.txt", "mine\n");
-  const Outcome second =
-      run({"simulate", "--trajectory", csv, "--out", out.string(), "--no-figures", "--no-csv"});
+  const Outcome second = run({"simulate", "--trajectory", csv, "--out", out.string(), "--no-figures", "--no-csv"});
   ASSERT_EQ(second.code, 0) << second.err;
   EXPECT_NE(second.err.find("was not empty: 2 files replaced, 2 of an earlier run removed; 1 other files left"),
             std::string::npos)
@@ -1326,8 +1335,8 @@ TEST(CliIdentify, JsonStatusAgreesWithTheExitCodeWhenTheConfigurationCannotBeWri
 TEST(CliIdentify, JsonOfDataThatCannotDetermineTheParametersHasNullsNotZeros) {
   const std::string log = (temp_dir() / "lz-json.csv").string();
   ASSERT_EQ(run({"synth", "--test", "Lz", "--out", log}).code, 0);
-  const Outcome r = run({"identify", "--points", log, "--test", "Lz", "--json", "--out",
-                         (temp_dir() / "lz-json.yaml").string()});
+  const Outcome r =
+      run({"identify", "--points", log, "--test", "Lz", "--json", "--out", (temp_dir() / "lz-json.yaml").string()});
   expect_error(r, 5, {"not identifiable"});
   const YAML::Node j = json(r);
   EXPECT_EQ(j["status"].as<std::string>(), "failed");
@@ -1357,9 +1366,11 @@ TEST(CliOptions, SynthOptionsOutOfTheirRangeAreRefused) {
 
 TEST(CliOptions, FiniteButAbsurdSynthValuesAreRefusedAsOutOfRangeNotAsNonFinite) {
   const std::string out = (temp_dir() / "absurd-options.csv").string();
-  for (const auto& [option, value] : std::vector<std::pair<std::string, std::string>>{
-           {"--noise-um", "1e9"}, {"--offsets-mm", "1e6"}, {"--offsets-mm", "0,0,0,0,0,2000"},
-           {"--point-offset-mm", "0,0,1e9"}}) {
+  for (const auto& [option, value] :
+       std::vector<std::pair<std::string, std::string>>{{"--noise-um", "1e9"},
+                                                        {"--offsets-mm", "1e6"},
+                                                        {"--offsets-mm", "0,0,0,0,0,2000"},
+                                                        {"--point-offset-mm", "0,0,1e9"}}) {
     const Outcome r = run({"synth", "--test", "Lz", "--out", out, option, value});
     expect_error(r, 2, {option + " ", "below the stroke"});
     EXPECT_EQ(r.err.find("finite"), std::string::npos) << r.err;
@@ -1369,7 +1380,8 @@ TEST(CliOptions, FiniteButAbsurdSynthValuesAreRefusedAsOutOfRangeNotAsNonFinite)
 
 TEST(CliOptions, FiniteButAbsurdStreamAndSettleValuesAreRefusedNamingTheirRange) {
   const std::string none;
-  expect_error(run({"stream", "--max-velocity", "1", "--rate", "1e300"}, &none), 2, {"--rate 1e+300", "at most 1e6 Hz"});
+  expect_error(run({"stream", "--max-velocity", "1", "--rate", "1e300"}, &none), 2,
+               {"--rate 1e+300", "at most 1e6 Hz"});
   expect_error(run({"stream", "--rt-priority", "500"}, &none), 2, {"--rt-priority 500", "SCHED_FIFO priority 1..99"});
   expect_error(run({"stream", "--rt-priority", "-1"}, &none), 2, {"--rt-priority -1", "or 0 for none"});
   const std::string tracker = std::string(HEXATWIST_SOURCE_DIR) + "/examples/tracker_Rz.csv";
@@ -1430,8 +1442,7 @@ TEST(CliConfig, ALeadLongerThanTheStrokeIsRefusedAtLoad) {
 }
 
 TEST(CliConfig, LengthOffsetsThatPutHomeOutsideTheStrokeAreRefusedAtLoad) {
-  const std::string bad =
-      write_file("offset-home.yaml", kSymmetric + "length_offsets: [-0.9, 0, 0, 0, 0, 0]\n");
+  const std::string bad = write_file("offset-home.yaml", kSymmetric + "length_offsets: [-0.9, 0, 0, 0, 0, 0]\n");
   expect_error(run({"config", "--config", bad}), 2, {"offset-home.yaml:17:", "length_offset", "outside the stroke"});
 }
 
@@ -1477,8 +1488,9 @@ TEST(CliDynamics, TheExampleWritesCsvJsonAndFigureAndExceedsTheSeedMotorsSpeed) 
   const Outcome r = run({"dynamics", "--trajectory", example, "--out", out.string()});
   // 65 deg/s of yaw and 63 deg/s of roll need legs faster than the seed's 0.5 m/s (3000 rpm at
   // 10 mm lead): exit 3, and the report is kept.
-  expect_error(r, 3, {"motion_simulator.csv", "motor envelope exceeded", "leg 4 at t = 0.930 s", "motor speed",
-                      "above the maximum 3000 rpm"});
+  expect_error(r, 3,
+               {"motion_simulator.csv", "motor envelope exceeded", "leg 4 at t = 0.930 s", "motor speed",
+                "above the maximum 3000 rpm"});
   EXPECT_NE(r.out.find("envelope: EXCEEDED: leg 4 at t = 0.930 s"), std::string::npos) << r.out;
   const YAML::Node s = YAML::LoadFile((out / "summary.json").string());
   EXPECT_EQ(s["envelope"].as<std::string>(), "exceeded");

@@ -16,7 +16,8 @@ TEST(Compensation, CompensatedCommandsReachTheCommandedPoseExactly) {
     const Model model = m == 0 ? seed_model() : random_platform(rng);
     const int count = m == 0 ? 2000 : 100;
     for (int n = 0; n < count; ++n) {
-      const Pose p = m == 0 ? random_valid_pose(model, rng, 0.5, deg2rad(30)) : random_valid_pose(model, rng, 0.2, deg2rad(15));
+      const Pose p =
+          m == 0 ? random_valid_pose(model, rng, 0.5, deg2rad(30)) : random_valid_pose(model, rng, 0.2, deg2rad(15));
       Vector6d cmd;
       LimitReport lim;
       ASSERT_EQ(motor_commands(model, p, Strategy::Compensated, cmd, lim), Status::Ok) << str(p);
@@ -24,7 +25,8 @@ TEST(Compensation, CompensatedCommandsReachTheCommandedPoseExactly) {
       ASSERT_EQ(forward_kinematics(model, cmd, LengthKind::Motor, Placement{}, r), Status::Ok) << str(p);
       const PoseError e = pose_error(r.placement, placement_from_pose(p));
       const Vector3d A = model.spec().observation_P;
-      const double obs = (platform_point_B(model, r.placement, A) - platform_point_B(model, placement_from_pose(p), A)).norm();
+      const double obs =
+          (platform_point_B(model, r.placement, A) - platform_point_B(model, placement_from_pose(p), A)).norm();
       const double tol = m == 0 ? 1e-11 : 1e-10;
       EXPECT_LT(e.position, tol) << str(p);
       EXPECT_LT(e.rotation, tol) << str(p);
@@ -46,7 +48,9 @@ TEST(Compensation, ConventionalCommandsMissThePoseByTheTwist) {
     FkResult r;
     ASSERT_EQ(forward_kinematics(seed_model(), cmd, LengthKind::Motor, Placement{}, r), Status::Ok);
     const Vector3d A = seed_model().spec().observation_P;
-    const double miss = (platform_point_B(seed_model(), r.placement, A) - platform_point_B(seed_model(), placement_from_pose(p), A)).norm();
+    const double miss =
+        (platform_point_B(seed_model(), r.placement, A) - platform_point_B(seed_model(), placement_from_pose(p), A))
+            .norm();
     EXPECT_GT(miss, previous) << yaw_deg;
     previous = miss;
   }
@@ -112,8 +116,7 @@ TEST(Compensation, RealTimePathAndFullReportReachTheSameLimitDecision) {
 
 // The command as it was before the cheap condition proof: every limit of check_limits, but the
 // platform singularity decided by the exact condition number (jacobian_condition) at every pose.
-Status reference_command(const Model& model, const Pose& p, Strategy strategy, Vector6d& command,
-                         LimitReport& r) {
+Status reference_command(const Model& model, const Pose& p, Strategy strategy, Vector6d& command, LimitReport& r) {
   r = LimitReport{};
   if (!p.is_finite()) return r.status = Status::NonFiniteInput;
   LegState legs;
@@ -128,7 +131,8 @@ Status reference_command(const Model& model, const Pose& p, Strategy strategy, V
   Vector6d dtheta = Vector6d::Zero();
   if (strategy == Strategy::Compensated && model.has_twist()) {
     if (const Status s = twist(model, legs, dtheta); s != Status::Ok) return r.status = s;
-    const Vector6d cmd = legs.length - model.geometry().length_offset - model.geometry().twist_gain.cwiseProduct(dtheta);
+    const Vector6d cmd =
+        legs.length - model.geometry().length_offset - model.geometry().twist_gain.cwiseProduct(dtheta);
     if (const Status s = check_stroke(model, cmd, r); s != Status::Ok) return s;
     command = cmd;
   } else {
@@ -173,7 +177,8 @@ TEST(Compensation, CheapConditionProofLeavesEveryVerdictBitForBit) {
       ASSERT_EQ(s, ref) << str(p) << " kind " << kind;
       ASSERT_EQ(r.status, ref_r.status) << str(p);
       ASSERT_EQ(r.leg, ref_r.leg) << str(p);
-      ASSERT_TRUE(std::memcmp(&r.value, &ref_r.value, sizeof(double)) == 0) << str(p) << " " << r.value << " " << ref_r.value;
+      ASSERT_TRUE(std::memcmp(&r.value, &ref_r.value, sizeof(double)) == 0)
+          << str(p) << " " << r.value << " " << ref_r.value;
       ASSERT_EQ(r.bound, ref_r.bound) << str(p);
       // The command itself comes before the condition in both (the fast path's lanes differ from
       // the reference's LegState by rounding): written or not alike, and the same to rounding.
@@ -228,7 +233,8 @@ TEST(Compensation, CheapConditionProofLeavesEveryVerdictOnAsymmetricPlatforms) {
       }
     }
   }
-  std::printf("  %ld poses on 30 platforms: %ld commands Ok, %ld refused for the platform singularity\n", n, ok, singular);
+  std::printf("  %ld poses on 30 platforms: %ld commands Ok, %ld refused for the platform singularity\n", n, ok,
+              singular);
   EXPECT_GT(ok, n / 4);
   EXPECT_GT(singular, n / 20);
 }

@@ -240,8 +240,7 @@ TEST(Config, BadLengthOffsetsAreLocated) {
   expect_error(kSymmetric + "length_offsets: 0.001\n", line, {"field 'length_offsets'", "6 numbers", "scalar"});
   expect_error(kSymmetric + "length_offsets: [0, 0, x, 0, 0, 0]\n", line, {"field 'length_offsets[2]'", "number"});
   // The model's own check (shorter than the stroke), at the entry it came from.
-  expect_error(kSymmetric + "length_offsets: [0, 0, 0, 1.5, 0, 0]\n", line,
-               {"field 'length_offsets[3]'", "stroke"});
+  expect_error(kSymmetric + "length_offsets: [0, 0, 0, 1.5, 0, 0]\n", line, {"field 'length_offsets[3]'", "stroke"});
 }
 
 TEST(Config, ZeroLeadLegsFormNeedsNoAxesAndNoThread) {
@@ -286,7 +285,8 @@ TEST(Config, JacobianConditionLimitIsOptionalAndValidated) {
   EXPECT_EQ(m.spec().limits.jacobian_condition_max, 30.0);
   expect_error(kSymmetric + "  jacobian_condition_max: 1\n", 17, {"field 'limits.jacobian_condition_max'", "> 1"});
   expect_error(kSymmetric + "  jacobian_condition_max: .nan\n", 17, {"field 'limits.jacobian_condition_max'"});
-  expect_error(kSymmetric + "  jacobian_condition_max: many\n", 17, {"field 'limits.jacobian_condition_max'", "'many'"});
+  expect_error(kSymmetric + "  jacobian_condition_max: many\n", 17,
+               {"field 'limits.jacobian_condition_max'", "'many'"});
   expect_error(kSymmetric + "  jacobian_condition_max: 4\n", 17, {"field 'limits.jacobian_condition_max'", "home"});
 }
 
@@ -336,7 +336,8 @@ TEST(Config, TextWhereANumberBelongsIsRejected) {
 TEST(Config, EmptyValueIsReportedOnItsOwnLine) {
   // yaml-cpp marks an empty value at the next key; the message must still point at "Rb:".
   expect_error(replace_line(kSymmetric, 4, "  Rb:"), 4, {"field 'symmetric.Rb'"});
-  expect_error(replace_line(kSymmetric, 16, "  singularity_margin_deg:"), 16, {"field 'limits.singularity_margin_deg'"});
+  expect_error(replace_line(kSymmetric, 16, "  singularity_margin_deg:"), 16,
+               {"field 'limits.singularity_margin_deg'"});
 }
 
 TEST(Config, NanAndInfAreRejected) {
@@ -393,7 +394,8 @@ TEST(Config, UnknownKeyIsRejected) {
 
 TEST(Config, KeyGivenTwiceIsRejected) {
   // yaml-cpp would silently keep the first value.
-  expect_error(replace_line(kSymmetric, 9, "  lead: 0.010\n  lead: 0.005"), 10, {"field 'screw.lead'", "twice", "line 9"});
+  expect_error(replace_line(kSymmetric, 9, "  lead: 0.010\n  lead: 0.005"), 10,
+               {"field 'screw.lead'", "twice", "line 9"});
 }
 
 TEST(Config, LegsListMustHoldSixLegs) {
@@ -416,8 +418,10 @@ TEST(Config, NeitherSymmetricNorLegsIsRejected) {
 }
 
 TEST(Config, ThreadMustBeRightOrLeft) {
-  expect_error(replace_line(kSymmetric, 10, "  thread: sideways"), 10, {"field 'screw.thread'", "right or left", "'sideways'"});
-  expect_error(replace_line(kSymmetric, 11, "  driven_side: middle"), 11, {"field 'screw.driven_side'", "base or platform"});
+  expect_error(replace_line(kSymmetric, 10, "  thread: sideways"), 10,
+               {"field 'screw.thread'", "right or left", "'sideways'"});
+  expect_error(replace_line(kSymmetric, 11, "  driven_side: middle"), 11,
+               {"field 'screw.driven_side'", "base or platform"});
 }
 
 TEST(Config, ThreadAndDrivenSideAreRequiredWhenLeadIsPositive) {
@@ -455,19 +459,19 @@ namespace hexatwist {
 namespace {
 
 const std::string kRigSections =
-    "servo:\n"                          // 17
-    "  max_speed_rpm: 1500\n"           // 18
-    "  kp: 100\n"                       // 19
-    "  ki: 1000\n"                      // 20
-    "  kd: 0.5\n"                       // 21
-    "load:\n"                           // 22
-    "  mass: 900\n"                     // 23
-    "  inertia: [100, 200, 300]\n"      // 24
-    "simulation:\n"                     // 25
-    "  control_rate_hz: 2000\n"         // 26
-    "  plant_step: 1.0e-4\n"            // 27
-    "study:\n"                          // 28
-    "  angular_amplitude_deg: 20\n"     // 29
+    "servo:\n"                                                  // 17
+    "  max_speed_rpm: 1500\n"                                   // 18
+    "  kp: 100\n"                                               // 19
+    "  ki: 1000\n"                                              // 20
+    "  kd: 0.5\n"                                               // 21
+    "load:\n"                                                   // 22
+    "  mass: 900\n"                                             // 23
+    "  inertia: [100, 200, 300]\n"                              // 24
+    "simulation:\n"                                             // 25
+    "  control_rate_hz: 2000\n"                                 // 26
+    "  plant_step: 1.0e-4\n"                                    // 27
+    "study:\n"                                                  // 28
+    "  angular_amplitude_deg: 20\n"                             // 29
     "  linear: {velocity: 0.1, acceleration: 0.4, jerk: 2}\n";  // 30
 
 std::string config_error(const std::string& yaml) {
@@ -529,7 +533,8 @@ TEST(Config, RigSectionErrorsNameLineAndField) {
       {19, "  kp: 0", "rig.yaml:19:7: field 'servo.kp': expected > 0 when ki or kd is given"},
       {23, "  mass: heavy", "rig.yaml:23:9: field 'load.mass': expected a number"},
       {24, "  inertia: [100, 200]", "rig.yaml:24:"},
-      {27, "  plant_step: 0.01", "rig.yaml:27:15: field 'simulation.plant_step': 0.01 s is longer than the control period"},
+      {27, "  plant_step: 0.01",
+       "rig.yaml:27:15: field 'simulation.plant_step': 0.01 s is longer than the control period"},
       {30, "  linear: {velocity: 0.1, acceleration: 0, jerk: 2}", "field 'study.linear.acceleration': expected > 0"},
   };
   for (const auto& c : cases) {
@@ -539,7 +544,6 @@ TEST(Config, RigSectionErrorsNameLineAndField) {
   // The servo needs a screw on every leg.
   EXPECT_NE(config_error(test::replace_line(base, 9, "  lead: 0")).find("needs a lead screw"), std::string::npos);
 }
-
 
 // ---- corrected configuration (identify's output) ------------------------------------------------
 
@@ -621,8 +625,8 @@ TEST(Config, CorrectedConfigRefusesBadTextAndLegsThatDiffer) {
   ModelSpec spec = corrected_of(test::seed_model().spec());
   test::expect_error_line([&] { (void)corrected_config_yaml("screw: [", "bad.yaml", spec, ""); }, "bad.yaml:");
   spec.legs[3].lead = 0.011;
-  test::expect_error_line([&] { (void)corrected_config_yaml(seed, "seed.yaml", spec, ""); }, "seed.yaml: corrected model:",
-                    {"leg 4", "one screw"});
+  test::expect_error_line([&] { (void)corrected_config_yaml(seed, "seed.yaml", spec, ""); },
+                          "seed.yaml: corrected model:", {"leg 4", "one screw"});
 }
 
 }  // namespace

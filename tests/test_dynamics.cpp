@@ -2,8 +2,8 @@
 // pose that forward kinematics gives for perturbed leg lengths).
 #include <gtest/gtest.h>
 
-#include "hexatwist/io/config.hpp"
 #include "hexatwist/dynamics/dynamics.hpp"
+#include "hexatwist/io/config.hpp"
 #include "support.hpp"
 
 #include <Eigen/Eigenvalues>

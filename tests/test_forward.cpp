@@ -69,9 +69,11 @@ TEST(Forward, WarmStartFromOneMillisecondEarlierTakesFewIterations) {
     const double t = 1e-3 * k, w = 2 * kPi * 0.5;
     Pose p;
     p.position = Vector3d(0.2 * std::sin(w * t), 0.15 * std::sin(1.3 * w * t), 0.15 * std::sin(0.7 * w * t));
-    p.rpy = Vector3d(deg2rad(6) * std::sin(0.9 * w * t), deg2rad(10) * std::sin(1.1 * w * t), deg2rad(15) * std::sin(w * t));
+    p.rpy = Vector3d(deg2rad(6) * std::sin(0.9 * w * t), deg2rad(10) * std::sin(1.1 * w * t),
+                     deg2rad(15) * std::sin(w * t));
     const Placement x = placement_from_pose(p);
-    ASSERT_EQ(forward_kinematics(seed_model(), lengths_for(seed_model(), x, LengthKind::Motor), LengthKind::Motor, previous, r),
+    ASSERT_EQ(forward_kinematics(seed_model(), lengths_for(seed_model(), x, LengthKind::Motor), LengthKind::Motor,
+                                 previous, r),
               Status::Ok);
     EXPECT_LT(pose_error(r.placement, x).position, kRoundTripTol);
     worst = std::max(worst, r.iterations);
@@ -87,8 +89,10 @@ Matrix6d residual_jacobian_fd(const Model& model, const Placement& x, const Vect
     Vector6d d = Vector6d::Zero();
     d[k] = h;
     Vector6d fp, fm;
-    EXPECT_EQ(fk_residual(model, {x.t + d.head<3>(), exp_so3(d.tail<3>()) * x.R_BP}, m, kind, st, fp, nullptr), Status::Ok);
-    EXPECT_EQ(fk_residual(model, {x.t - d.head<3>(), exp_so3(-d.tail<3>()) * x.R_BP}, m, kind, st, fm, nullptr), Status::Ok);
+    EXPECT_EQ(fk_residual(model, {x.t + d.head<3>(), exp_so3(d.tail<3>()) * x.R_BP}, m, kind, st, fp, nullptr),
+              Status::Ok);
+    EXPECT_EQ(fk_residual(model, {x.t - d.head<3>(), exp_so3(-d.tail<3>()) * x.R_BP}, m, kind, st, fm, nullptr),
+              Status::Ok);
     J.col(k) = (fp - fm) / (2 * h);
   }
   return J;
@@ -101,7 +105,8 @@ TEST(Forward, ResidualJacobianMatchesCentralFiniteDifferences) {
     for (const LengthKind kind : {LengthKind::Geometric, LengthKind::Motor}) {
       for (int n = 0; n < 20; ++n) {
         const Placement x = placement_from_pose(random_valid_pose(model, rng, 0.3, deg2rad(25)));
-        const Vector6d target = lengths_for(model, placement_from_pose(random_valid_pose(model, rng, 0.3, deg2rad(25))), kind);
+        const Vector6d target =
+            lengths_for(model, placement_from_pose(random_valid_pose(model, rng, 0.3, deg2rad(25))), kind);
         LegState st;
         Vector6d f;
         Matrix6d J;
@@ -125,7 +130,8 @@ TEST(Forward, MotorModeDiffersFromGeometricModeByTheTwist) {
   ASSERT_EQ(forward_kinematics(seed_model(), m, LengthKind::Motor, Placement{}, mot), Status::Ok);
   EXPECT_LT(pose_error(mot.placement, placement_from_pose(p)).position, kRoundTripTol);
   const Vector3d A = seed_model().spec().observation_P;
-  const double miss = (platform_point_B(seed_model(), geo.placement, A) - platform_point_B(seed_model(), mot.placement, A)).norm();
+  const double miss =
+      (platform_point_B(seed_model(), geo.placement, A) - platform_point_B(seed_model(), mot.placement, A)).norm();
   EXPECT_GT(miss, 0.5e-3);
   EXPECT_LT(miss, 5e-3);
 }
@@ -234,7 +240,9 @@ TEST(Forward, ConvergesFromHomeOnAHundredThousandPosesAcrossTheReachableWorkspac
 }
 
 // Motor-side lengths of a pose of `model`.
-Vector6d motor_lengths(const Model& model, const Pose& p) { return lengths_for(model, placement_from_pose(p), LengthKind::Motor); }
+Vector6d motor_lengths(const Model& model, const Pose& p) {
+  return lengths_for(model, placement_from_pose(p), LengthKind::Motor);
+}
 
 TEST(Forward, ConvergesFromFarGuessesOnAsymmetricPlatforms) {
   // Guess and solution both drawn inside every limit, up to 0.4 m and 30 deg apart. Newton may
@@ -249,8 +257,9 @@ TEST(Forward, ConvergesFromFarGuessesOnAsymmetricPlatforms) {
       const Placement guess = placement_from_pose(random_valid_pose(model, rng, 0.2, deg2rad(15)));
       FkResult r, at_guess;
       const Status s = forward_kinematics(model, motor_lengths(model, p), LengthKind::Motor, guess, r);
-      ASSERT_EQ(forward_kinematics(model, lengths_for(model, guess, LengthKind::Motor), LengthKind::Motor, guess, at_guess),
-                Status::Ok);
+      ASSERT_EQ(
+          forward_kinematics(model, lengths_for(model, guess, LengthKind::Motor), LengthKind::Motor, guess, at_guess),
+          Status::Ok);
       if (s == Status::AssemblyModeChanged) {
         EXPECT_NE(r.det_sign, at_guess.det_sign);
         ++other_mode;
@@ -287,7 +296,8 @@ TEST(Forward, ConvergesNearPoorlyConditionedSolutionsOnAsymmetricPlatforms) {
       near.position += Vector3d::Constant(5e-3 / std::sqrt(3.0));
       near.rpy += Vector3d::Constant(deg2rad(0.3) / std::sqrt(3.0));
       FkResult r;
-      ASSERT_EQ(forward_kinematics(model, c.compensated, LengthKind::Motor, placement_from_pose(near), r), Status::Ok) << str(p);
+      ASSERT_EQ(forward_kinematics(model, c.compensated, LengthKind::Motor, placement_from_pose(near), r), Status::Ok)
+          << str(p);
       EXPECT_LT(pose_error(r.placement, placement_from_pose(p)).position, kRandomPlatformTol) << str(p);
       EXPECT_NEAR(r.condition, condition, 1e-6 * condition);
       const Status s = forward_kinematics(model, c.compensated, LengthKind::Motor, Placement{}, r);
@@ -387,9 +397,11 @@ TEST(Forward, CrossingOntoTheOtherAssemblyModeIsReported) {
       guess.rpy[2] = deg2rad(guess_yaw);
       target.rpy[2] = deg2rad(target_yaw);
       FkResult at_guess, r;
-      ASSERT_EQ(forward_kinematics(model, motor_lengths(model, guess), LengthKind::Motor, placement_from_pose(guess), at_guess),
+      ASSERT_EQ(forward_kinematics(model, motor_lengths(model, guess), LengthKind::Motor, placement_from_pose(guess),
+                                   at_guess),
                 Status::Ok);
-      const Status s = forward_kinematics(model, motor_lengths(model, target), LengthKind::Motor, placement_from_pose(guess), r);
+      const Status s =
+          forward_kinematics(model, motor_lengths(model, target), LengthKind::Motor, placement_from_pose(guess), r);
       if (s == Status::Ok) {
         EXPECT_EQ(r.det_sign, at_guess.det_sign) << guess_yaw << " -> " << target_yaw;
       }
@@ -413,7 +425,8 @@ TEST(Forward, TrackedStartsFromHomeAndFollowsAMotion) {
   FkResult r;
   Pose p;
   p.position = Vector3d(0.1, -0.05, 0.02);
-  ASSERT_EQ(forward_kinematics_tracked(seed_model(), motor_lengths(seed_model(), p), LengthKind::Motor, tracker, r), Status::Ok);
+  ASSERT_EQ(forward_kinematics_tracked(seed_model(), motor_lengths(seed_model(), p), LengthKind::Motor, tracker, r),
+            Status::Ok);
   EXPECT_TRUE(tracker.valid);
   EXPECT_EQ(tracker.det_sign, r.det_sign);
   EXPECT_LT(pose_error(tracker.last, placement_from_pose(p)).position, kRoundTripTol);
@@ -427,7 +440,8 @@ TEST(Forward, TrackedStartsFromHomeAndFollowsAMotion) {
 
 TEST(Forward, HomeLengthsGiveHomeWithoutIterating) {
   FkResult r;
-  ASSERT_EQ(forward_kinematics(seed_model(), seed_model().length_home(), LengthKind::Motor, Placement{}, r), Status::Ok);
+  ASSERT_EQ(forward_kinematics(seed_model(), seed_model().length_home(), LengthKind::Motor, Placement{}, r),
+            Status::Ok);
   EXPECT_EQ(r.iterations, 0);
   EXPECT_LT(r.pose.to_vector().cwiseAbs().maxCoeff(), 1e-15);
 }
@@ -484,8 +498,8 @@ TEST(Forward, ATrackerSetAtAPoseTracksFromThere) {
     ASSERT_TRUE(tracker.valid);
     // Its mode is the one forward kinematics finds at that pose.
     FkResult at;
-    ASSERT_EQ(forward_kinematics(model, lengths_for(model, placement_from_pose(p), LengthKind::Motor), LengthKind::Motor,
-                                 placement_from_pose(p), at),
+    ASSERT_EQ(forward_kinematics(model, lengths_for(model, placement_from_pose(p), LengthKind::Motor),
+                                 LengthKind::Motor, placement_from_pose(p), at),
               Status::Ok);
     EXPECT_EQ(tracker.det_sign, at.det_sign);
     // A pose 1 ms of fast motion away is found from there in few iterations.

@@ -1,12 +1,12 @@
 // The internal kernels of the real-time path: vectorised sin/cos and atan2 (src/kinematics/fast_math.hpp)
 // against libm, the fixed-size 6x6 LU and condition proof (src/kinematics/linear_solve.hpp) and the
 // Gauss-Jordan inverse on lane columns (src/kinematics/gauss_jordan.hpp) against Eigen.
+#include "hexatwist/hexatwist.hpp"
 #include "kinematics/fast_math.hpp"
 #include "kinematics/gauss_jordan.hpp"
 #include "kinematics/lanes.hpp"
 #include "kinematics/linear_solve.hpp"
 #include "kinematics/twist_internal.hpp"
-#include "hexatwist/hexatwist.hpp"
 #include "support.hpp"
 
 #include <Eigen/LU>
@@ -44,9 +44,9 @@ TEST(FastMath, Atan2MatchesLibmOverAllQuadrantsAndScales) {
 
 TEST(FastMath, Atan2HandlesAxesZerosAndInfinity) {
   const double inf = INFINITY;
-  const std::vector<std::pair<double, double>> cases{{0.0, 1.0},  {1.0, 0.0},  {0.0, -1.0}, {-1.0, 0.0}, {1.0, 1.0},
-                                                     {-1.0, -1.0}, {1.0, -0.0}, {-0.0, 1.0}, {0.0, 0.0},  {1e-300, 1.0},
-                                                     {1.0, 1e-300}, {inf, 1.0}, {1.0, inf},  {-1.0, -inf}};
+  const std::vector<std::pair<double, double>> cases{
+      {0.0, 1.0},  {1.0, 0.0}, {0.0, -1.0},   {-1.0, 0.0},   {1.0, 1.0}, {-1.0, -1.0}, {1.0, -0.0},
+      {-0.0, 1.0}, {0.0, 0.0}, {1e-300, 1.0}, {1.0, 1e-300}, {inf, 1.0}, {1.0, inf},   {-1.0, -inf}};
   for (const auto& [y, x] : cases) {
     Array6d ya = Array6d::Constant(y), xa = Array6d::Constant(x);
     EXPECT_NEAR(atan2(ya, xa)[0], std::atan2(y, x), 1e-15) << "atan2(" << y << ", " << x << ")";
@@ -61,7 +61,8 @@ TEST(FastMath, SinCosMatchLibmAndFallBackForHugeAngles) {
     const Vector3d a(1000 * u(rng), 10 * u(rng), u(rng));
     Vector3d s, c;
     sin_cos(a, s, c);
-    for (int k = 0; k < 3; ++k) worst = std::max({worst, std::abs(s[k] - std::sin(a[k])), std::abs(c[k] - std::cos(a[k]))});
+    for (int k = 0; k < 3; ++k)
+      worst = std::max({worst, std::abs(s[k] - std::sin(a[k])), std::abs(c[k] - std::cos(a[k]))});
   }
   EXPECT_LT(worst, 2e-15);  // measured 2.2e-16
   const Vector3d huge(1e7, -3e9, kPi);
@@ -345,7 +346,8 @@ TEST(Lanes, TwistShareBoundCoversTheMotorSideJacobiansTwistRows) {
     Vector6d d;
     d << 1, 1, 1, 1 / model.condition_length(), 1 / model.condition_length(), 1 / model.condition_length();
     for (int n = 0; n < 3000; ++n) {
-      const Pose p = m == 1 ? random_valid_pose(model, rng, 0.8, deg2rad(80)) : random_valid_pose(model, rng, 0.4, deg2rad(30));
+      const Pose p =
+          m == 1 ? random_valid_pose(model, rng, 0.8, deg2rad(80)) : random_valid_pose(model, rng, 0.4, deg2rad(30));
       LegState st;
       ASSERT_EQ(inverse_kinematics(model, p, st), Status::Ok);
       Matrix6d Jm, Jg;
@@ -359,7 +361,8 @@ TEST(Lanes, TwistShareBoundCoversTheMotorSideJacobiansTwistRows) {
         const lane_v length = load6(st.length.data(), k), dot_a = dot(leg, ja), dot_d = dot(leg, jd);
         const lane_v length2 = length * length;
         const TwistTerms t = twist_terms(leg, ja, jd, dot_a, dot_d, length2);
-        const lane_v leg_bound = twist_share_bound(model, t.x, length * t.y, dot_a, dot_d, length, length2, 1.0 / length, k);
+        const lane_v leg_bound =
+            twist_share_bound(model, t.x, length * t.y, dot_a, dot_d, length, length2, 1.0 / length, k);
         sum += leg_bound;
         // Leg by leg, the bound is on the larger of the two halves' Euclidean norms.
         for (int l = 0; l < kWidth && k * kWidth + l < kLegs; ++l) {

@@ -23,8 +23,8 @@ TEST(Kinematics, SeedAxesAreThoseOfEquationSix) {
   const double r = std::sqrt(3.0) / 2.0;
   const std::array<Vector3d, kLegs> ja{Vector3d(-r, 0.5, 0), Vector3d(r, 0.5, 0), Vector3d(r, 0.5, 0),
                                        Vector3d(0, -1, 0),   Vector3d(0, -1, 0),  Vector3d(-r, 0.5, 0)};
-  const std::array<Vector3d, kLegs> jd{Vector3d(0, 1, 0),     Vector3d(0, 1, 0),     Vector3d(r, -0.5, 0),
-                                       Vector3d(r, -0.5, 0),  Vector3d(-r, -0.5, 0), Vector3d(-r, -0.5, 0)};
+  const std::array<Vector3d, kLegs> jd{Vector3d(0, 1, 0),    Vector3d(0, 1, 0),     Vector3d(r, -0.5, 0),
+                                       Vector3d(r, -0.5, 0), Vector3d(-r, -0.5, 0), Vector3d(-r, -0.5, 0)};
   for (int i = 0; i < kLegs; ++i) {
     EXPECT_LT((seed_model().leg(i).axis_base_B - ja[static_cast<std::size_t>(i)]).norm(), 1e-15) << "leg " << i + 1;
     EXPECT_LT((seed_model().leg(i).axis_platform_P - jd[static_cast<std::size_t>(i)]).norm(), 1e-15) << "leg " << i + 1;
@@ -57,8 +57,10 @@ TEST(Kinematics, LengthJacobianMatchesCentralFiniteDifferences) {
       for (int k = 0; k < 6; ++k) {
         Vector6d d = Vector6d::Zero();
         d[k] = h;
-        ASSERT_EQ(inverse_kinematics(model, Placement{x.t + d.head<3>(), exp_so3(d.tail<3>()) * x.R_BP}, sp), Status::Ok);
-        ASSERT_EQ(inverse_kinematics(model, Placement{x.t - d.head<3>(), exp_so3(-d.tail<3>()) * x.R_BP}, sm), Status::Ok);
+        ASSERT_EQ(inverse_kinematics(model, Placement{x.t + d.head<3>(), exp_so3(d.tail<3>()) * x.R_BP}, sp),
+                  Status::Ok);
+        ASSERT_EQ(inverse_kinematics(model, Placement{x.t - d.head<3>(), exp_so3(-d.tail<3>()) * x.R_BP}, sm),
+                  Status::Ok);
         J_fd.col(k) = (sp.length - sm.length) / (2 * h);
       }
       EXPECT_LT((J - J_fd).cwiseAbs().maxCoeff(), 5e-9) << J << "\nvs\n" << J_fd;  // measured 4.3e-10

@@ -16,10 +16,12 @@ Status check(const Model& model, const Pose& p, LimitReport& r) {
 
 TEST(Limits, SeedTestExtremesAreInside) {
   // The seed's four tests at their extremes (notes §1) must pass the default limits.
-  for (const Vector6d& q : {(Vector6d() << 0.5, 0, 0, 0, 0, 0).finished(), (Vector6d() << -0.5, 0, 0, 0, 0, 0).finished(),
-                           (Vector6d() << 0, 0, 0.5, 0, 0, 0).finished(), (Vector6d() << 0, 0, -0.5, 0, 0, 0).finished(),
-                           (Vector6d() << 0, 0, 0, 0, deg2rad(30), 0).finished(), (Vector6d() << 0, 0, 0, 0, -deg2rad(30), 0).finished(),
-                           (Vector6d() << 0, 0, 0, 0, 0, deg2rad(30)).finished(), (Vector6d() << 0, 0, 0, 0, 0, -deg2rad(30)).finished()}) {
+  for (const Vector6d& q :
+       {(Vector6d() << 0.5, 0, 0, 0, 0, 0).finished(), (Vector6d() << -0.5, 0, 0, 0, 0, 0).finished(),
+        (Vector6d() << 0, 0, 0.5, 0, 0, 0).finished(), (Vector6d() << 0, 0, -0.5, 0, 0, 0).finished(),
+        (Vector6d() << 0, 0, 0, 0, deg2rad(30), 0).finished(), (Vector6d() << 0, 0, 0, 0, -deg2rad(30), 0).finished(),
+        (Vector6d() << 0, 0, 0, 0, 0, deg2rad(30)).finished(),
+        (Vector6d() << 0, 0, 0, 0, 0, -deg2rad(30)).finished()}) {
     LimitReport r;
     EXPECT_EQ(check(seed_model(), Pose::from_vector(q), r), Status::Ok) << q.transpose();
   }
@@ -87,8 +89,8 @@ TEST(Limits, SingularityMarginIsReportedForTheRightJoint) {
     ++found;
     LegState st;
     ASSERT_EQ(inverse_kinematics(model, p, st), Status::Ok);
-    const Vector3d axis = s == Status::SingularBase ? model.leg(r.leg).axis_base_B
-                                                    : Vector3d(st.axis_platform_B.row(r.leg).transpose());
+    const Vector3d axis =
+        s == Status::SingularBase ? model.leg(r.leg).axis_base_B : Vector3d(st.axis_platform_B.row(r.leg).transpose());
     EXPECT_NEAR(std::sin(r.value), st.s_B.row(r.leg).transpose().cross(axis).norm(), 1e-12);
     EXPECT_LT(r.value, r.bound);
   }
@@ -154,12 +156,14 @@ TEST(Limits, AStrokeEndIsInsideOnEveryPathAndPastItOutside) {
   const Pose up = pose_of(0.05, -0.02, 0.25, 2, -3, 5);
   LegState st;
   ASSERT_EQ(inverse_kinematics(seed_model(), up, st), Status::Ok);
-  expect_on_the_bound_is_inside(up, st.length.maxCoeff(), true, [](ModelSpec& s, double b) { s.limits.length_max = b; },
-                                Status::StrokeAboveMax, false);
+  expect_on_the_bound_is_inside(
+      up, st.length.maxCoeff(), true, [](ModelSpec& s, double b) { s.limits.length_max = b; }, Status::StrokeAboveMax,
+      false);
   const Pose down = pose_of(-0.04, 0.03, -0.2, -2, 1, -6);
   ASSERT_EQ(inverse_kinematics(seed_model(), down, st), Status::Ok);
-  expect_on_the_bound_is_inside(down, st.length.minCoeff(), false, [](ModelSpec& s, double b) { s.limits.length_min = b; },
-                                Status::StrokeBelowMin, false);
+  expect_on_the_bound_is_inside(
+      down, st.length.minCoeff(), false, [](ModelSpec& s, double b) { s.limits.length_min = b; },
+      Status::StrokeBelowMin, false);
 }
 
 TEST(Limits, ABendOnItsLimitIsInsideOnEveryPathAndPastItOutside) {
@@ -169,8 +173,9 @@ TEST(Limits, ABendOnItsLimitIsInsideOnEveryPathAndPastItOutside) {
     Vector6d bb, bp;
     bend_angles(seed_model(), st, bb, bp);
     const Status refused = bb.maxCoeff() >= bp.maxCoeff() ? Status::BendBase : Status::BendPlatform;
-    expect_on_the_bound_is_inside(p, std::max(bb.maxCoeff(), bp.maxCoeff()), true,
-                                  [](ModelSpec& s, double b) { s.limits.bend_max = b; }, refused, true);
+    expect_on_the_bound_is_inside(
+        p, std::max(bb.maxCoeff(), bp.maxCoeff()), true, [](ModelSpec& s, double b) { s.limits.bend_max = b; }, refused,
+        true);
   }
 }
 
@@ -202,8 +207,8 @@ TEST(Limits, ASingularityMarginMetExactlyIsInsideOnEveryPathAndPastItOutside) {
     ASSERT_EQ(inverse_kinematics(seed_model(), p, st), Status::Ok);
     const double angle = smallest(seed_model(), st, which);
     if (!(angle < at_home - 1e-6)) continue;
-    expect_on_the_bound_is_inside(p, angle, false, [](ModelSpec& s, double b) { s.limits.singularity_margin = b; },
-                                  which, true);
+    expect_on_the_bound_is_inside(
+        p, angle, false, [](ModelSpec& s, double b) { s.limits.singularity_margin = b; }, which, true);
     ++tested;
   }
   EXPECT_GT(tested, 0);
@@ -215,8 +220,9 @@ TEST(Limits, AConditionNumberOnItsLimitIsInsideOnEveryPathAndPastItOutside) {
   ASSERT_EQ(inverse_kinematics(seed_model(), p, st), Status::Ok);
   double condition;
   ASSERT_EQ(jacobian_condition(seed_model(), st, condition), Status::Ok);
-  expect_on_the_bound_is_inside(p, condition, true, [](ModelSpec& s, double b) { s.limits.jacobian_condition_max = b; },
-                                Status::PlatformSingularity, true);
+  expect_on_the_bound_is_inside(
+      p, condition, true, [](ModelSpec& s, double b) { s.limits.jacobian_condition_max = b; },
+      Status::PlatformSingularity, true);
 }
 
 TEST(Limits, CommandsOnTheStrokeEndsAndWithinTheToleranceAreInsideBeyondOutside) {
@@ -230,8 +236,8 @@ TEST(Limits, CommandsOnTheStrokeEndsAndWithinTheToleranceAreInsideBeyondOutside)
   for (int leg = 0; leg < kLegs; ++leg) {
     SCOPED_TRACE(leg);
     Vector6d cmd = m.length_home();
-    for (const double inside : {hi, std::nextafter(hi, INFINITY), accepted_max(hi), lo, std::nextafter(lo, 0.0),
-                                accepted_min(lo)}) {
+    for (const double inside :
+         {hi, std::nextafter(hi, INFINITY), accepted_max(hi), lo, std::nextafter(lo, 0.0), accepted_min(lo)}) {
       cmd[leg] = inside;
       EXPECT_EQ(check_stroke(m, cmd, r), Status::Ok) << std::setprecision(17) << inside;
     }
@@ -356,7 +362,7 @@ TEST(Limits, PureYawTowardsTheSingularityIsRefusedByTheConditionLimit) {
   std::printf("  refused from yaw %.1f deg\n", refused_at);
   EXPECT_GT(refused_at, 80.0);
   EXPECT_LT(refused_at, 88.0);  // measured: 86.3 deg
-  EXPECT_GT(previous, 1e3);  // at 90 deg
+  EXPECT_GT(previous, 1e3);     // at 90 deg
 }
 
 TEST(Limits, ModelRefusesAHomeBeyondTheConditionLimit) {

@@ -398,12 +398,12 @@ TEST(Measurement, StationsRefuseBadSpecsInOneLine) {
   const Model model = test::seed_model();
   StationsSpec spec;
   spec.count = 0;
-  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); }, "stations:",
-                          {"1 to 10000", "got 0"});
+  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
+                          "stations:", {"1 to 10000", "got 0"});
   spec.count = 3;
   spec.translation = std::nan("");
-  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); }, "stations:",
-                          {"finite"});
+  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
+                          "stations:", {"finite"});
   // Far outside the workspace: within +-30 m, a draw inside the seed's +-0.5 m has odds of 1e-5.
   spec.translation = 30.0;
   test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },

@@ -6,9 +6,9 @@
 
 #include <cmath>
 
-#include "hexatwist/io/config.hpp"
 #include "hexatwist/dynamics/dynamics.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
+#include "hexatwist/io/config.hpp"
 #include "hexatwist/kinematics/twist.hpp"
 #include "support.hpp"
 
@@ -118,9 +118,7 @@ TEST(Mechanism, PlatformMotionMatchesTheRotationsDerivatives) {
   for (int trial = 0; trial < 20; ++trial) {
     const Pose pose = random_pose(rng, 0.2, deg2rad(40));
     const Vector6d rate = random_vector(rng, 0.5, 1.5), acc = random_vector(rng, 2.0, 4.0);
-    const auto at = [&](double t) {
-      return Pose::from_vector(pose.to_vector() + t * rate + 0.5 * t * t * acc);
-    };
+    const auto at = [&](double t) { return Pose::from_vector(pose.to_vector() + t * rate + 0.5 * t * t * acc); };
     const auto omega = [&](double t) {
       const double h = 1e-6;
       const Matrix3d Rp = rotation_from_rpy(at(t + h).rpy), Rm = rotation_from_rpy(at(t - h).rpy);
@@ -152,7 +150,8 @@ TEST(Mechanism, MassMatrixIsTheHessianOfTheKineticEnergy) {
     for (int i = 0; i < 6; ++i)
       for (int j = 0; j < 6; ++j) {
         const Vector6d ei = Vector6d::Unit(i), ej = Vector6d::Unit(j);
-        H(i, j) = i == j ? 2.0 * kinetic(rig, x, ei) : kinetic(rig, x, ei + ej) - kinetic(rig, x, ei) - kinetic(rig, x, ej);
+        H(i, j) =
+            i == j ? 2.0 * kinetic(rig, x, ei) : kinetic(rig, x, ei + ej) - kinetic(rig, x, ei) - kinetic(rig, x, ej);
       }
     worst = std::max(worst, (M - H).cwiseAbs().maxCoeff() / H.cwiseAbs().maxCoeff());
   }
@@ -294,7 +293,8 @@ TEST(Mechanism, ForwardDynamicsInvertsInverseDynamics) {
     ASSERT_EQ(inverse_dynamics(rig, motion, id), Status::Ok);
     Vector6d acc;
     ASSERT_EQ(forward_dynamics(rig, motion.placement, motion.velocity, id.torque, acc), Status::Ok);
-    worst = std::max(worst, (acc - motion.acceleration).cwiseAbs().maxCoeff() / motion.acceleration.cwiseAbs().maxCoeff());
+    worst =
+        std::max(worst, (acc - motion.acceleration).cwiseAbs().maxCoeff() / motion.acceleration.cwiseAbs().maxCoeff());
   }
   report("relative difference of the acceleration", worst);
   EXPECT_LT(worst, 1e-10);
@@ -321,11 +321,10 @@ TEST(Mechanism, ShareOfGravityIsTheHoldingTorqueAndFrictionVanishesWithoutIt) {
       const double screw = b.torque[i] - b.drives[i];
       const double speed = a.speed[i];
       if (std::abs(speed) < 20.0 * with.servo().friction_speed) continue;
-      const double expected_loss = (screw * speed > 0.0 ? 1.0 / with.mechanism().efficiency - 1.0
-                                                        : with.mechanism().back_efficiency - 1.0) *
-                                       screw +
-                                   with.servo().viscous_friction * speed +
-                                   with.servo().coulomb_friction * (speed > 0 ? 1.0 : -1.0);
+      const double expected_loss =
+          (screw * speed > 0.0 ? 1.0 / with.mechanism().efficiency - 1.0 : with.mechanism().back_efficiency - 1.0) *
+              screw +
+          with.servo().viscous_friction * speed + with.servo().coulomb_friction * (speed > 0 ? 1.0 : -1.0);
       EXPECT_NEAR(a.friction[i], expected_loss, 1e-6 * std::abs(screw) + 1e-9) << "leg " << i + 1;
     }
   }

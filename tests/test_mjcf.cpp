@@ -42,7 +42,8 @@ std::string fmt_vector(const Vector6d& v) {
 }
 
 Placement placement(double x, double y, double z, double roll_deg, double pitch_deg, double yaw_deg) {
-  return placement_from_pose(Pose{Vector3d(x, y, z), Vector3d(deg2rad(roll_deg), deg2rad(pitch_deg), deg2rad(yaw_deg))});
+  return placement_from_pose(
+      Pose{Vector3d(x, y, z), Vector3d(deg2rad(roll_deg), deg2rad(pitch_deg), deg2rad(yaw_deg))});
 }
 
 // Poses the platform at `x` from wherever the legs are, in `steps` stages, solving the legs each time.
@@ -71,13 +72,14 @@ TEST(Mjcf, LoadsWithTheExpectedSizesAndMass) {
     EXPECT_EQ(sim.m->nu, 6);
     EXPECT_EQ(sim.m->neq, 18);
     const double tiny = 0.0;
-    EXPECT_NEAR(mj_getTotalmass(sim.m), rig.load().mass + 6 * (rig.mechanism().housing.mass + rig.mechanism().rod.mass) + tiny,
-                1e-9);
+    EXPECT_NEAR(mj_getTotalmass(sim.m),
+                rig.load().mass + 6 * (rig.mechanism().housing.mass + rig.mechanism().rod.mass) + tiny, 1e-9);
     for (int i = 1; i <= 6; ++i) {
       const std::string n = std::to_string(i);
       for (const char* j : {"_ja", "_jb", "_screw", "_nut", "_slide", "_je", "_jd", "_rotor"})
         EXPECT_NO_THROW((void)sim.id(mjOBJ_JOINT, "leg" + n + j));
-      for (const std::string b : {"housing", "rotor", "screw", "rod", "end"}) EXPECT_NO_THROW((void)sim.id(mjOBJ_BODY, b + n));
+      for (const std::string b : {"housing", "rotor", "screw", "rod", "end"})
+        EXPECT_NO_THROW((void)sim.id(mjOBJ_BODY, b + n));
       EXPECT_NO_THROW((void)sim.id(mjOBJ_ACTUATOR, "motor" + n));
     }
   }
@@ -89,7 +91,7 @@ TEST(Mjcf, AtHomeEveryEqualityHoldsAndTheJointsAreWhereTheModelPutsThem) {
     const Model& model = rig.model();
     MjSim sim(mjcf_model(rig));
     mj_forward(sim.m, sim.d);
-    EXPECT_EQ(sim.d->ne, 6 * 6 + 12);  // six welds and twelve joint equalities
+    EXPECT_EQ(sim.d->ne, 6 * 6 + 12);                                  // six welds and twelve joint equalities
     EXPECT_EQ(sim.d->nf, rig.servo().coulomb_friction > 0.0 ? 6 : 0);  // the rotors' dry friction
     report("max |efc_pos| at qpos0 [m or rad]", sim.max_residual());
     EXPECT_LT(sim.max_residual(), 1e-14);
@@ -123,9 +125,11 @@ TEST(Mjcf, JointsCarryTheTwistTheLengthAndTheMotorAngleAtAnyPose) {
       for (int i = 0; i < 6; ++i) {
         const std::string n = "leg" + std::to_string(i + 1);
         worst_twist = std::max(worst_twist, std::abs(sim.q(n + "_screw") + sim.q(n + "_nut") - dtheta[i]));
-        worst_length = std::max(worst_length, std::abs(sim.q(n + "_slide") - (legs.length[i] - model.leg(i).length_home)));
+        worst_length =
+            std::max(worst_length, std::abs(sim.q(n + "_slide") - (legs.length[i] - model.leg(i).length_home)));
         worst_motor = std::max(worst_motor, std::abs(sim.q(n + "_rotor") - rotor_angle(model.leg(i), phi[i])));
-        const Vector3d end = Eigen::Map<const Vector3d>(sim.d->xpos + 3 * sim.id(mjOBJ_BODY, "end" + std::to_string(i + 1)));
+        const Vector3d end =
+            Eigen::Map<const Vector3d>(sim.d->xpos + 3 * sim.id(mjOBJ_BODY, "end" + std::to_string(i + 1)));
         worst_joint = std::max(worst_joint, (end - model.leg(i).base_B - legs.leg_B.row(i).transpose()).norm());
       }
     }
@@ -215,8 +219,9 @@ TEST(Mjcf, WithTheMotorsHeldThePlatformRestsAtTwistAwareForwardKinematics) {
     FkResult fk;
     ASSERT_EQ(forward_kinematics(model, m, LengthKind::Motor, Placement{}, fk), Status::Ok);
     FkResult geometric;  // the pose of a twist-blind plant: |L| = m + offset
-    ASSERT_EQ(forward_kinematics(model, m + model.geometry().length_offset, LengthKind::Geometric, Placement{}, geometric),
-              Status::Ok);
+    ASSERT_EQ(
+        forward_kinematics(model, m + model.geometry().length_offset, LengthKind::Geometric, Placement{}, geometric),
+        Status::Ok);
     // Start 2 mm and 0.2 deg away from both.
     Placement start = geometric.placement;
     start.t += Vector3d(0.002, -0.001, 0.001);
@@ -235,7 +240,8 @@ TEST(Mjcf, WithTheMotorsHeldThePlatformRestsAtTwistAwareForwardKinematics) {
     const Settled blind = settle(rig, phi, start, true);
     const double dt_blind = (blind.placement.t - fk.placement.t).norm();
     report("twist coupling removed: |t_mujoco - t_fk| [m]", dt_blind);
-    report("twist coupling removed: |t_mujoco - t_geometric_fk| [m]", (blind.placement.t - geometric.placement.t).norm());
+    report("twist coupling removed: |t_mujoco - t_geometric_fk| [m]",
+           (blind.placement.t - geometric.placement.t).norm());
     EXPECT_GT(dt_blind, 50e-6);
     EXPECT_LT((blind.placement.t - geometric.placement.t).norm(), 4e-8);
   }
@@ -314,10 +320,12 @@ TEST(Mjcf, MujocoInverseDynamicsGivesHexatwistsMotorTorquesWithoutFriction) {
     const int ne = sim.d->ne;  // the equality rows (the test's rig has no friction rows)
     ASSERT_EQ(sim.d->nefc, ne);
     Eigen::MatrixXd A(nv, ne + 6);
-    A.leftCols(ne) = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-                         sim.d->efc_J, ne, nv).transpose();
+    A.leftCols(ne) =
+        Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(sim.d->efc_J, ne, nv)
+            .transpose();
     A.rightCols(6) = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-                         sim.d->actuator_moment, 6, nv).transpose();
+                         sim.d->actuator_moment, 6, nv)
+                         .transpose();
     const Eigen::VectorXd x = A.colPivHouseholderQr().solve(Eigen::Map<const Eigen::VectorXd>(sim.d->qfrc_inverse, nv));
     const Vector6d tau_mj = x.tail(6);
 
@@ -330,8 +338,8 @@ TEST(Mjcf, MujocoInverseDynamicsGivesHexatwistsMotorTorquesWithoutFriction) {
     peak = std::max(peak, id.torque.cwiseAbs().maxCoeff());
     if (k % 10 == 0)
       std::printf("  t %.3f s: |v| %.3f m/s, |w| %.1f deg/s, tau_hx %s, max |tau_mj - tau_hx| %.3g N m\n", t,
-                  pm.velocity.head<3>().norm(), rad2deg(pm.velocity.tail<3>().norm()),
-                  fmt_vector(id.torque).c_str(), (tau_mj - id.torque).cwiseAbs().maxCoeff());
+                  pm.velocity.head<3>().norm(), rad2deg(pm.velocity.tail<3>().norm()), fmt_vector(id.torque).c_str(),
+                  (tau_mj - id.torque).cwiseAbs().maxCoeff());
   }
   report("max |tau_mujoco - tau_hexatwist| [N m]", worst);
   report("peak |tau_hexatwist| [N m]", peak);

@@ -216,7 +216,8 @@ TEST(Model, RejectsLegsThatDoNotHoldThePlatform) {
   expect_rejected(vertical, {"legs", "do not hold"});
   // Legs in identical pairs: three distinct legs cannot fix six degrees of freedom.
   ModelSpec pairs = seed_spec();
-  for (int i = 1; i < kLegs; i += 2) pairs.legs[static_cast<std::size_t>(i)] = pairs.legs[static_cast<std::size_t>(i - 1)];
+  for (int i = 1; i < kLegs; i += 2)
+    pairs.legs[static_cast<std::size_t>(i)] = pairs.legs[static_cast<std::size_t>(i - 1)];
   expect_rejected(pairs, {"legs", "do not hold"});
 }
 
@@ -305,7 +306,8 @@ TEST(Model, TwistGainFollowsScrewAndNutMechanicsForEveryThreadAndDrivenSide) {
     const double hand = leg.thread == ThreadSense::Right ? 1.0 : -1.0;
     for (const double qm : {0.0, 3.7, -12.0}) {
       for (const double dtheta : {0.3, -0.7}) {
-        EXPECT_NEAR(model.leg(i).twist_gain * dtheta, screw_nut_length_error(hand, leg.driven, leg.lead, qm, dtheta), 1e-15)
+        EXPECT_NEAR(model.leg(i).twist_gain * dtheta, screw_nut_length_error(hand, leg.driven, leg.lead, qm, dtheta),
+                    1e-15)
             << "leg " << i + 1;
       }
     }

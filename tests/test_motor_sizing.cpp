@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "hexatwist/io/config.hpp"
 #include "hexatwist/dynamics/motor_sizing.hpp"
+#include "hexatwist/io/config.hpp"
 
 namespace hexatwist {
 namespace {
@@ -17,7 +17,7 @@ const Config& seed() {
 }
 
 constexpr double kAmplitude = 0.05;  // [m]
-constexpr double kFrequency = 1.0;  // [Hz]
+constexpr double kFrequency = 1.0;   // [Hz]
 
 // z = A sin(2 pi f t) over two periods, at the control rate.
 Trajectory heave_sine() {
@@ -100,7 +100,8 @@ TEST(MotorSizing, TermsAddUpToTheTorqueAndSharesAreTheirRmsOverTheTorqueRms) {
       for (int i = 0; i < 6; ++i) sum2[i][t] += s.terms[t][i] * s.terms[t][i];
     }
     ASSERT_LT((total - s.torque).cwiseAbs().maxCoeff(), 1e-9 * (1.0 + s.torque.cwiseAbs().maxCoeff())) << s.time;
-    ASSERT_LT((s.power - s.torque.cwiseProduct(s.speed)).cwiseAbs().maxCoeff(), 1e-9 * (1.0 + s.power.cwiseAbs().maxCoeff()));
+    ASSERT_LT((s.power - s.torque.cwiseProduct(s.speed)).cwiseAbs().maxCoeff(),
+              1e-9 * (1.0 + s.power.cwiseAbs().maxCoeff()));
     for (int i = 0; i < 6; ++i) torque2[i] += s.torque[i] * s.torque[i];
   }
   for (int i = 0; i < 6; ++i) {
@@ -150,7 +151,8 @@ TEST(MotorSizing, FlagsExactlyTheFirstSpeedViolation) {
   const Rig rig = with_servo(servo);
   MotorSizing s;
   ASSERT_EQ(size_motors(rig, heave_sine(), s), Status::Ok);
-  const auto [k, leg] = first_where(s, [&](const MotorSample& x, int i) { return std::abs(x.speed[i]) > servo.max_speed; });
+  const auto [k, leg] =
+      first_where(s, [&](const MotorSample& x, int i) { return std::abs(x.speed[i]) > servo.max_speed; });
   ASSERT_GE(leg, 0);
   EXPECT_EQ(s.violation.check, EnvelopeCheck::Speed);
   EXPECT_EQ(s.violation.index, k);
@@ -172,8 +174,9 @@ TEST(MotorSizing, FlagsExactlyTheFirstPeakTorqueViolation) {
   const Rig rig = with_servo(servo);
   MotorSizing s;
   ASSERT_EQ(size_motors(rig, heave_sine(), s), Status::Ok);
-  const auto [k, leg] = first_where(
-      s, [&](const MotorSample& x, int i) { return std::abs(x.torque[i]) > peak_torque_at(servo, std::abs(x.speed[i])); });
+  const auto [k, leg] = first_where(s, [&](const MotorSample& x, int i) {
+    return std::abs(x.torque[i]) > peak_torque_at(servo, std::abs(x.speed[i]));
+  });
   ASSERT_GE(leg, 0);
   ASSERT_EQ(s.violation.check, EnvelopeCheck::PeakTorque);
   EXPECT_EQ(s.violation.index, k);

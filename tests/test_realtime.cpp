@@ -3,8 +3,8 @@
 #include <cstdlib>
 #include <new>
 
-#include "hexatwist/io/config.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
+#include "hexatwist/io/config.hpp"
 #include "support.hpp"
 
 namespace {
@@ -25,19 +25,26 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 namespace hexatwist::test {
 namespace {
 
-static_assert(noexcept(inverse_kinematics(std::declval<const Model&>(), std::declval<const Pose&>(), std::declval<LegState&>())));
-static_assert(noexcept(twist(std::declval<const Model&>(), std::declval<const LegState&>(), std::declval<Vector6d&>())));
+static_assert(noexcept(inverse_kinematics(std::declval<const Model&>(), std::declval<const Pose&>(),
+                                          std::declval<LegState&>())));
+static_assert(noexcept(twist(std::declval<const Model&>(), std::declval<const LegState&>(),
+                             std::declval<Vector6d&>())));
 static_assert(noexcept(motor_commands(std::declval<const Model&>(), std::declval<const Pose&>(), Strategy::Compensated,
                                       std::declval<Vector6d&>(), std::declval<LimitReport&>())));
-static_assert(noexcept(forward_kinematics(std::declval<const Model&>(), std::declval<const Vector6d&>(), LengthKind::Motor,
-                                          std::declval<const Placement&>(), std::declval<FkResult&>())));
-static_assert(noexcept(forward_kinematics_tracked(std::declval<const Model&>(), std::declval<const Vector6d&>(), LengthKind::Motor,
-                                                  std::declval<FkTracker&>(), std::declval<FkResult&>())));
-static_assert(noexcept(jacobian_condition(std::declval<const Model&>(), std::declval<const LegState&>(), std::declval<double&>())));
-static_assert(noexcept(check_limits(std::declval<const Model&>(), std::declval<const LegState&>(), std::declval<LimitReport&>())));
+static_assert(noexcept(forward_kinematics(std::declval<const Model&>(), std::declval<const Vector6d&>(),
+                                          LengthKind::Motor, std::declval<const Placement&>(),
+                                          std::declval<FkResult&>())));
+static_assert(noexcept(forward_kinematics_tracked(std::declval<const Model&>(), std::declval<const Vector6d&>(),
+                                                  LengthKind::Motor, std::declval<FkTracker&>(),
+                                                  std::declval<FkResult&>())));
+static_assert(noexcept(jacobian_condition(std::declval<const Model&>(), std::declval<const LegState&>(),
+                                          std::declval<double&>())));
+static_assert(noexcept(check_limits(std::declval<const Model&>(), std::declval<const LegState&>(),
+                                    std::declval<LimitReport&>())));
 
-static_assert(noexcept(stream_line(std::declval<const Model&>(), std::declval<const StreamSettings&>(), std::string_view(),
-                                   AngleUnit::Degrees, std::declval<StreamState&>(), std::declval<StreamOutput&>())));
+static_assert(noexcept(stream_line(std::declval<const Model&>(), std::declval<const StreamSettings&>(),
+                                   std::string_view(), AngleUnit::Degrees, std::declval<StreamState&>(),
+                                   std::declval<StreamOutput&>())));
 static_assert(noexcept(inverse_dynamics(std::declval<const Rig&>(), std::declval<const PlatformMotion&>(),
                                         std::declval<InverseDynamics&>())));
 static_assert(noexcept(forward_dynamics(std::declval<const Rig&>(), std::declval<const Placement&>(),
@@ -45,7 +52,8 @@ static_assert(noexcept(forward_dynamics(std::declval<const Rig&>(), std::declval
                                         std::declval<Vector6d&>())));
 static_assert(noexcept(mechanism_mass_matrix(std::declval<const Rig&>(), std::declval<const Placement&>(),
                                              std::declval<Matrix6d&>())));
-static_assert(noexcept(format_stream_output(std::declval<const StreamOutput&>(), StreamFormat::Json, std::span<char>())));
+static_assert(noexcept(format_stream_output(std::declval<const StreamOutput&>(), StreamFormat::Json,
+                                            std::span<char>())));
 
 TEST(RealTime, CountingAllocatorSeesAllocations) {
   // The probe works: a heap allocation is counted (so the zero counts below mean something).
@@ -86,7 +94,7 @@ TEST(RealTime, CommandsTwistLimitsConditionAndFkDoNotAllocate) {
     (void)compute_commands(model, p, rep);
     ok += motor_commands(model, p, Strategy::Conventional, cmd, lim) == Status::Ok;
     if (motor_commands(model, p, Strategy::Compensated, cmd, lim) == Status::Ok) {
-      (void)forward_kinematics(model, cmd, LengthKind::Motor, previous, fk);  // warm-ish
+      (void)forward_kinematics(model, cmd, LengthKind::Motor, previous, fk);         // warm-ish
       (void)forward_kinematics(model, cmd, LengthKind::Geometric, Placement{}, fk);  // cold
       (void)forward_kinematics_tracked(model, cmd, LengthKind::Motor, tracker, fk);
       previous = fk.placement;

@@ -3,8 +3,8 @@
 
 #include <functional>
 
-#include "hexatwist/io/config.hpp"
 #include "hexatwist/error.hpp"
+#include "hexatwist/io/config.hpp"
 #include "hexatwist/simulation/rig.hpp"
 
 namespace hexatwist {
@@ -30,7 +30,9 @@ TEST(Rig, RefusesBadNumbersNamingTheField) {
   EXPECT_EQ(error_of([](RigSpec& s) { s.servo.encoder_counts = 1000.5; }).rfind("servo.encoder_counts:", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.servo.gear_ratio = 0; }).rfind("servo.gear_ratio:", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.servo.ki = 10; }).rfind("servo.kp: expected > 0 when", 0), 0u);
-  EXPECT_EQ(error_of([](RigSpec& s) { s.servo.pole_frequency = 200; }).rfind("servo.pole_frequency: 200 Hz is too high", 0), 0u);
+  EXPECT_EQ(
+      error_of([](RigSpec& s) { s.servo.pole_frequency = 200; }).rfind("servo.pole_frequency: 200 Hz is too high", 0),
+      0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.load.mass = -3; }).rfind("load.mass:", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.load.inertia.y() = 0; }).rfind("load.inertia:", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.simulation.control_rate = 0; }).rfind("simulation.control_rate:", 0), 0u);
@@ -40,8 +42,9 @@ TEST(Rig, RefusesBadNumbersNamingTheField) {
             0u);
   // Steps too short for the count of steps per period to fit an int (found by fuzzing: the
   // conversion came before the check), and just past the allowed count.
-  EXPECT_EQ(error_of([](RigSpec& s) { s.simulation.plant_step = 1e-40; })
-                .rfind("simulation.plant_step: 1e-40 s gives more than 10000 steps per control period", 0),
+  EXPECT_EQ(error_of([](RigSpec& s) {
+              s.simulation.plant_step = 1e-40;
+            }).rfind("simulation.plant_step: 1e-40 s gives more than 10000 steps per control period", 0),
             0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.simulation.plant_step = 0.99e-7; }).rfind("simulation.plant_step:", 0), 0u);
   EXPECT_EQ(error_of([](RigSpec& s) { s.simulation.plant_step = 1e-7; }), "");

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <iomanip>
 
-#include "hexatwist/io/config.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
+#include "hexatwist/io/config.hpp"
 #include "hexatwist/simulation/simulation.hpp"
 
 namespace hexatwist {
@@ -67,7 +67,8 @@ TEST(Simulation, LengthOffsetsAreCommandedAwayAndPutBackByThePlant) {
   // Offsets shift every command by -delta and the plant's real length by +delta: the closed loop
   // does what it does without them (up to the encoder's rounding of other angles), in the
   // twisting plant and in the twist-free one.
-  RigSpec spec{seed().rig.model().spec(), seed().rig.servo(), seed().rig.load(), seed().rig.simulation(), seed().rig.mechanism()};
+  RigSpec spec{seed().rig.model().spec(), seed().rig.servo(), seed().rig.load(), seed().rig.simulation(),
+               seed().rig.mechanism()};
   const std::array<double, kLegs> delta{1e-3, -0.7e-3, 0.2e-3, -1e-3, 0.5e-3, 0.0};
   for (std::size_t i = 0; i < delta.size(); ++i) spec.model.legs[i].length_offset = delta[i];
   const Rig offset(spec);
@@ -157,7 +158,8 @@ TEST(Simulation, AMotorSpeedOrHoldingTorqueOnItsLimitIsInsideAndPastItOutside) {
   SimulationIssue issue;
   ServoSpec fast = seed_rig.servo();
   fast.max_speed = 1e5;
-  ASSERT_EQ(check_trajectory(Rig(seed_rig.model(), fast, seed_rig.load(), seed_rig.simulation()), t, issue), Status::Ok);
+  ASSERT_EQ(check_trajectory(Rig(seed_rig.model(), fast, seed_rig.load(), seed_rig.simulation()), t, issue),
+            Status::Ok);
   ServoSpec at = seed_rig.servo();
   ASSERT_EQ(check_trajectory(seed_rig, t, issue), Status::MotorSpeedAboveMax);
   double speed = 0.0;  // the largest over the legs and ticks: raise the limit to each one reported
@@ -172,7 +174,8 @@ TEST(Simulation, AMotorSpeedOrHoldingTorqueOnItsLimitIsInsideAndPastItOutside) {
   for (const double bound : {speed, std::nextafter(speed, 0.0), speed * (1.0 - 1e-12)}) {
     at.max_speed = bound;
     const Status s = check_trajectory(Rig(seed_rig.model(), at, seed_rig.load(), seed_rig.simulation()), t, issue);
-    EXPECT_EQ(s, bound == speed * (1.0 - 1e-12) ? Status::MotorSpeedAboveMax : Status::Ok) << std::setprecision(17) << bound;
+    EXPECT_EQ(s, bound == speed * (1.0 - 1e-12) ? Status::MotorSpeedAboveMax : Status::Ok)
+        << std::setprecision(17) << bound;
   }
   ServoSpec weak;
   weak.torque_limit = 3.0;
@@ -190,7 +193,8 @@ TEST(Simulation, AMotorSpeedOrHoldingTorqueOnItsLimitIsInsideAndPastItOutside) {
   }
   for (const double bound : {hold, std::nextafter(hold, 0.0), hold * (1.0 - 1e-12)}) {
     weak.torque_limit = bound;
-    const Status s = check_trajectory(Rig(seed_rig.model(), weak, LoadSpec{}, SimulationSpec{}), still(Pose{}, 0.01), issue);
+    const Status s =
+        check_trajectory(Rig(seed_rig.model(), weak, LoadSpec{}, SimulationSpec{}), still(Pose{}, 0.01), issue);
     EXPECT_EQ(s, bound == hold * (1.0 - 1e-12) ? Status::TorqueAboveMax : Status::Ok) << std::setprecision(17) << bound;
   }
 }

@@ -304,8 +304,10 @@ TEST(Stream, ALimitedStepThatFailsItsCheckIsHeldWithTheFailure) {
 std::vector<std::string> split_csv(const std::string& line) {
   std::vector<std::string> cells(1);
   for (const char c : line) {
-    if (c == ',') cells.emplace_back();
-    else if (c != '\n') cells.back() += c;
+    if (c == ',')
+      cells.emplace_back();
+    else if (c != '\n')
+      cells.back() += c;
   }
   return cells;
 }

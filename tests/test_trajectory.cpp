@@ -727,7 +727,8 @@ TEST(Trajectory, BadResampleInputsAreErrors) {
   TimedPoses huge = polynomial_samples({0.0, 0.25, 0.6}, 1);
   huge.lines = {3, 5, 7};
   huge.poses[1].position.y() = 1e308;
-  expect(error_of([&] { (void)resample(huge, 0.01); }), "between sample 0 (line 3) and sample 1 (line 5): the interpolation overflows");
+  expect(error_of([&] { (void)resample(huge, 0.01); }),
+         "between sample 0 (line 3) and sample 1 (line 5): the interpolation overflows");
 }
 
 // ---- waypoints and interpolation -------------------------------------------------------------

@@ -22,7 +22,8 @@ void expect_twist_matches_chain(const Model& model, const Pose& pose) {
 
 TEST(Twist, MatchesJointChainOnSeedPlatform) {
   std::mt19937_64 rng(kSeed);
-  for (int n = 0; n < 2000; ++n) expect_twist_matches_chain(seed_model(), random_valid_pose(seed_model(), rng, 0.5, deg2rad(30)));
+  for (int n = 0; n < 2000; ++n)
+    expect_twist_matches_chain(seed_model(), random_valid_pose(seed_model(), rng, 0.5, deg2rad(30)));
 }
 
 TEST(Twist, MatchesJointChainOnRandomAsymmetricPlatforms) {

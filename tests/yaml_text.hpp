@@ -10,21 +10,21 @@ namespace hexatwist::test {
 
 /// The seed platform in the symmetric form; the comments give the line numbers.
 inline const std::string kSymmetricYaml =
-    "name: test platform\n"         //  1
-    "symmetric:\n"                  //  2
-    "  Ra: 1.2\n"                   //  3
-    "  Rb: 1.5\n"                   //  4
-    "  da: 0.2\n"                   //  5
-    "  db: 0.3\n"                   //  6
-    "  H: 1.511\n"                  //  7
-    "screw:\n"                      //  8
-    "  lead: 0.010\n"               //  9
-    "  thread: right\n"             // 10
-    "  driven_side: base\n"         // 11
-    "limits:\n"                     // 12
-    "  length_min: 1.40\n"          // 13
-    "  length_max: 2.45\n"          // 14
-    "  bend_max_deg: 40\n"          // 15
+    "name: test platform\n"           //  1
+    "symmetric:\n"                    //  2
+    "  Ra: 1.2\n"                     //  3
+    "  Rb: 1.5\n"                     //  4
+    "  da: 0.2\n"                     //  5
+    "  db: 0.3\n"                     //  6
+    "  H: 1.511\n"                    //  7
+    "screw:\n"                        //  8
+    "  lead: 0.010\n"                 //  9
+    "  thread: right\n"               // 10
+    "  driven_side: base\n"           // 11
+    "limits:\n"                       // 12
+    "  length_min: 1.40\n"            // 13
+    "  length_max: 2.45\n"            // 14
+    "  bend_max_deg: 40\n"            // 15
     "  singularity_margin_deg: 5\n";  // 16
 
 inline std::vector<std::string> split_lines(const std::string& text) {

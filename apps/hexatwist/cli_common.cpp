@@ -106,8 +106,8 @@ void OutputSet::stage() {
     std::error_code ec;
     if (fs::is_directory(p.path, ec)) {
       roll_back();
-      throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}': it is a directory; nothing was written",
-                                                     printable(p.path)));
+      throw ExitError(kExitOutputFailed,
+                      fmt::format("cannot write '{}': it is a directory; nothing was written", printable(p.path)));
     }
     errno = 0;
     std::ofstream out(p.tmp, std::ios::binary | std::ios::trunc);
@@ -254,8 +254,10 @@ std::string describe_limit(const LimitReport& r) {
       return fmt::format("{}holding the load takes {:.2f} N m, above the motor's limit {:.2f} N m (servo.torque_limit)",
                          leg, r.value, r.bound);
     case Status::PlatformSingularity:
-      return fmt::format("the platform is near a singularity: the Jacobian's condition number {:.4g} is above the limit "
-                         "{:.4g} (limits.jacobian_condition_max)", r.value, r.bound);
+      return fmt::format(
+          "the platform is near a singularity: the Jacobian's condition number {:.4g} is above the limit "
+          "{:.4g} (limits.jacobian_condition_max)",
+          r.value, r.bound);
     default:
       return leg + std::string(describe(r.status));
   }

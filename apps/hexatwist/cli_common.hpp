@@ -18,10 +18,10 @@ namespace hexatwist::cli {
 /// Exit codes of the tool.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitBadInput = 2,      ///< malformed input, bad configuration, unreadable file
-  kExitOutOfLimit = 3,    ///< a pose outside a limit, or a forward-kinematics failure
-  kExitOutputFailed = 4,  ///< an output file or figure could not be written
-  kExitNotIdentified = 5, ///< identify: the data do not determine the parameters, or the solver did not converge
+  kExitBadInput = 2,       ///< malformed input, bad configuration, unreadable file
+  kExitOutOfLimit = 3,     ///< a pose outside a limit, or a forward-kinematics failure
+  kExitOutputFailed = 4,   ///< an output file or figure could not be written
+  kExitNotIdentified = 5,  ///< identify: the data do not determine the parameters, or the solver did not converge
 };
 
 /// A failure the tool reports as one line on stderr with its exit code.

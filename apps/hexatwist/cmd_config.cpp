@@ -109,10 +109,11 @@ int run_config(const ConfigOptions& o) {
   std::string out = fmt::format("platform: {}\nsource: {}\n", spec.name, model_source(o.model));
   out += fmt::format("home height: {:.6f} m; pivot {} m [P]; observation point {} m [P]\n", spec.home_height,
                      v3(spec.pivot_P), v3(spec.observation_P));
-  out += fmt::format("limits: length {:.4f} .. {:.4f} m, U-joint bend <= {:.2f} deg, singularity margin {:.2f} deg, "
-                     "Jacobian condition <= {:.4g}\n",
-                     lim.length_min, lim.length_max, rad2deg(lim.bend_max), rad2deg(lim.singularity_margin),
-                     lim.jacobian_condition_max);
+  out += fmt::format(
+      "limits: length {:.4f} .. {:.4f} m, U-joint bend <= {:.2f} deg, singularity margin {:.2f} deg, "
+      "Jacobian condition <= {:.4g}\n",
+      lim.length_min, lim.length_max, rad2deg(lim.bend_max), rad2deg(lim.singularity_margin),
+      lim.jacobian_condition_max);
   for (int i = 0; i < kLegs; ++i) {
     const Leg& l = model.leg(i);
     out += fmt::format("leg {}:\n  base joint      {} m [B]\n  platform joint  {} m [P]\n", i + 1, v3(l.base_B),
@@ -160,7 +161,9 @@ Command make_config_command(CLI::App& root) {
   CLI::App* app = root.add_subcommand("config", "Show the resolved platform model (every leg's vectors, SI units)");
   add_model_options(*app, opts->model);
   app->add_flag("--json", opts->json, "Machine-readable output (SI units: m, rad)");
-  app->add_flag("--yaml", opts->yaml, "Print the embedded seed configuration as YAML (a starting point for your own); not with --config or --json");
+  app->add_flag(
+      "--yaml", opts->yaml,
+      "Print the embedded seed configuration as YAML (a starting point for your own); not with --config or --json");
   return {app, [opts] { return run_config(*opts); }};
 }
 

@@ -39,16 +39,19 @@ std::string describe_violation(const EnvelopeViolation& v) {
   const std::string where = fmt::format("leg {} at t = {:.3f} s", v.leg + 1, v.time);
   switch (v.check) {
     case EnvelopeCheck::Speed:
-      return fmt::format("{}: motor speed {:.0f} rpm ({:.2f} rad/s) is above the maximum {:.0f} rpm (servo.max_speed_rpm)",
-                         where, rpm(v.value), v.value, rpm(v.bound));
+      return fmt::format(
+          "{}: motor speed {:.0f} rpm ({:.2f} rad/s) is above the maximum {:.0f} rpm (servo.max_speed_rpm)", where,
+          rpm(v.value), v.value, rpm(v.bound));
     case EnvelopeCheck::PeakTorque:
-      return fmt::format("{}: torque {:.2f} N m is above the peak envelope's {:.2f} N m at that speed "
-                         "(servo.torque_limit, peak_corner_rpm, peak_torque_at_max_speed)",
-                         where, v.value, v.bound);
+      return fmt::format(
+          "{}: torque {:.2f} N m is above the peak envelope's {:.2f} N m at that speed "
+          "(servo.torque_limit, peak_corner_rpm, peak_torque_at_max_speed)",
+          where, v.value, v.bound);
     case EnvelopeCheck::ContinuousTorque:
-      return fmt::format("leg {}: RMS torque {:.2f} N m over the trajectory (0 to {:.3f} s) is above the continuous "
-                         "rating {:.2f} N m (servo.continuous_torque)",
-                         v.leg + 1, v.value, v.time, v.bound);
+      return fmt::format(
+          "leg {}: RMS torque {:.2f} N m over the trajectory (0 to {:.3f} s) is above the continuous "
+          "rating {:.2f} N m (servo.continuous_torque)",
+          v.leg + 1, v.value, v.time, v.bound);
     case EnvelopeCheck::None:
       break;
   }
@@ -173,11 +176,13 @@ Figure torque_speed(const Rig& rig, const MotorSizing& s, const std::string& ste
       envelope.x.push_back(rpm(data.envelope.speed[k]));
       envelope.y.push_back(data.envelope.torque[k]);
     }
-    Series continuous{fmt::format("continuous +-{:g} N m", tc), {-w, w, nan, -w, w}, {tc, tc, nan, -tc, -tc},
-                      Series::Style::Dashed};
+    Series continuous{
+        fmt::format("continuous +-{:g} N m", tc), {-w, w, nan, -w, w}, {tc, tc, nan, -tc, -tc}, Series::Style::Dashed};
     // The speed limit spans the whole torque range drawn.
     const double t_hi = std::max(rig.servo().torque_limit, m.peak_torque) * 1.05;
-    Series max_speed{fmt::format("max speed +-{:g} rpm", w), {w, w, nan, -w, -w}, {-t_hi, t_hi, nan, -t_hi, t_hi},
+    Series max_speed{fmt::format("max speed +-{:g} rpm", w),
+                     {w, w, nan, -w, -w},
+                     {-t_hi, t_hi, nan, -t_hi, t_hi},
                      Series::Style::Dotted};
     p.series = {std::move(points), std::move(envelope), std::move(continuous), std::move(max_speed)};
     fig.panels.push_back(std::move(p));
@@ -207,13 +212,15 @@ std::string table(const Rig& rig, const DynamicsOptions& o, const Trajectory& tr
                      "largest shares (rms/rms)", "envelope use peak/speed/rms");
   for (int i = 0; i < kLegs; ++i) {
     const MotorSummary& m = s.motors[i];
-    out += fmt::format("{:>3} {:>11.2f} {:>8.3f} {:>10.2f} {:>15.0f} {:>11.1f} {:>11.0f} {:>9.1f}   {:<34} {:>9.0f}%/{:>3.0f}%/{:>3.0f}%\n",
-                       i + 1, m.peak_torque, m.peak_torque_time, m.rms_torque, rpm(m.peak_speed), m.peak_speed,
-                       m.peak_power, m.energy_regenerated, largest_terms(m), 100.0 * m.peak_usage,
-                       100.0 * m.speed_usage, 100.0 * m.rms_usage);
+    out += fmt::format(
+        "{:>3} {:>11.2f} {:>8.3f} {:>10.2f} {:>15.0f} {:>11.1f} {:>11.0f} {:>9.1f}   {:<34} "
+        "{:>9.0f}%/{:>3.0f}%/{:>3.0f}%\n",
+        i + 1, m.peak_torque, m.peak_torque_time, m.rms_torque, rpm(m.peak_speed), m.peak_speed, m.peak_power,
+        m.energy_regenerated, largest_terms(m), 100.0 * m.peak_usage, 100.0 * m.speed_usage, 100.0 * m.rms_usage);
   }
-  out += s.violation.check == EnvelopeCheck::None ? "envelope: ok, every motor inside it\n"
-                                                  : fmt::format("envelope: EXCEEDED: {}\n", describe_violation(s.violation));
+  out += s.violation.check == EnvelopeCheck::None
+             ? "envelope: ok, every motor inside it\n"
+             : fmt::format("envelope: EXCEEDED: {}\n", describe_violation(s.violation));
   return out;
 }
 
@@ -230,8 +237,9 @@ int run_dynamics(const DynamicsOptions& o) {
     const std::string where = fmt::format("{}: t = {:.3f} s", printable(o.trajectory), sizing.failed_time);
     if (is_limit(status))
       throw ExitError(kExitOutOfLimit, fmt::format("{}: {}; nothing was written", where, describe_limit(sizing.limit)));
-    throw ExitError(kExitOutOfLimit, fmt::format("{} (sample {}): inverse dynamics failed: {} ({}); nothing was written",
-                                                 where, sizing.failed_index, describe(status), to_string(status)));
+    throw ExitError(kExitOutOfLimit,
+                    fmt::format("{} (sample {}): inverse dynamics failed: {} ({}); nothing was written", where,
+                                sizing.failed_index, describe(status), to_string(status)));
   }
 
   // Every file is written as one set: all of them or none (exit 4).
@@ -263,9 +271,9 @@ int run_dynamics(const DynamicsOptions& o) {
   write_stdout_or_withdraw(text, set.paths());
   // A motor outside its envelope is the run's finding: the report is complete and kept.
   if (sizing.violation.check != EnvelopeCheck::None)
-    throw ExitError(kExitOutOfLimit, fmt::format("{}: motor envelope exceeded: {} (the report was written to {})",
-                                                 printable(o.trajectory), describe_violation(sizing.violation),
-                                                 printable(o.out)));
+    throw ExitError(kExitOutOfLimit,
+                    fmt::format("{}: motor envelope exceeded: {} (the report was written to {})",
+                                printable(o.trajectory), describe_violation(sizing.violation), printable(o.out)));
   return kExitOk;
 }
 

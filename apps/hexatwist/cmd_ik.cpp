@@ -25,7 +25,8 @@ int run_ik(const IkOptions& o) {
   // The numbers were finite when parsed (parse_pose_m_deg): so they are too large to compute with.
   if (status == Status::NonFiniteInput)
     throw ExitError(kExitBadInput, fmt::format("--pose {}: too large to compute with (the leg lengths overflow); "
-                                               "expected a pose within reach of the platform", printable(o.pose)));
+                                               "expected a pose within reach of the platform",
+                                               printable(o.pose)));
   const bool ok = status == Status::Ok;
   // The twist (and the length error) exist wherever no U-joint is singular, also outside the
   // other limits; compute_commands leaves them unspecified otherwise.

@@ -45,8 +45,7 @@ struct Run {
 
 Run build_run(const Config& config, const RunOptions& o) {
   if (int{!o.test.empty()} + int{!o.trajectory.empty()} + int{o.stations > 0} != 1)
-    throw ExitError(kExitBadInput,
-                    "give one of --test NAME (Lz, Lx, Rz or Ry), --trajectory FILE.csv or --stations N");
+    throw ExitError(kExitBadInput, "give one of --test NAME (Lz, Lx, Rz or Ry), --trajectory FILE.csv or --stations N");
   Run run;
   const double dt = config.rig.control_period();
   if (!o.trajectory.empty()) {
@@ -64,8 +63,8 @@ Run build_run(const Config& config, const RunOptions& o) {
     }
     run.test.name = fmt::format("stations{}", o.stations);
     run.test.label = fmt::format("{} stations", o.stations);
-    run.test.description = fmt::format("{} random stations (seed {}), {:g} s at each", o.stations, o.station_seed,
-                                       spec.dwell);
+    run.test.description =
+        fmt::format("{} random stations (seed {}), {:g} s at each", o.stations, o.station_seed, spec.dwell);
     run.commanded = timed_poses(run.test.trajectory);
     return run;
   }
@@ -254,8 +253,9 @@ int run_synth(const SynthOptions& o) {
   files.add(out, fmt::to_string(b));
   files.add(truth, truth_json(config, o, run, so, log));
   if (!o.run_out.empty())
-    files.add(o.run_out, trajectory_csv(run.test.trajectory, static_cast<std::size_t>(std::llround(
-                                                                 rig.simulation().control_rate / so.rate))));
+    files.add(o.run_out,
+              trajectory_csv(run.test.trajectory,
+                             static_cast<std::size_t>(std::llround(rig.simulation().control_rate / so.rate))));
   files.commit();
 
   const Vector3d& origin = log.X_BT.t;
@@ -380,8 +380,7 @@ int run_measure(const MeasureOptions& o) {
   check_option(o.settle < run.test.trajectory.duration(), "--settle", o.settle,
                fmt::format("a time shorter than the run ({:g} s): no point can be still for longer [s]",
                            run.test.trajectory.duration()));
-  if (!std::isnan(o.register_until))
-    check_option(true, "--register-until", o.register_until, "a time [s]");
+  if (!std::isnan(o.register_until)) check_option(true, "--register-until", o.register_until, "a time [s]");
   MeasurementOptions mo;
   mo.strategy = strategy_of(o.run);
   mo.time = {o.log.time_offset, o.log.rate};
@@ -486,8 +485,8 @@ std::vector<ParameterRow> parameter_rows(const Model& nominal, const Identificat
   const PlatformParameters& e = id.estimate;
   rows.push_back({"lead", "mm", 1e3, nominal.leg(0).lead, e.lead, id.sd[kLeadIndex], 6});
   for (int i = 0; i < kLegs; ++i)
-    rows.push_back({fmt::format("offset {}", i + 1), "mm", 1e3, nominal.geometry().length_offset[i],
-                    e.length_offset[i], id.sd[kOffsetIndex + i]});
+    rows.push_back({fmt::format("offset {}", i + 1), "mm", 1e3, nominal.geometry().length_offset[i], e.length_offset[i],
+                    id.sd[kOffsetIndex + i]});
   for (int a = 0; a < 3; ++a)
     rows.push_back({fmt::format("point {}", "xyz"[a]), "mm", 1e3, nominal.spec().observation_P[a], e.observation_P[a],
                     id.sd[kObservationIndex + a]});
@@ -531,20 +530,23 @@ std::string identify_json(const Model& nominal, const IdentifyOptions& o, const 
   const bool solved = status == Status::Ok;
   const auto number = [](JsonWriter& w, std::string_view key, double v, bool known) {
     w.key(key);
-    known && std::isfinite(v) ? w.value(v) : w.null();
+    known&& std::isfinite(v) ? w.value(v) : w.null();
   };
   JsonWriter j;
   j.begin_object().field("command", "identify").field("status", failure.empty() ? "ok" : "failed");
   if (!failure.empty()) j.field("reason", failure);
   j.field("model", nominal.spec().name).field("config", model_source(o.run.model)).field("points", o.log.points);
   j.field("log_points", static_cast<int>(log.points_T.size())).field("observations", id.count);
-  j.field("poses", static_cast<int>(set.poses)).field("settle", set.settle).field("strategy", o.run.strategy).field("lead_effect", o.lead_effect);
+  j.field("poses", static_cast<int>(set.poses))
+      .field("settle", set.settle)
+      .field("strategy", o.run.strategy)
+      .field("lead_effect", o.lead_effect);
   number(j, "rms_before", id.rms_before, true);
   number(j, "rms_after", id.rms_after, fitted);
   number(j, "max_after", id.max_after, fitted);
   j.key("max_after_line");
-  fitted && id.max_after_index >= 0 ? j.value(log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]])
-                                    : j.null();
+  fitted&& id.max_after_index >= 0 ? j.value(log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]])
+                                   : j.null();
   number(j, "sigma", id.sigma, fitted);
   const double scatter = scatter_at_rest(set);
   number(j, "tracker_noise", scatter, true);
@@ -600,8 +602,8 @@ int run_identify(const IdentifyOptions& o) {
   const PointLog log = read_point_log(o.log, format);
   ObservationSet set;
   try {
-    set = observations_at_rest(model, run.commanded, log, {o.log.time_offset, o.log.rate}, strategy_of(o.run),
-                               o.settle);
+    set =
+        observations_at_rest(model, run.commanded, log, {o.log.time_offset, o.log.rate}, strategy_of(o.run), o.settle);
   } catch (const Error& e) {
     throw ExitError(kExitBadInput, e.what());
   }
@@ -618,10 +620,9 @@ int run_identify(const IdentifyOptions& o) {
     const char* what = status == Status::NotIdentifiable       ? "not identifiable"
                        : status == Status::SolverNoConvergence ? "no convergence"
                                                                : "failed";
-    fail(ExitError(kExitNotIdentified,
-                   fmt::format("{}: {} points at rest at {} pose{}: {}: {}; nothing was written",
-                               printable(o.log.points), set.observations.size(), set.poses,
-                               set.poses == 1 ? "" : "s", what, id.reason)),
+    fail(ExitError(kExitNotIdentified, fmt::format("{}: {} points at rest at {} pose{}: {}: {}; nothing was written",
+                                                   printable(o.log.points), set.observations.size(), set.poses,
+                                                   set.poses == 1 ? "" : "s", what, id.reason)),
          status);
   }
 
@@ -630,13 +631,14 @@ int run_identify(const IdentifyOptions& o) {
   // (another configuration, log or run), whose lead and thread would mean nothing.
   if (const double scatter = scatter_at_rest(set), floor = std::max(scatter, kTrackerNoiseFloor);
       !(id.sigma <= kNoiseRatioMax * floor))
-    fail(ExitError(kExitNotIdentified,
-                   fmt::format("{}: the fit leaves a noise of {:.4g} mm per axis, {:.3g} times the tracker's scatter at "
-                               "rest ({:.4g} mm, at least {:g} mm counted; {:g} times allowed): the model does not "
-                               "explain the data (another configuration, log or run?); nothing was written",
-                               printable(o.log.points), 1e3 * id.sigma, id.sigma / floor, 1e3 * scatter,
-                               1e3 * kTrackerNoiseFloor, kNoiseRatioMax)),
-         Status::NotIdentifiable);
+    fail(
+        ExitError(kExitNotIdentified,
+                  fmt::format("{}: the fit leaves a noise of {:.4g} mm per axis, {:.3g} times the tracker's scatter at "
+                              "rest ({:.4g} mm, at least {:g} mm counted; {:g} times allowed): the model does not "
+                              "explain the data (another configuration, log or run?); nothing was written",
+                              printable(o.log.points), 1e3 * id.sigma, id.sigma / floor, 1e3 * scatter,
+                              1e3 * kTrackerNoiseFloor, kNoiseRatioMax)),
+        Status::NotIdentifiable);
 
   // The thread hand is decided only if the other sign fits worse by more than the noise explains:
   // twice the cost difference over sigma^2 is a chi-square of one degree of freedom; ask 25 (5 sd).
@@ -653,8 +655,9 @@ int run_identify(const IdentifyOptions& o) {
                                  printable(o.log.points), id.cost_ratio, separation)),
            Status::NotIdentifiable);
   }
-  const std::string source_text =
-      o.run.model.config.empty() ? std::string(seed_config_yaml()) : read_text_file(o.run.model.config, "--config", "config file");
+  const std::string source_text = o.run.model.config.empty()
+                                      ? std::string(seed_config_yaml())
+                                      : read_text_file(o.run.model.config, "--config", "config file");
   ModelSpec corrected = corrected_spec(model.spec(), id.estimate);
   corrected.name = fmt::format("{} (identified from {})", model.spec().name, o.log.points);
   const std::string header = fmt::format(
@@ -667,7 +670,8 @@ int run_identify(const IdentifyOptions& o) {
     (void)load_config(yaml, o.out);  // what is written must load
   } catch (const Error& e) {
     fail(ExitError(kExitNotIdentified, fmt::format("{}: the corrected configuration does not load: {}; nothing was "
-                                                   "written", printable(o.out), e.what())),
+                                                   "written",
+                                                   printable(o.out), e.what())),
          Status::NotIdentifiable);
   }
   try {
@@ -690,16 +694,16 @@ int run_identify(const IdentifyOptions& o) {
                                               : "twist only (the drives' travel is right; --lead-effect twist)");
   const SignFit& plus = id.fits[0];
   const SignFit& minus = id.fits[1];
-  text += fmt::format("twist sign: +1 cost {:.4g} m^2{}, -1 cost {:.4g} m^2{}: {} ({}-hand thread), cost ratio {:.3g}\n",
-                      plus.cost, plus.lead_at_bound ? " (lead at 0)" : "", minus.cost,
-                      minus.lead_at_bound ? " (lead at 0)" : "", id.estimate.twist_sign > 0.0 ? "+1" : "-1",
-                      id.estimate.twist_sign > 0.0 ? "right" : "left", id.cost_ratio);
+  text += fmt::format(
+      "twist sign: +1 cost {:.4g} m^2{}, -1 cost {:.4g} m^2{}: {} ({}-hand thread), cost ratio {:.3g}\n", plus.cost,
+      plus.lead_at_bound ? " (lead at 0)" : "", minus.cost, minus.lead_at_bound ? " (lead at 0)" : "",
+      id.estimate.twist_sign > 0.0 ? "+1" : "-1", id.estimate.twist_sign > 0.0 ? "right" : "left", id.cost_ratio);
   text += fmt::format(
       "residual: rms {:.4f} mm before (nominal model, tracker frame by Kabsch), {:.4f} mm after, largest {:.4f} mm "
       "(line {}); noise {:.4f} mm per axis (the tracker's scatter at rest {:.4f} mm); condition {:.3g}\n",
       1e3 * id.rms_before, 1e3 * id.rms_after, 1e3 * id.max_after,
-      log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]], 1e3 * id.sigma,
-      1e3 * scatter_at_rest(set), id.condition);
+      log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]], 1e3 * id.sigma, 1e3 * scatter_at_rest(set),
+      id.condition);
   text += fmt::format("{:<12} {:>12} {:>12} {:>10} {:>12}\n", "parameter", "nominal", "estimate", "sd", "change");
   for (const ParameterRow& r : parameter_rows(model, id)) {
     const std::string change = r.name == "lead" ? fmt::format("{:+.4f} %", 100.0 * (r.estimate / r.nominal - 1.0))
@@ -708,10 +712,11 @@ int run_identify(const IdentifyOptions& o) {
                         r.decimals, r.scale * r.estimate, r.decimals, r.scale * r.sd, r.decimals, change, r.unit);
   }
   const Eigen::AngleAxisd turn(id.estimate.X_BT.R);
-  text += fmt::format("tracker frame in the base frame: origin ({:.4f}, {:.4f}, {:.4f}) m, turned {:.4f} deg about "
-                      "({:.4f}, {:.4f}, {:.4f})\n",
-                      id.estimate.X_BT.t.x(), id.estimate.X_BT.t.y(), id.estimate.X_BT.t.z(),
-                      rad2deg(turn.angle()), turn.axis().x(), turn.axis().y(), turn.axis().z());
+  text += fmt::format(
+      "tracker frame in the base frame: origin ({:.4f}, {:.4f}, {:.4f}) m, turned {:.4f} deg about "
+      "({:.4f}, {:.4f}, {:.4f})\n",
+      id.estimate.X_BT.t.x(), id.estimate.X_BT.t.y(), id.estimate.X_BT.t.z(), rad2deg(turn.angle()), turn.axis().x(),
+      turn.axis().y(), turn.axis().z());
   text += fmt::format("wrote {}: the corrected configuration", o.out);
   write_stdout_or_withdraw(text + "\n", {o.out});
   return kExitOk;
@@ -729,12 +734,14 @@ Command make_synth_command(CLI::App& root) {
       "errors, the noise) beside it, all files or none; outputs naming the same file are refused (exit 2). Input for "
       "measure.");
   add_run_options(*app, o->run);
-  app->add_option("--noise-um", o->noise_um, "Tracker noise, standard deviation per axis [um], >= 0")->capture_default_str();
+  app->add_option("--noise-um", o->noise_um, "Tracker noise, standard deviation per axis [um], >= 0")
+      ->capture_default_str();
   app->add_option("--rate", o->rate, "Tracker samples per second [Hz], > 0; must divide the control rate")
       ->capture_default_str();
   app->add_option("--seed", o->seed, "Seed of the tracker's placement, the noise and random offsets")
       ->capture_default_str();
-  app->add_option("--lead-error-pct", o->lead_error_pct, "Real lead minus nominal, in % of the nominal; above -100 (a zero lead)")
+  app->add_option("--lead-error-pct", o->lead_error_pct,
+                  "Real lead minus nominal, in % of the nominal; above -100 (a zero lead)")
       ->capture_default_str();
   app->add_flag("--flip-sign", o->flip_sign, "The real twist term has the opposite sign (other thread hand)");
   app->add_option("--offsets-mm", o->offsets_mm,
@@ -758,7 +765,8 @@ Command make_measure_command(CLI::App& root) {
       "A laser tracker's point log of the observation point, processed as the paper's experiment: aligned in time "
       "with the commanded trajectory, the tracker frame registered (Kabsch/Umeyama) on the points at rest in a window "
       "(the calibration moves with --test), the observation-point errors of the points after it, beside the "
-      "simulation of the same run: the study's table, summary.json/.md, CSVs and figures, written as a set (all or none, "
+      "simulation of the same run: the study's table, summary.json/.md, CSVs and figures, written as a set (all or "
+      "none, "
       "exit 4). Two --columns names for one column, or a point farther from the run than a leg is long, is exit 2.");
   add_log_options(*app, o->log);
   add_run_options(*app, o->run);

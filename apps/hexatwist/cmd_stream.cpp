@@ -7,8 +7,8 @@
 #include <unistd.h>
 
 #include <array>
-#include <chrono>
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -51,7 +51,7 @@ struct StreamOptions {
   std::uint64_t count = 0;
   double idle_timeout = 0;
   int rt_priority = 0;
-  int cpu = -1;  // -1 = any
+  int cpu = -1;                  // -1 = any
   int receive_buffer = 4 << 20;  // bytes
   bool busy_poll = false;
   bool quiet = false;
@@ -117,7 +117,8 @@ class LineReader {
 };
 
 template <class E>
-E parse_choice(const std::string& text, const std::string& option, std::initializer_list<std::pair<const char*, E>> choices) {
+E parse_choice(const std::string& text, const std::string& option,
+               std::initializer_list<std::pair<const char*, E>> choices) {
   std::string names;
   for (const auto& [name, value] : choices) {
     if (text == name) return value;
@@ -128,8 +129,8 @@ E parse_choice(const std::string& text, const std::string& option, std::initiali
 
 StreamSettings settings_from(const StreamOptions& o) {
   StreamSettings s;
-  s.strategy = parse_choice<Strategy>(o.strategy, "--strategy",
-                                      {{"compensated", Strategy::Compensated}, {"conventional", Strategy::Conventional}});
+  s.strategy = parse_choice<Strategy>(
+      o.strategy, "--strategy", {{"compensated", Strategy::Compensated}, {"conventional", Strategy::Conventional}});
   s.on_reject = parse_choice<RejectPolicy>(o.on_reject, "--on-reject",
                                            {{"hold", RejectPolicy::Hold}, {"skip", RejectPolicy::Skip}});
   s.period = 1.0 / o.rate;
@@ -194,10 +195,12 @@ void enter_realtime(int priority) {
   sched_param p{};
   p.sched_priority = priority;
   if (sched_setscheduler(0, SCHED_FIFO, &p) != 0)
-    throw ExitError(kExitBadInput, fmt::format("--rt-priority {}: cannot use SCHED_FIFO: {} (needs root or CAP_SYS_NICE)",
-                                               priority, std::strerror(errno)));
+    throw ExitError(kExitBadInput,
+                    fmt::format("--rt-priority {}: cannot use SCHED_FIFO: {} (needs root or CAP_SYS_NICE)", priority,
+                                std::strerror(errno)));
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-    throw ExitError(kExitBadInput, fmt::format("--rt-priority {}: cannot lock memory: {}", priority, std::strerror(errno)));
+    throw ExitError(kExitBadInput,
+                    fmt::format("--rt-priority {}: cannot lock memory: {}", priority, std::strerror(errno)));
 }
 
 // Default UDP endpoints: loopback, poses to port 9000, answers to port 9001.
@@ -230,14 +233,16 @@ int run_stream(StreamOptions o) {
     in_udp->set_receive_buffer(o.receive_buffer, "--receive-buffer");
     in_text = udp_text(local.host, in_udp->local_port());  // the port it got, also for port 0
   } else if (o.input != "stdin" && o.input != "-") {
-    throw ExitError(kExitBadInput, fmt::format("--input: '{}' is neither stdin nor udp://HOST:PORT", printable(o.input)));
+    throw ExitError(kExitBadInput,
+                    fmt::format("--input: '{}' is neither stdin nor udp://HOST:PORT", printable(o.input)));
   }
   if (is_udp(o.output)) {
     const UdpAddress peer = parse_udp_address(o.output, "--output");
     out_udp = UdpSocket::connected(peer, "--output");
     out_text = peer.text;
   } else if (o.output != "stdout" && o.output != "-") {
-    throw ExitError(kExitBadInput, fmt::format("--output: '{}' is neither stdout nor udp://HOST:PORT", printable(o.output)));
+    throw ExitError(kExitBadInput,
+                    fmt::format("--output: '{}' is neither stdout nor udp://HOST:PORT", printable(o.output)));
   }
   if (o.busy_poll && o.rt_priority > 0 && rt_throttled())
     throw ExitError(kExitBadInput,
@@ -311,7 +316,8 @@ int run_stream(StreamOptions o) {
     for (std::size_t k = 1; k < by_status.size(); ++k)
       if (by_status[k] > 0)
         reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", by_status[k], to_string(static_cast<Status>(k)));
-    std::fprintf(stderr, "hexatwist stream: %s; %llu inputs; commands: %llu new, %llu held, %llu none; %llu rejected%s%s%s\n",
+    std::fprintf(stderr,
+                 "hexatwist stream: %s; %llu inputs; commands: %llu new, %llu held, %llu none; %llu rejected%s%s%s\n",
                  stop_reason.c_str(), static_cast<unsigned long long>(state->inputs),
                  static_cast<unsigned long long>(by_action[0]), static_cast<unsigned long long>(by_action[1]),
                  static_cast<unsigned long long>(by_action[2]), static_cast<unsigned long long>(rejected),
@@ -337,9 +343,13 @@ Command make_stream_command(CLI::App& root) {
       "input, --count, --idle-timeout or SIGINT/SIGTERM, with a summary on stderr; exit 0 if every input was "
       "accepted, 3 if any was rejected.");
   add_model_options(*app, o->model);
-  app->add_option("--input", o->input, "stdin, or udp://HOST:PORT to listen on (HOST defaults to 127.0.0.1; port 0 picks one; udp alone: udp://127.0.0.1:9000)")
+  app->add_option("--input", o->input,
+                  "stdin, or udp://HOST:PORT to listen on (HOST defaults to 127.0.0.1; port 0 picks one; udp alone: "
+                  "udp://127.0.0.1:9000)")
       ->capture_default_str();
-  app->add_option("--output", o->output, "stdout, or udp://HOST:PORT to send each answer to (HOST defaults to 127.0.0.1; udp alone: udp://127.0.0.1:9001)")
+  app->add_option("--output", o->output,
+                  "stdout, or udp://HOST:PORT to send each answer to (HOST defaults to 127.0.0.1; udp alone: "
+                  "udp://127.0.0.1:9001)")
       ->capture_default_str();
   app->add_option("--strategy", o->strategy, "compensated (Eq. 12, twist included) or conventional (twist ignored)")
       ->capture_default_str();
@@ -350,14 +360,20 @@ Command make_stream_command(CLI::App& root) {
                   "hold: answer a rejected pose with the last valid command; skip: with no command")
       ->capture_default_str();
   app->add_option("--max-velocity", o->max_velocity, "rate limit of each leg's command [m/s] (0: none)");
-  app->add_option("--max-acceleration", o->max_acceleration, "acceleration limit of each leg's command [m/s^2] (0: none)");
-  app->add_option("--rate", o->rate, "input rate the limits assume [Hz]: one input every 1/rate s; only with --max-velocity or --max-acceleration")->capture_default_str();
+  app->add_option("--max-acceleration", o->max_acceleration,
+                  "acceleration limit of each leg's command [m/s^2] (0: none)");
+  app->add_option(
+         "--rate", o->rate,
+         "input rate the limits assume [Hz]: one input every 1/rate s; only with --max-velocity or --max-acceleration")
+      ->capture_default_str();
   app->add_option("--start", o->start,
                   "pose the platform stands at when the stream starts (x,y,z [m],roll,pitch,yaw [deg]), home or none; "
                   "default: home with rate limits, none without");
   app->add_option("--count", o->count, "stop after this many inputs (0: no limit)");
-  app->add_option("--idle-timeout", o->idle_timeout, "UDP: stop after this many seconds without a datagram (0: wait); refused on stdin");
-  app->add_option("--rt-priority", o->rt_priority, "run under SCHED_FIFO at this priority with memory locked (needs root)");
+  app->add_option("--idle-timeout", o->idle_timeout,
+                  "UDP: stop after this many seconds without a datagram (0: wait); refused on stdin");
+  app->add_option("--rt-priority", o->rt_priority,
+                  "run under SCHED_FIFO at this priority with memory locked (needs root)");
   app->add_option("--cpu", o->cpu, "pin the process to this CPU (0-based; default: any)");
   app->add_option("--receive-buffer", o->receive_buffer,
                   "UDP: socket receive buffer [bytes] (the kernel caps it at net.core.rmem_max): poses that arrive "
@@ -375,21 +391,26 @@ Command make_stream_command(CLI::App& root) {
                 if (app->count(udp_only) > 0)
                   throw ExitError(kExitBadInput, fmt::format("{}: only with --input udp://HOST:PORT", udp_only));
             if (app->count("--rate") > 0 && o->max_velocity == 0 && o->max_acceleration == 0)
-              throw ExitError(kExitBadInput, "--rate: only with --max-velocity or --max-acceleration (the input rate "
-                                             "their limits assume)");
+              throw ExitError(kExitBadInput,
+                              "--rate: only with --max-velocity or --max-acceleration (the input rate "
+                              "their limits assume)");
             if (!(o->rate > 0) || !std::isfinite(o->rate))
               throw ExitError(kExitBadInput, "--rate: expected a positive rate [Hz]");
             // Finite but absurd: no input arrives (or is parsed) faster than every microsecond.
             if (o->rate > 1e6)
               throw ExitError(kExitBadInput, fmt::format("--rate {:g}: expected at most 1e6 Hz (one input per "
-                                                         "microsecond) [Hz]", o->rate));
+                                                         "microsecond) [Hz]",
+                                                         o->rate));
             if (o->rt_priority < 0 || o->rt_priority > sched_get_priority_max(SCHED_FIFO))
-              throw ExitError(kExitBadInput, fmt::format("--rt-priority {}: expected a SCHED_FIFO priority {}..{}, or 0 "
-                                                         "for none", o->rt_priority, sched_get_priority_min(SCHED_FIFO),
-                                                         sched_get_priority_max(SCHED_FIFO)));
+              throw ExitError(
+                  kExitBadInput,
+                  fmt::format("--rt-priority {}: expected a SCHED_FIFO priority {}..{}, or 0 "
+                              "for none",
+                              o->rt_priority, sched_get_priority_min(SCHED_FIFO), sched_get_priority_max(SCHED_FIFO)));
             if (o->max_velocity < 0 || o->max_acceleration < 0 || !std::isfinite(o->max_velocity) ||
                 !std::isfinite(o->max_acceleration))
-              throw ExitError(kExitBadInput, "--max-velocity, --max-acceleration: expected a positive limit, or 0 for none");
+              throw ExitError(kExitBadInput,
+                              "--max-velocity, --max-acceleration: expected a positive limit, or 0 for none");
             if (o->idle_timeout < 0 || !std::isfinite(o->idle_timeout))
               throw ExitError(kExitBadInput, "--idle-timeout: expected seconds >= 0");
             return run_stream(*o);

@@ -60,8 +60,10 @@ int run_simulate(const StudyOptions& o) {
 
 void add_common(CLI::App& app, StudyOptions& o) {
   add_model_options(app, o.model);
-  app.add_option("--out", o.out, "Output folder for summary.json, summary.md, CSVs and figures (created if missing), written as a set: all "
-                 "or none (exit 4); in a reused folder, an earlier run's files that this run does not write are removed")
+  app.add_option(
+         "--out", o.out,
+         "Output folder for summary.json, summary.md, CSVs and figures (created if missing), written as a set: all "
+         "or none (exit 4); in a reused folder, an earlier run's files that this run does not write are removed")
       ->capture_default_str();
   app.add_flag("--no-figures", o.no_figures, "Skip the PNG/SVG figures (gnuplot)");
   app.add_flag("--no-csv", o.no_csv, "Skip the per-tick CSVs (about 9 MB per test and strategy at 1 kHz)");

@@ -30,14 +30,15 @@ int main(int argc, char** argv) {
   CLI::App app{
       "hexatwist: twist-aware kinematics of lead-screw Stewart platforms.\n"
       "Poses are typed as x,y,z [m] and roll,pitch,yaw [deg] (R = Rz*Ry*Rx); all JSON output is SI (m, rad).\n"
-      "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit, numerical failure or (dynamics) a motor outside its envelope, 4 output not written, 5 identify: "
+      "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit, numerical failure or (dynamics) a motor outside its "
+      "envelope, 4 output not written, 5 identify: "
       "the data do not determine the parameters."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
-  const std::vector<Command> commands{make_study_command(app),   make_simulate_command(app), make_dynamics_command(app), make_synth_command(app),
-                                      make_measure_command(app), make_identify_command(app), make_stream_command(app),   make_ik_command(app),
-                                      make_fk_command(app),      make_config_command(app),   make_linuxcnc_command(app),
-                                      make_mjcf_command(app)};
+  const std::vector<Command> commands{make_study_command(app),  make_simulate_command(app), make_dynamics_command(app),
+                                      make_synth_command(app),  make_measure_command(app),  make_identify_command(app),
+                                      make_stream_command(app), make_ik_command(app),       make_fk_command(app),
+                                      make_config_command(app), make_linuxcnc_command(app), make_mjcf_command(app)};
   // Help and version go to standard output like every result: a failed write is exit 4.
   const auto print_and_check = [&](const CLI::Error& e) {
     const int code = app.exit(e);
@@ -66,9 +67,10 @@ int main(int argc, char** argv) {
       if (word.starts_with("-")) continue;
       for (const Command& c : commands) chosen = chosen || c.app->get_name() == word;
       if (chosen) break;
-      print_error("hexatwist: error: ", fmt::format("unknown subcommand '{}'; expected study, simulate, dynamics, synth, "
-                                                    "measure, identify, stream, ik, fk, config, linuxcnc or mjcf (see --help)",
-                                                    word));
+      print_error("hexatwist: error: ",
+                  fmt::format("unknown subcommand '{}'; expected study, simulate, dynamics, synth, "
+                              "measure, identify, stream, ik, fk, config, linuxcnc or mjcf (see --help)",
+                              word));
       return kExitBadInput;
     }
     print_error("hexatwist: error: ", fmt::format("{} (see --help)", e.what()));

@@ -278,8 +278,7 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
           "the {} of {} (t <= {:.3f} s): rms residual {} mm, largest {} mm (line {}), noise estimate {} mm per axis, "
           "condition {:.3g}. The {} points after them are evaluated (`{}_measured.csv`).\n",
           t.name, r.source, strategy_name(r.strategy), reg.count, m.window, r.window, m.window_end,
-          mm(reg.rms_residual), mm(reg.max_residual),
-          worst_line(m), mm(reg.sigma), reg.condition,
+          mm(reg.rms_residual), mm(reg.max_residual), worst_line(m), mm(reg.sigma), reg.condition,
           m.points.size() - m.window, t.name);
     }
   }
@@ -476,8 +475,8 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std:
 }
 
 void simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<ReportedTest>& tests,
-                                std::chrono::steady_clock::time_point start,
-                                const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation) {
+                         std::chrono::steady_clock::time_point start,
+                         const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation) {
   simulate_tests(rig, tests, o.out_dir);
   const double simulated = [&] {
     double d = 0.0;
@@ -672,8 +671,10 @@ std::vector<std::string> write_report(const Rig& rig, const ReportOptions& o, co
         others.push_back(n);
       }
     }
-    std::string note = fmt::format("hexatwist {}: note: --out '{}' was not empty: {} files replaced, {} of an earlier "
-                                   "run removed", o.command, printable(o.out_dir), replaced, removed);
+    std::string note = fmt::format(
+        "hexatwist {}: note: --out '{}' was not empty: {} files replaced, {} of an earlier "
+        "run removed",
+        o.command, printable(o.out_dir), replaced, removed);
     if (!others.empty()) {
       note += fmt::format("; {} other files left, not described by the summary:", others.size());
       for (std::size_t k = 0; k < others.size() && k < 5; ++k) note += " " + printable(others[k]);

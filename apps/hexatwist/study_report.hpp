@@ -66,8 +66,8 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std:
 /// platform, those lines, the table, the notes, and the time taken since `start`. If standard
 /// output cannot be written, the report's files are removed (ExitError(4)): all or nothing.
 void simulate_and_report(const Rig& rig, const ReportOptions& options, std::vector<ReportedTest>& tests,
-                                std::chrono::steady_clock::time_point start,
-                                const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation = {});
+                         std::chrono::steady_clock::time_point start,
+                         const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation = {});
 
 /// Notes for the reader that the table does not show (torque saturation); empty if none.
 std::string report_notes(const Rig& rig, const std::vector<ReportedTest>& tests);

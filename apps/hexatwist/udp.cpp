@@ -69,7 +69,8 @@ namespace {
 
 int open_socket(const UdpAddress& a, std::string_view option) {
   const int fd = ::socket(a.addr.ss_family, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) throw ExitError(kExitBadInput, fmt::format("{}: cannot open a UDP socket: {}", option, std::strerror(errno)));
+  if (fd < 0)
+    throw ExitError(kExitBadInput, fmt::format("{}: cannot open a UDP socket: {}", option, std::strerror(errno)));
   return fd;
 }
 
@@ -78,7 +79,8 @@ int open_socket(const UdpAddress& a, std::string_view option) {
 UdpSocket UdpSocket::bound(const UdpAddress& local, std::string_view option) {
   UdpSocket s(open_socket(local, option));
   if (::bind(s.fd_, reinterpret_cast<const sockaddr*>(&local.addr), local.length) != 0)
-    throw ExitError(kExitBadInput, fmt::format("{}: cannot listen on {}: {}", option, local.text, std::strerror(errno)));
+    throw ExitError(kExitBadInput,
+                    fmt::format("{}: cannot listen on {}: {}", option, local.text, std::strerror(errno)));
   return s;
 }
 

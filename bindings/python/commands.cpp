@@ -61,7 +61,8 @@ py::array_t<double> motor_command(const Model& model, const py::object& pose_in,
     pose = pose_row(q, 0);
   } else {
     const Rows6 r = rows6(pose_in, "pose");
-    if (!r.single) raise_input("pose: expected 6 numbers x, y, z [m], roll, pitch, yaw [rad]; use commands() for (N, 6)");
+    if (!r.single)
+      raise_input("pose: expected 6 numbers x, y, z [m], roll, pitch, yaw [rad]; use commands() for (N, 6)");
     pose = pose_row(r.data, 0);
   }
   Vector6d c;

@@ -31,10 +31,10 @@ inline constexpr std::size_t kBlock = 4096;
 /// A checked read-only view of an (N, 6) float64 array (or (6,) seen as N = 1). Throws
 /// ValueError / TypeError with one line naming the argument. Holds the array (or its copy).
 struct Rows6 {
-  py::array array;     ///< the array read (the input itself when it was C-contiguous float64)
+  py::array array;  ///< the array read (the input itself when it was C-contiguous float64)
   const double* data = nullptr;
   std::size_t rows = 0;
-  bool single = false; ///< the input was one row of shape (6,)
+  bool single = false;  ///< the input was one row of shape (6,)
 };
 Rows6 rows6(const py::handle& obj, const char* name, bool allow_single = true);
 

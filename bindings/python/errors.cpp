@@ -30,7 +30,8 @@ Errors& errors() {
 }
 
 void raise_status(Status s, const std::string& what) {
-  py::object err = errors().status_error(what + ": " + std::string(to_string(s)) + " (" + std::string(describe(s)) + ")");
+  py::object err =
+      errors().status_error(what + ": " + std::string(to_string(s)) + " (" + std::string(describe(s)) + ")");
   err.attr("status") = py::str(std::string(to_string(s)));
   PyErr_SetObject(errors().status_error.ptr(), err.ptr());
   throw py::error_already_set();
@@ -113,9 +114,9 @@ void expose_errors(py::module_& m) {
   auto sub = [&](const char* qual, const char* doc, py::tuple bases) {
     return py::reinterpret_steal<py::object>(PyErr_NewExceptionWithDoc(qual, doc, bases.ptr(), nullptr));
   };
-  e.config_error = sub("hexatwist.ConfigError",
-                       "An invalid model, configuration or input text (the library's one-line message).",
-                       py::make_tuple(e.error, builtins.attr("ValueError")));
+  e.config_error =
+      sub("hexatwist.ConfigError", "An invalid model, configuration or input text (the library's one-line message).",
+          py::make_tuple(e.error, builtins.attr("ValueError")));
   e.input_error = sub("hexatwist.InputError", "A bad argument: shape, NaN or inf, an unknown name.",
                       py::make_tuple(e.error, builtins.attr("ValueError")));
   e.dtype_error = sub("hexatwist.DTypeError", "An array argument of the wrong dtype (float64 expected).",
@@ -142,17 +143,26 @@ void expose_errors(py::module_& m) {
   for (int s = 0; s <= static_cast<int>(Status::AssemblyModeChanged); ++s)
     names.append(py::str(std::string(to_string(static_cast<Status>(s)))));
   m.attr("STATUS_NAMES") = py::tuple(names);
-  m.def("describe_status", [](int s) {
-    if (s < 0 || s > static_cast<int>(Status::AssemblyModeChanged)) raise_input("status: no status " + std::to_string(s));
-    return std::string(describe(static_cast<Status>(s)));
-  }, py::arg("status"), "One-sentence description of a status code.");
-  m.def("set_num_threads", [](int n) {
-    if (n < 0) raise_input("set_num_threads: expected a count >= 0 (0 = every core)");
-    thread_setting() = static_cast<unsigned>(n);
-  }, py::arg("n"), "Threads of the batch functions (0, the default: every core). Results do not depend on it.");
-  m.def("get_num_threads", [] { return thread_count(); }, "Threads the batch functions use.");
-  m.def("_input_copies", [] { return input_copies().load(); },
-        "Debug counter: inputs the bindings had to copy (never a C-contiguous float64 array).");
+  m.def(
+      "describe_status",
+      [](int s) {
+        if (s < 0 || s > static_cast<int>(Status::AssemblyModeChanged))
+          raise_input("status: no status " + std::to_string(s));
+        return std::string(describe(static_cast<Status>(s)));
+      },
+      py::arg("status"), "One-sentence description of a status code.");
+  m.def(
+      "set_num_threads",
+      [](int n) {
+        if (n < 0) raise_input("set_num_threads: expected a count >= 0 (0 = every core)");
+        thread_setting() = static_cast<unsigned>(n);
+      },
+      py::arg("n"), "Threads of the batch functions (0, the default: every core). Results do not depend on it.");
+  m.def(
+      "get_num_threads", [] { return thread_count(); }, "Threads the batch functions use.");
+  m.def(
+      "_input_copies", [] { return input_copies().load(); },
+      "Debug counter: inputs the bindings had to copy (never a C-contiguous float64 array).");
 }
 
 }  // namespace hexatwist::python

@@ -41,8 +41,7 @@ py::dict fk_batch(const Model& model, const py::object& lengths_in, const std::s
     Placement start;  // home; then the last solution of this block
     for (std::size_t i = begin; i < end; ++i) {
       if (!chain) start = placement_from_pose(pose_row(guess.data, guess.single ? 0 : i));
-      const Status s =
-          forward_kinematics(model, Eigen::Map<const Vector6d>(l + 6 * i), kind, start, r, options);
+      const Status s = forward_kinematics(model, Eigen::Map<const Vector6d>(l + 6 * i), kind, start, r, options);
       ps[i] = static_cast<std::int8_t>(s);
       pi[i] = r.iterations;
       pr[i] = r.residual;
@@ -128,7 +127,8 @@ py::dict tracker_track(PyFkTracker& t, const py::object& lengths_in, int max_ite
 }  // namespace
 
 void expose_forward(py::module_& m) {
-  py::class_<PyFkTracker>(m, "FkTracker",
+  py::class_<PyFkTracker>(
+      m, "FkTracker",
       "Forward kinematics along a motion (forward.hpp, forward_kinematics_tracked): each solve starts from the "
       "last solution and is ok only on the same assembly mode (the sign of the Jacobian's determinant) and with "
       "the Jacobian's condition inside limits.jacobian_condition_max (else platform_singularity); a failed row "
@@ -150,15 +150,19 @@ void expose_forward(py::module_& m) {
            "Solves (N, 6) or (6,) leg lengths [m] in order (GIL released). Returns a dict: poses (N, 6) [m, rad] "
            "(NaN unless ok), status (N,) int8 (ok, assembly_mode_changed, platform_singularity, no_convergence, "
            "...), iterations (N,) int32, residual (N,) [m], condition (N,) [-] and det_sign (N,) [-].")
-      .def_property_readonly("valid", [](const PyFkTracker& t) { return t.tracker.valid; },
-                             "False until set() or the first solution.")
-      .def_property_readonly("det_sign", [](const PyFkTracker& t) { return t.tracker.det_sign; },
-                             "Assembly mode kept: sign of the Jacobian's determinant (0 before the first).")
-      .def_property_readonly("last", [](const PyFkTracker& t) -> py::object {
-        if (!t.tracker.valid) return py::none();
-        const Vector6d q = pose_from_placement(t.tracker.last).to_vector();
-        return py::array_t<double>(6, q.data());
-      }, "The last solution [m, rad], the next solve's start (None until valid).");
+      .def_property_readonly(
+          "valid", [](const PyFkTracker& t) { return t.tracker.valid; }, "False until set() or the first solution.")
+      .def_property_readonly(
+          "det_sign", [](const PyFkTracker& t) { return t.tracker.det_sign; },
+          "Assembly mode kept: sign of the Jacobian's determinant (0 before the first).")
+      .def_property_readonly(
+          "last",
+          [](const PyFkTracker& t) -> py::object {
+            if (!t.tracker.valid) return py::none();
+            const Vector6d q = pose_from_placement(t.tracker.last).to_vector();
+            return py::array_t<double>(6, q.data());
+          },
+          "The last solution [m, rad], the next solve's start (None until valid).");
 
   m.def("_forward", &fk_batch, py::arg("model"), py::arg("lengths"), py::arg("kind") = "motor",
         py::arg("guess") = py::none(), py::arg("max_iterations") = 30, py::arg("tolerance") = 1e-12);

@@ -9,8 +9,9 @@ py::dict ik_batch(const Model& model, const py::object& poses_in) {
   const Rows6 poses = rows6(poses_in, "poses");
   const std::size_t n = poses.rows;
   auto lengths = new_rows(n, 6, poses.single);
-  py::array_t<double> axes = poses.single ? py::array_t<double>({6, 3})
-                                          : py::array_t<double>({static_cast<py::ssize_t>(n), py::ssize_t{6}, py::ssize_t{3}});
+  py::array_t<double> axes = poses.single
+                                 ? py::array_t<double>({6, 3})
+                                 : py::array_t<double>({static_cast<py::ssize_t>(n), py::ssize_t{6}, py::ssize_t{3}});
   auto bend_base = new_rows(n, 6, poses.single), bend_platform = new_rows(n, 6, poses.single);
   auto status = new_column<std::int8_t>(n, poses.single);
   double *pl = lengths.mutable_data(), *pa = axes.mutable_data(), *pb = bend_base.mutable_data(),

@@ -63,7 +63,8 @@ py::dict measured_test(const py::object& config_src, const std::string& test) {
   for (const StudyTest& st : seed_tests(config.study)) {
     if (st.name != test) continue;
     double end = 0.0;
-    const Trajectory tr = measured_test_trajectory(config.study, st, CalibrationSpec{}, config.rig.control_period(), end);
+    const Trajectory tr =
+        measured_test_trajectory(config.study, st, CalibrationSpec{}, config.rig.control_period(), end);
     py::array_t<double> t(static_cast<py::ssize_t>(tr.poses.size()));
     py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
     for (std::size_t k = 0; k < tr.poses.size(); ++k) {
@@ -85,7 +86,8 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
   const TimedPoses tp = timed(t, poses);
   PointLog log;
   std::size_t ns = 0, np = 0;
-  if (!py::isinstance<py::array_t<double>>(stamps) || stamps.ndim() != 1) raise_input("stamps: expected a 1-D float64 array [s]");
+  if (!py::isinstance<py::array_t<double>>(stamps) || stamps.ndim() != 1)
+    raise_input("stamps: expected a 1-D float64 array [s]");
   const double* p = rows_of(points, 3, "points", np);
   ns = static_cast<std::size_t>(stamps.shape(0));
   if (ns != np) raise_input("stamps and points: expected as many stamps as points");
@@ -97,9 +99,11 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
     log.stamp_columns.push_back(1);
   }
   log.source = "point log";
-  const ObservationSet set = observations_at_rest(model, tp, log, TimeAlignment{time_offset, 0.0}, strategy_from(strategy), settle);
+  const ObservationSet set =
+      observations_at_rest(model, tp, log, TimeAlignment{time_offset, 0.0}, strategy_from(strategy), settle);
   const std::size_t k = set.observations.size();
-  py::array_t<double> motor({static_cast<py::ssize_t>(k), py::ssize_t{6}}), pts({static_cast<py::ssize_t>(k), py::ssize_t{3}});
+  py::array_t<double> motor({static_cast<py::ssize_t>(k), py::ssize_t{6}}),
+      pts({static_cast<py::ssize_t>(k), py::ssize_t{3}});
   for (std::size_t i = 0; i < k; ++i) {
     std::copy(set.observations[i].motor.data(), set.observations[i].motor.data() + 6, motor.mutable_data() + 6 * i);
     std::copy(set.observations[i].p_T.data(), set.observations[i].p_T.data() + 3, pts.mutable_data() + 3 * i);
@@ -126,15 +130,19 @@ py::dict params(const PlatformParameters& p) {
   return d;
 }
 
-py::dict identify_py(const Model& model, const py::array& motor, const py::array& points, const std::string& lead_effect) {
+py::dict identify_py(const Model& model, const py::array& motor, const py::array& points,
+                     const std::string& lead_effect) {
   std::size_t nm = 0, np = 0;
   const double* m = rows_of(motor, 6, "motor", nm);
   const double* p = rows_of(points, 3, "points", np);
   if (nm != np) raise_input("motor and points: expected as many rows");
   IdentificationOptions o;
-  if (lead_effect == "twist") o.lead_effect = LeadEffect::TwistOnly;
-  else if (lead_effect == "travel") o.lead_effect = LeadEffect::TwistAndTravel;
-  else raise_input("lead_effect: expected 'twist' or 'travel', got '" + lead_effect + "'");
+  if (lead_effect == "twist")
+    o.lead_effect = LeadEffect::TwistOnly;
+  else if (lead_effect == "travel")
+    o.lead_effect = LeadEffect::TwistAndTravel;
+  else
+    raise_input("lead_effect: expected 'twist' or 'travel', got '" + lead_effect + "'");
   std::vector<Observation> obs(nm);
   for (std::size_t k = 0; k < nm; ++k) {
     obs[k].motor = Eigen::Map<const Vector6d>(m + 6 * k);
@@ -181,7 +189,8 @@ void expose_measurement(py::module_& m) {
   m.def("_measured_test", &measured_test, py::arg("config") = py::none(), py::arg("test") = "Rz");
   m.def("_observations_at_rest", &observations, py::arg("model"), py::arg("t"), py::arg("poses"), py::arg("stamps"),
         py::arg("points"), py::arg("time_offset") = 0.0, py::arg("strategy") = "compensated", py::arg("settle") = 0.25);
-  m.def("_identify", &identify_py, py::arg("model"), py::arg("motor"), py::arg("points"), py::arg("lead_effect") = "twist");
+  m.def("_identify", &identify_py, py::arg("model"), py::arg("motor"), py::arg("points"),
+        py::arg("lead_effect") = "twist");
 }
 
 }  // namespace hexatwist::python

@@ -19,7 +19,8 @@ py::array_t<double> array6(const Vector6d& v) { return py::array_t<double>(6, v.
 
 void require_finite(const Rows6& r, const char* name) {
   for (std::size_t i = 0; i < 6 * r.rows; ++i)
-    if (!std::isfinite(r.data[i])) raise_input(std::string(name) + ": row " + std::to_string(i / 6) + " holds NaN or inf");
+    if (!std::isfinite(r.data[i]))
+      raise_input(std::string(name) + ": row " + std::to_string(i / 6) + " holds NaN or inf");
 }
 
 Rows6 matching(const py::object& obj, const char* name, const Rows6& poses) {
@@ -30,9 +31,9 @@ Rows6 matching(const py::object& obj, const char* name, const Rows6& poses) {
   return r;
 }
 
-constexpr std::array<const char*, 12> kParts{"torque", "angle", "speed", "acceleration", "power", "gravity",
-                                             "platform_inertia", "velocity_product", "legs", "drives",
-                                             "friction", "screw_force"};
+constexpr std::array<const char*, 12> kParts{
+    "torque",           "angle", "speed",  "acceleration", "power",      "gravity", "platform_inertia",
+    "velocity_product", "legs",  "drives", "friction",     "screw_force"};
 
 py::dict inverse_dynamics_batch(const py::object& config, const py::object& poses_in, const py::object& rates_in,
                                 const py::object& accelerations_in) {
@@ -61,9 +62,17 @@ py::dict inverse_dynamics_batch(const py::object& config, const py::object& pose
                           Eigen::Map<const Vector6d>(accelerations.data + 6 * i));
       const Status s = inverse_dynamics(r, motion, id);
       ps[i] = static_cast<std::int8_t>(s);
-      const std::array<const Vector6d*, kParts.size()> v{&id.torque, &id.angle, &id.speed, &id.acceleration,
-                                                         &id.power, &id.gravity, &id.platform_inertia,
-                                                         &id.velocity_product, &id.legs, &id.drives, &id.friction,
+      const std::array<const Vector6d*, kParts.size()> v{&id.torque,
+                                                         &id.angle,
+                                                         &id.speed,
+                                                         &id.acceleration,
+                                                         &id.power,
+                                                         &id.gravity,
+                                                         &id.platform_inertia,
+                                                         &id.velocity_product,
+                                                         &id.legs,
+                                                         &id.drives,
+                                                         &id.friction,
                                                          &id.screw_force};
       for (std::size_t j = 0; j < kParts.size(); ++j)
         for (int k = 0; k < 6; ++k) p[j][6 * i + k] = s == Status::Ok ? (*v[j])[k] : NAN;
@@ -113,70 +122,92 @@ void expose_mechanism(py::module_& m) {
         py::arg("pose_accelerations"));
   m.def("_platform_motion", &platform_motion_batch, py::arg("poses"), py::arg("pose_rates"),
         py::arg("pose_accelerations"));
-  m.def("mass_matrix", [](const py::object& config, const py::object& pose) {
-    const auto rig = rig_of(config);
-    Matrix6d M;
-    check(mechanism_mass_matrix(rig->config->rig, placement_of(pose), M), "mass_matrix");
-    return matrix6(M);
-  }, py::arg("config"), py::arg("pose"),
-        "The mechanism's mass matrix M (6, 6) at `pose` [m, rad], every body included: kinetic energy = "
-        "1/2 x'^T M x' with x' = [v of the pivot [m/s, B]; w [rad/s, B]]; units kg, kg m, kg m^2 by block. "
-        "Raises StatusError where the pose has no inverse kinematics or twist.");
-  m.def("bias", [](const py::object& config, const py::object& pose, const py::object& velocity) {
-    const auto rig = rig_of(config);
-    Vector6d b;
-    check(mechanism_bias(rig->config->rig, placement_of(pose), vector6(velocity, "velocity"), b), "bias");
-    return array6(b);
-  }, py::arg("config"), py::arg("pose"), py::arg("velocity"),
-        "Generalised force of everything but the motors and friction at zero acceleration (velocity products "
-        "minus gravity) (6,) [N; N m, B], so that M x'' + bias = J_phi^T (torque - friction). `velocity` = "
-        "[v of the pivot m/s; w rad/s, B].");
-  m.def("forward_dynamics", [](const py::object& config, const py::object& pose, const py::object& velocity,
-                               const py::object& torque) {
-    const auto rig = rig_of(config);
-    Vector6d a;
-    check(forward_dynamics(rig->config->rig, placement_of(pose), vector6(velocity, "velocity"),
-                           vector6(torque, "torque"), a),
-          "forward_dynamics");
-    return array6(a);
-  }, py::arg("config"), py::arg("pose"), py::arg("velocity"), py::arg("torque"),
-        "Platform acceleration x'' (6,) [v' m/s^2; w' rad/s^2, B] for the net motor torques `torque` (6,) [N m] "
-        "at the shafts (friction not included: pass torque - friction), from M x'' = J_phi^T torque - bias, at "
-        "`pose` [m, rad] moving with `velocity` [v of the pivot m/s; w rad/s, B].");
-  m.def("kinetic_energy", [](const py::object& config, const py::object& pose, const py::object& velocity) {
-    const auto rig = rig_of(config);
-    double e = 0.0;
-    check(kinetic_energy(rig->config->rig, placement_of(pose), vector6(velocity, "velocity"), e), "kinetic_energy");
-    return e;
-  }, py::arg("config"), py::arg("pose"), py::arg("velocity"),
-        "Kinetic energy of every body [J] at `pose` [m, rad] moving with `velocity` [v of the pivot m/s; w rad/s, B].");
-  m.def("potential_energy", [](const py::object& config, const py::object& pose) {
-    const auto rig = rig_of(config);
-    double e = 0.0;
-    check(potential_energy(rig->config->rig, placement_of(pose), e), "potential_energy");
-    return e;
-  }, py::arg("config"), py::arg("pose"), "Potential energy in gravity of every body, zero at home [J].");
-  m.def("motor_angles", [](const py::object& config, const py::object& pose) {
-    const auto rig = rig_of(config);
-    Vector6d a;
-    check(motor_angles(rig->config->rig, placement_of(pose), a), "motor_angles");
-    return array6(a);
-  }, py::arg("config"), py::arg("pose"), "Motor angles relative to home (6,) [rad] at `pose` [m, rad] (twist included).");
-  m.def("motor_jacobian", [](const py::object& config, const py::object& pose) {
-    const auto rig = rig_of(config);
-    const Rig& r = rig->config->rig;
-    LegState legs;
-    check(inverse_kinematics(r.model(), Pose::from_vector(vector6(pose, "pose")), legs), "motor_jacobian");
-    Matrix6d J;
-    check(motor_jacobian(r, legs, J), "motor_jacobian");
-    return matrix6(J);
-  }, py::arg("config"), py::arg("pose"),
-        "Jacobian J_phi (6, 6) of the motor angles: phi' = J_phi x', x' = [v of the pivot m/s; w rad/s, B] "
-        "[rad/m | rad/rad].");
-  m.def("peak_torque_at", [](const py::object& config, double speed) {
-    return peak_torque_at(rig_of(config)->config->rig.servo(), speed);
-  }, py::arg("config"), py::arg("speed"),
-        "The motor's intermittent torque envelope at `speed` [rad/s] (its magnitude is used) [N m].");
+  m.def(
+      "mass_matrix",
+      [](const py::object& config, const py::object& pose) {
+        const auto rig = rig_of(config);
+        Matrix6d M;
+        check(mechanism_mass_matrix(rig->config->rig, placement_of(pose), M), "mass_matrix");
+        return matrix6(M);
+      },
+      py::arg("config"), py::arg("pose"),
+      "The mechanism's mass matrix M (6, 6) at `pose` [m, rad], every body included: kinetic energy = "
+      "1/2 x'^T M x' with x' = [v of the pivot [m/s, B]; w [rad/s, B]]; units kg, kg m, kg m^2 by block. "
+      "Raises StatusError where the pose has no inverse kinematics or twist.");
+  m.def(
+      "bias",
+      [](const py::object& config, const py::object& pose, const py::object& velocity) {
+        const auto rig = rig_of(config);
+        Vector6d b;
+        check(mechanism_bias(rig->config->rig, placement_of(pose), vector6(velocity, "velocity"), b), "bias");
+        return array6(b);
+      },
+      py::arg("config"), py::arg("pose"), py::arg("velocity"),
+      "Generalised force of everything but the motors and friction at zero acceleration (velocity products "
+      "minus gravity) (6,) [N; N m, B], so that M x'' + bias = J_phi^T (torque - friction). `velocity` = "
+      "[v of the pivot m/s; w rad/s, B].");
+  m.def(
+      "forward_dynamics",
+      [](const py::object& config, const py::object& pose, const py::object& velocity, const py::object& torque) {
+        const auto rig = rig_of(config);
+        Vector6d a;
+        check(forward_dynamics(rig->config->rig, placement_of(pose), vector6(velocity, "velocity"),
+                               vector6(torque, "torque"), a),
+              "forward_dynamics");
+        return array6(a);
+      },
+      py::arg("config"), py::arg("pose"), py::arg("velocity"), py::arg("torque"),
+      "Platform acceleration x'' (6,) [v' m/s^2; w' rad/s^2, B] for the net motor torques `torque` (6,) [N m] "
+      "at the shafts (friction not included: pass torque - friction), from M x'' = J_phi^T torque - bias, at "
+      "`pose` [m, rad] moving with `velocity` [v of the pivot m/s; w rad/s, B].");
+  m.def(
+      "kinetic_energy",
+      [](const py::object& config, const py::object& pose, const py::object& velocity) {
+        const auto rig = rig_of(config);
+        double e = 0.0;
+        check(kinetic_energy(rig->config->rig, placement_of(pose), vector6(velocity, "velocity"), e), "kinetic_energy");
+        return e;
+      },
+      py::arg("config"), py::arg("pose"), py::arg("velocity"),
+      "Kinetic energy of every body [J] at `pose` [m, rad] moving with `velocity` [v of the pivot m/s; w rad/s, B].");
+  m.def(
+      "potential_energy",
+      [](const py::object& config, const py::object& pose) {
+        const auto rig = rig_of(config);
+        double e = 0.0;
+        check(potential_energy(rig->config->rig, placement_of(pose), e), "potential_energy");
+        return e;
+      },
+      py::arg("config"), py::arg("pose"), "Potential energy in gravity of every body, zero at home [J].");
+  m.def(
+      "motor_angles",
+      [](const py::object& config, const py::object& pose) {
+        const auto rig = rig_of(config);
+        Vector6d a;
+        check(motor_angles(rig->config->rig, placement_of(pose), a), "motor_angles");
+        return array6(a);
+      },
+      py::arg("config"), py::arg("pose"),
+      "Motor angles relative to home (6,) [rad] at `pose` [m, rad] (twist included).");
+  m.def(
+      "motor_jacobian",
+      [](const py::object& config, const py::object& pose) {
+        const auto rig = rig_of(config);
+        const Rig& r = rig->config->rig;
+        LegState legs;
+        check(inverse_kinematics(r.model(), Pose::from_vector(vector6(pose, "pose")), legs), "motor_jacobian");
+        Matrix6d J;
+        check(motor_jacobian(r, legs, J), "motor_jacobian");
+        return matrix6(J);
+      },
+      py::arg("config"), py::arg("pose"),
+      "Jacobian J_phi (6, 6) of the motor angles: phi' = J_phi x', x' = [v of the pivot m/s; w rad/s, B] "
+      "[rad/m | rad/rad].");
+  m.def(
+      "peak_torque_at",
+      [](const py::object& config, double speed) { return peak_torque_at(rig_of(config)->config->rig.servo(), speed); },
+      py::arg("config"), py::arg("speed"),
+      "The motor's intermittent torque envelope at `speed` [rad/s] (its magnitude is used) [N m].");
 }
 
 }  // namespace hexatwist::python

@@ -150,15 +150,15 @@ std::string to_yaml(const Model& model) {
   auto driven = [](DrivenSide d) { return d == DrivenSide::Base ? "base" : "platform"; };
   o << "name: \"" << name << "\"\n";
   o << "home_height: " << num(s.home_height) << "   # [m]\n";
-  o << "screw:\n  lead: " << num(l0.lead) << "\n  thread: " << thread(l0.thread) << "\n  driven_side: "
-    << driven(l0.driven) << "\n";
+  o << "screw:\n  lead: " << num(l0.lead) << "\n  thread: " << thread(l0.thread)
+    << "\n  driven_side: " << driven(l0.driven) << "\n";
   o << "legs:   # base [m, B], platform [m, P], fixed U-joint axes base_axis [B], platform_axis [P]\n";
   for (const LegSpec& l : s.legs) {
     o << "  - base: " << list3(l.base_B) << "\n    platform: " << list3(l.platform_P) << "\n";
     if (l.axis_base_B != Vector3d::Zero()) o << "    base_axis: " << list3(l.axis_base_B) << "\n";
     if (l.axis_platform_P != Vector3d::Zero()) o << "    platform_axis: " << list3(l.axis_platform_P) << "\n";
-    o << "    lead: " << num(l.lead) << "\n    thread: " << thread(l.thread) << "\n    driven_side: " << driven(l.driven)
-      << "\n";
+    o << "    lead: " << num(l.lead) << "\n    thread: " << thread(l.thread)
+      << "\n    driven_side: " << driven(l.driven) << "\n";
   }
   o << "length_offsets: [";
   for (int i = 0; i < kLegs; ++i) o << (i ? ", " : "") << num(s.legs[static_cast<std::size_t>(i)].length_offset);
@@ -241,10 +241,13 @@ std::pair<std::string, std::string> read_source(const py::object& path_or_text) 
 
 }  // namespace
 
-std::pair<std::string, std::string> read_yaml_source(const py::object& path_or_text) { return read_source(path_or_text); }
+std::pair<std::string, std::string> read_yaml_source(const py::object& path_or_text) {
+  return read_source(path_or_text);
+}
 
 void expose_model(py::module_& m) {
-  py::class_<Model, std::shared_ptr<Model>> c(m, "Model",
+  py::class_<Model, std::shared_ptr<Model>> c(
+      m, "Model",
       "Immutable, validated six-leg U-P-U lead-screw platform. Frames: B is the base frame, P the platform "
       "frame (B translated by home_height along z at home). Build with default_model(), load_model(), or "
       "Model.from_arrays(); pickles exactly.");
@@ -261,65 +264,88 @@ void expose_model(py::module_& m) {
                "6); length_min, length_max [m]; bend_max, singularity_margin [rad]; jacobian_condition_max [-]; "
                "observation_point, pivot [m, P]. Raises ConfigError naming the leg and field at fault.");
   c.def_property_readonly("name", [](const Model& x) { return x.spec().name; });
-  c.def_property_readonly("home_height", [](const Model& x) { return x.spec().home_height; }, "[m]");
-  c.def_property_readonly("base", [](const Model& x) { return rows3(x.spec().legs, &LegSpec::base_B); },
-                          "Base joint centres (6, 3) [m, B].");
-  c.def_property_readonly("platform", [](const Model& x) { return rows3(x.spec().legs, &LegSpec::platform_P); },
-                          "Platform joint centres (6, 3) [m, P].");
-  c.def_property_readonly("base_axes", [](const Model& x) { return rows3(x.spec().legs, &LegSpec::axis_base_B); },
-                          "Fixed base U-joint axes ja as given (6, 3) [-, B].");
-  c.def_property_readonly("platform_axes",
-                          [](const Model& x) { return rows3(x.spec().legs, &LegSpec::axis_platform_P); },
-                          "Fixed platform U-joint axes jd as given (6, 3) [-, P].");
-  c.def_property_readonly("lead", [](const Model& x) {
-    Vector6d v;
-    for (int i = 0; i < kLegs; ++i) v[i] = x.leg(i).lead;
-    return vec(v);
-  }, "Screw lead per leg (6,) [m].");
-  c.def_property_readonly("threads", [](const Model& x) {
-    py::list l;
-    for (const Leg& g : x.legs()) l.append(g.thread == ThreadSense::Right ? "right" : "left");
-    return py::tuple(l);
-  }, "Thread hand per leg.");
-  c.def_property_readonly("length_offsets", [](const Model& x) {
-    Vector6d v;
-    for (int i = 0; i < kLegs; ++i) v[i] = x.leg(i).length_offset;
-    return vec(v);
-  }, "Real minus motor-side length at zero twist (6,) [m].");
-  c.def_property_readonly("twist_gain", [](const Model& x) { return vec(x.geometry().twist_gain); },
-                          "Real minus motor-side length per rad of twist, sign*lead/2pi (6,) [m/rad].");
-  c.def_property_readonly("length_home", [](const Model& x) { return vec(x.length_home()); },
-                          "Leg lengths at home (6,) [m].");
-  c.def_property_readonly("observation_point", [](const Model& x) { return vec(x.spec().observation_P); },
-                          "Observation point A [m, P].");
-  c.def_property_readonly("pivot", [](const Model& x) { return vec(x.spec().pivot_P); }, "Rotation pivot [m, P].");
+  c.def_property_readonly(
+      "home_height", [](const Model& x) { return x.spec().home_height; }, "[m]");
+  c.def_property_readonly(
+      "base", [](const Model& x) { return rows3(x.spec().legs, &LegSpec::base_B); },
+      "Base joint centres (6, 3) [m, B].");
+  c.def_property_readonly(
+      "platform", [](const Model& x) { return rows3(x.spec().legs, &LegSpec::platform_P); },
+      "Platform joint centres (6, 3) [m, P].");
+  c.def_property_readonly(
+      "base_axes", [](const Model& x) { return rows3(x.spec().legs, &LegSpec::axis_base_B); },
+      "Fixed base U-joint axes ja as given (6, 3) [-, B].");
+  c.def_property_readonly(
+      "platform_axes", [](const Model& x) { return rows3(x.spec().legs, &LegSpec::axis_platform_P); },
+      "Fixed platform U-joint axes jd as given (6, 3) [-, P].");
+  c.def_property_readonly(
+      "lead",
+      [](const Model& x) {
+        Vector6d v;
+        for (int i = 0; i < kLegs; ++i) v[i] = x.leg(i).lead;
+        return vec(v);
+      },
+      "Screw lead per leg (6,) [m].");
+  c.def_property_readonly(
+      "threads",
+      [](const Model& x) {
+        py::list l;
+        for (const Leg& g : x.legs()) l.append(g.thread == ThreadSense::Right ? "right" : "left");
+        return py::tuple(l);
+      },
+      "Thread hand per leg.");
+  c.def_property_readonly(
+      "length_offsets",
+      [](const Model& x) {
+        Vector6d v;
+        for (int i = 0; i < kLegs; ++i) v[i] = x.leg(i).length_offset;
+        return vec(v);
+      },
+      "Real minus motor-side length at zero twist (6,) [m].");
+  c.def_property_readonly(
+      "twist_gain", [](const Model& x) { return vec(x.geometry().twist_gain); },
+      "Real minus motor-side length per rad of twist, sign*lead/2pi (6,) [m/rad].");
+  c.def_property_readonly(
+      "length_home", [](const Model& x) { return vec(x.length_home()); }, "Leg lengths at home (6,) [m].");
+  c.def_property_readonly(
+      "observation_point", [](const Model& x) { return vec(x.spec().observation_P); }, "Observation point A [m, P].");
+  c.def_property_readonly(
+      "pivot", [](const Model& x) { return vec(x.spec().pivot_P); }, "Rotation pivot [m, P].");
   c.def_property_readonly("has_twist", &Model::has_twist, "True if any leg has a non-zero lead.");
-  c.def_property_readonly("limits", [](const Model& x) {
-    const LimitSpec& l = x.spec().limits;
-    py::dict d;
-    d["length_min"] = l.length_min;
-    d["length_max"] = l.length_max;
-    d["bend_max"] = l.bend_max;
-    d["singularity_margin"] = l.singularity_margin;
-    d["jacobian_condition_max"] = l.jacobian_condition_max;
-    return d;
-  }, "Limits: length_min, length_max [m], bend_max, singularity_margin [rad], jacobian_condition_max [-].");
+  c.def_property_readonly(
+      "limits",
+      [](const Model& x) {
+        const LimitSpec& l = x.spec().limits;
+        py::dict d;
+        d["length_min"] = l.length_min;
+        d["length_max"] = l.length_max;
+        d["bend_max"] = l.bend_max;
+        d["singularity_margin"] = l.singularity_margin;
+        d["jacobian_condition_max"] = l.jacobian_condition_max;
+        return d;
+      },
+      "Limits: length_min, length_max [m], bend_max, singularity_margin [rad], jacobian_condition_max [-].");
   c.def("to_yaml", &to_yaml,
         "The model as YAML configuration text (explicit legs; numbers in shortest round-trip form, angles in "
         "degrees) that load_model reads back.");
   c.def("__repr__", [](const Model& x) { return "<hexatwist.Model '" + x.spec().name + "'>"; });
   c.def(py::pickle([](const Model& x) { return state_of(x); }, [](const py::tuple& t) { return from_state(t); }));
 
-  m.def("default_model", [] { return std::make_shared<Model>(default_model()); },
-        "The embedded seed platform (configs/seed.yaml): Ra 1.2, Rb 1.5, da 0.2, db 0.3, H 1.511 m, lead 10 mm.");
-  m.def("load_model", [](const py::object& src) {
-    auto [text, source] = read_source(src);
-    return std::make_shared<Model>(load_model(text, source));
-  }, py::arg("path_or_yaml"),
-        "Model from a YAML file (str without ':' or newline, or os.PathLike) or YAML text. Raises ConfigError "
-        "with the library's one-line 'source:line:column: field ...' message.");
-  m.def("seed_config_yaml", [] { return std::string(seed_config_yaml()); },
-        "The embedded seed configuration (platform, servo, load, simulation, study) as YAML text.");
+  m.def(
+      "default_model", [] { return std::make_shared<Model>(default_model()); },
+      "The embedded seed platform (configs/seed.yaml): Ra 1.2, Rb 1.5, da 0.2, db 0.3, H 1.511 m, lead 10 mm.");
+  m.def(
+      "load_model",
+      [](const py::object& src) {
+        auto [text, source] = read_source(src);
+        return std::make_shared<Model>(load_model(text, source));
+      },
+      py::arg("path_or_yaml"),
+      "Model from a YAML file (str without ':' or newline, or os.PathLike) or YAML text. Raises ConfigError "
+      "with the library's one-line 'source:line:column: field ...' message.");
+  m.def(
+      "seed_config_yaml", [] { return std::string(seed_config_yaml()); },
+      "The embedded seed configuration (platform, servo, load, simulation, study) as YAML text.");
 }
 
 }  // namespace hexatwist::python

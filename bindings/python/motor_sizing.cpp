@@ -114,7 +114,9 @@ py::dict size_motors_py(const py::object& config_src, const py::object& csv, con
   for (std::size_t k = 0; k < n; ++k) {
     const MotorSample& x = s.samples[k];
     time.mutable_data()[k] = x.time;
-    auto put = [&](py::array_t<double>& a, const Vector6d& v) { std::copy(v.data(), v.data() + 6, a.mutable_data() + 6 * k); };
+    auto put = [&](py::array_t<double>& a, const Vector6d& v) {
+      std::copy(v.data(), v.data() + 6, a.mutable_data() + 6 * k);
+    };
     put(torque, x.torque);
     put(speed, x.speed);
     put(power, x.power);
@@ -178,8 +180,8 @@ py::dict size_motors_py(const py::object& config_src, const py::object& csv, con
 
 void expose_motor_sizing(py::module_& m) {
   m.def("_size_motors", &size_motors_py, py::arg("config") = py::none(), py::arg("trajectory") = py::none(),
-        py::arg("times") = py::none(), py::arg("poses") = py::none(), py::arg("dt") = py::none(),
-        py::arg("t0") = 0.0, py::arg("envelope_points") = 64);
+        py::arg("times") = py::none(), py::arg("poses") = py::none(), py::arg("dt") = py::none(), py::arg("t0") = 0.0,
+        py::arg("envelope_points") = 64);
   py::list names;
   for (TorqueTerm t : kTerms) names.append(py::str(std::string(to_string(t))));
   m.attr("TORQUE_TERMS") = py::tuple(names);

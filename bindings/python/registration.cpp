@@ -10,7 +10,8 @@ const double* points_of(const py::handle& obj, const char* name, std::size_t& n,
     keep = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(obj);
   } catch (...) {
   }
-  if (!keep || keep.ndim() != 2 || keep.shape(1) != 3) raise_input(std::string(name) + ": expected an (N, 3) array [m]");
+  if (!keep || keep.ndim() != 2 || keep.shape(1) != 3)
+    raise_input(std::string(name) + ": expected an (N, 3) array [m]");
   n = static_cast<std::size_t>(keep.shape(0));
   return static_cast<const double*>(keep.data());
 }

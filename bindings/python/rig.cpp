@@ -58,7 +58,8 @@ std::shared_ptr<const PyRig> rig_of(const py::handle& src) {
 Config python_config(const py::object& src) { return *rig_of(src)->config; }
 
 void expose_rig(py::module_& m) {
-  py::class_<PyRig, std::shared_ptr<PyRig>> c(m, "Rig",
+  py::class_<PyRig, std::shared_ptr<PyRig>> c(
+      m, "Rig",
       "A validated configuration: the platform (Model) with its drives (servo), load (platform + payload), "
       "leg bodies and screw efficiency (mechanism), simulation rates and study (rig.hpp, config.hpp). Built once "
       "from YAML text, a path or None (the embedded seed); pass it wherever a `config` is taken. Pickles as its "
@@ -67,60 +68,75 @@ void expose_rig(py::module_& m) {
         py::arg("config") = py::none(),
         "Rig from YAML text, a path (str without ':' or newline, or os.PathLike) or None (the seed). Raises "
         "ConfigError with the library's one-line 'source:line:column: field ...' message.");
-  c.def_property_readonly("model", [](const PyRig& r) { return std::make_shared<Model>(r.config->rig.model()); },
-                          "The platform model.");
-  c.def_property_readonly("yaml", [](const PyRig& r) { return r.yaml; }, "The YAML text it was built from.");
-  c.def_property_readonly("source", [](const PyRig& r) { return r.source; }, "Where the text came from.");
-  c.def_property_readonly("control_period", [](const PyRig& r) { return r.config->rig.control_period(); },
-                          "Servo control period [s]: the sample period of simulate and size_motors.");
-  c.def_property_readonly("motor_gain", [](const PyRig& r) { return vec6(r.config->rig.motor_gain()); },
-                          "Motor-side length per motor radian, lead / (2 pi gear_ratio) (6,) [m/rad].");
-  c.def_property_readonly("drive_inertia", [](const PyRig& r) { return r.config->rig.drive_inertia(); },
-                          "Rotor + screw inertia at the motor shaft [kg m^2].");
-  c.def_property_readonly("nominal_inertia", [](const PyRig& r) { return vec6(r.config->rig.nominal_inertia()); },
-                          "Inertia each motor sees at home, drive + reflected load (6,) [kg m^2].");
-  c.def_property_readonly("servo", [](const PyRig& r) {
-    const ServoSpec& s = r.config->rig.servo();
-    py::dict d;
-    d["motor_inertia"] = s.motor_inertia;
-    d["screw_inertia"] = s.screw_inertia;
-    d["viscous_friction"] = s.viscous_friction;
-    d["coulomb_friction"] = s.coulomb_friction;
-    d["friction_speed"] = s.friction_speed;
-    d["torque_limit"] = s.torque_limit;
-    d["max_speed"] = s.max_speed;
-    d["peak_corner_speed"] = s.peak_corner_speed;
-    d["peak_torque_at_max_speed"] = s.peak_torque_at_max_speed;
-    d["continuous_torque"] = s.continuous_torque;
-    d["gear_ratio"] = s.gear_ratio;
-    return d;
-  }, "The drive (ServoSpec), SI: inertias [kg m^2], viscous_friction [N m s/rad], coulomb_friction, torque_limit, "
-     "peak_torque_at_max_speed, continuous_torque [N m], friction_speed, max_speed, peak_corner_speed [rad/s], "
-     "gear_ratio [-].");
-  c.def_property_readonly("load", [](const PyRig& r) {
-    const LoadSpec& l = r.config->rig.load();
-    py::dict d;
-    d["mass"] = l.mass;
-    d["center_of_mass"] = vec3(l.center_of_mass_P);
-    const Matrix3d I = l.inertia_tensor();
-    py::array_t<double> t({3, 3});
-    for (int i = 0; i < 3; ++i)
-      for (int k = 0; k < 3; ++k) t.mutable_data()[3 * i + k] = I(i, k);
-    d["inertia"] = t;
-    d["gravity"] = l.gravity;
-    return d;
-  }, "Platform + payload: mass [kg], center_of_mass [m, P], inertia (3, 3) about the centre of mass along P's "
-     "axes [kg m^2], gravity [m/s^2] along -z of B.");
-  c.def_property_readonly("mechanism", [](const PyRig& r) {
-    const MechanismSpec& s = r.config->rig.mechanism();
-    py::dict d;
-    d["housing"] = leg_body(s.housing);
-    d["rod"] = leg_body(s.rod);
-    d["efficiency"] = s.efficiency;
-    d["back_efficiency"] = s.back_efficiency;
-    return d;
-  }, "Leg bodies (housing on the base U-joint, rod on the platform U-joint: mass [kg], center [m from its "
-     "U-joint along the leg], axial_inertia, transverse_inertia [kg m^2]) and screw efficiencies [-].");
+  c.def_property_readonly(
+      "model", [](const PyRig& r) { return std::make_shared<Model>(r.config->rig.model()); }, "The platform model.");
+  c.def_property_readonly(
+      "yaml", [](const PyRig& r) { return r.yaml; }, "The YAML text it was built from.");
+  c.def_property_readonly(
+      "source", [](const PyRig& r) { return r.source; }, "Where the text came from.");
+  c.def_property_readonly(
+      "control_period", [](const PyRig& r) { return r.config->rig.control_period(); },
+      "Servo control period [s]: the sample period of simulate and size_motors.");
+  c.def_property_readonly(
+      "motor_gain", [](const PyRig& r) { return vec6(r.config->rig.motor_gain()); },
+      "Motor-side length per motor radian, lead / (2 pi gear_ratio) (6,) [m/rad].");
+  c.def_property_readonly(
+      "drive_inertia", [](const PyRig& r) { return r.config->rig.drive_inertia(); },
+      "Rotor + screw inertia at the motor shaft [kg m^2].");
+  c.def_property_readonly(
+      "nominal_inertia", [](const PyRig& r) { return vec6(r.config->rig.nominal_inertia()); },
+      "Inertia each motor sees at home, drive + reflected load (6,) [kg m^2].");
+  c.def_property_readonly(
+      "servo",
+      [](const PyRig& r) {
+        const ServoSpec& s = r.config->rig.servo();
+        py::dict d;
+        d["motor_inertia"] = s.motor_inertia;
+        d["screw_inertia"] = s.screw_inertia;
+        d["viscous_friction"] = s.viscous_friction;
+        d["coulomb_friction"] = s.coulomb_friction;
+        d["friction_speed"] = s.friction_speed;
+        d["torque_limit"] = s.torque_limit;
+        d["max_speed"] = s.max_speed;
+        d["peak_corner_speed"] = s.peak_corner_speed;
+        d["peak_torque_at_max_speed"] = s.peak_torque_at_max_speed;
+        d["continuous_torque"] = s.continuous_torque;
+        d["gear_ratio"] = s.gear_ratio;
+        return d;
+      },
+      "The drive (ServoSpec), SI: inertias [kg m^2], viscous_friction [N m s/rad], coulomb_friction, torque_limit, "
+      "peak_torque_at_max_speed, continuous_torque [N m], friction_speed, max_speed, peak_corner_speed [rad/s], "
+      "gear_ratio [-].");
+  c.def_property_readonly(
+      "load",
+      [](const PyRig& r) {
+        const LoadSpec& l = r.config->rig.load();
+        py::dict d;
+        d["mass"] = l.mass;
+        d["center_of_mass"] = vec3(l.center_of_mass_P);
+        const Matrix3d I = l.inertia_tensor();
+        py::array_t<double> t({3, 3});
+        for (int i = 0; i < 3; ++i)
+          for (int k = 0; k < 3; ++k) t.mutable_data()[3 * i + k] = I(i, k);
+        d["inertia"] = t;
+        d["gravity"] = l.gravity;
+        return d;
+      },
+      "Platform + payload: mass [kg], center_of_mass [m, P], inertia (3, 3) about the centre of mass along P's "
+      "axes [kg m^2], gravity [m/s^2] along -z of B.");
+  c.def_property_readonly(
+      "mechanism",
+      [](const PyRig& r) {
+        const MechanismSpec& s = r.config->rig.mechanism();
+        py::dict d;
+        d["housing"] = leg_body(s.housing);
+        d["rod"] = leg_body(s.rod);
+        d["efficiency"] = s.efficiency;
+        d["back_efficiency"] = s.back_efficiency;
+        return d;
+      },
+      "Leg bodies (housing on the base U-joint, rod on the platform U-joint: mass [kg], center [m from its "
+      "U-joint along the leg], axial_inertia, transverse_inertia [kg m^2]) and screw efficiencies [-].");
   c.def("__repr__", [](const PyRig& r) { return "<hexatwist.Rig '" + r.config->rig.model().spec().name + "'>"; });
   c.def(py::pickle([](const PyRig& r) { return py::make_tuple(1, r.yaml, r.source); },
                    [](const py::tuple& t) {

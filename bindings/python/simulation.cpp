@@ -24,7 +24,9 @@ py::dict samples_dict(const std::vector<SimulationSample>& s) {
     time.mutable_data()[k] = s[k].time;
     error.mutable_data()[k] = s[k].error;
     error_twist.mutable_data()[k] = s[k].error_twist_only;
-    auto put = [&](py::array_t<double>& a, const Vector6d& v) { std::copy(v.data(), v.data() + 6, a.mutable_data() + 6 * k); };
+    auto put = [&](py::array_t<double>& a, const Vector6d& v) {
+      std::copy(v.data(), v.data() + 6, a.mutable_data() + 6 * k);
+    };
     put(desired, s[k].desired);
     put(actual, s[k].actual);
     put(command, s[k].command);
@@ -131,7 +133,8 @@ py::dict study_py(const py::object& config_src, const std::string& test, const p
     sd["tracking_only"] = stats(r->tracking_only);
     summary[name] = sd;
   }
-  d["tracking_only"] = py::array_t<double>(static_cast<py::ssize_t>(run.tracking_only.size()), run.tracking_only.data());
+  d["tracking_only"] =
+      py::array_t<double>(static_cast<py::ssize_t>(run.tracking_only.size()), run.tracking_only.data());
   d["summary"] = summary;
   return d;
 }
@@ -142,19 +145,23 @@ void expose_simulation(py::module_& m) {
   m.def("_simulate", &simulate_py, py::arg("config") = py::none(), py::arg("test") = "Rz",
         py::arg("poses") = py::none(), py::arg("strategy") = "compensated", py::arg("twist_in_plant") = true);
   m.def("_study", &study_py, py::arg("config") = py::none(), py::arg("test") = "Rz", py::arg("poses") = py::none());
-  m.def("control_period", [](const py::object& c) { return config_of(c).rig.control_period(); },
-        py::arg("config") = py::none(), "The configuration's control period [s] (poses of simulate are this far apart).");
-  m.def("study_trajectory", [](const py::object& c, const std::string& test) {
-    const Config config = config_of(c);
-    const Trajectory tr = trajectory_of(config, test, py::none());
-    py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
-    for (std::size_t k = 0; k < tr.poses.size(); ++k) {
-      const Vector6d v = tr.poses[k].to_vector();
-      std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
-    }
-    return q;
-  }, py::arg("config") = py::none(), py::arg("test") = "Rz",
-     "Poses (T, 6) [m, rad] of one of the paper's tests (Lz, Lx, Rz, Ry), one per control period.");
+  m.def(
+      "control_period", [](const py::object& c) { return config_of(c).rig.control_period(); },
+      py::arg("config") = py::none(), "The configuration's control period [s] (poses of simulate are this far apart).");
+  m.def(
+      "study_trajectory",
+      [](const py::object& c, const std::string& test) {
+        const Config config = config_of(c);
+        const Trajectory tr = trajectory_of(config, test, py::none());
+        py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
+        for (std::size_t k = 0; k < tr.poses.size(); ++k) {
+          const Vector6d v = tr.poses[k].to_vector();
+          std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
+        }
+        return q;
+      },
+      py::arg("config") = py::none(), py::arg("test") = "Rz",
+      "Poses (T, 6) [m, rad] of one of the paper's tests (Lz, Lx, Rz, Ry), one per control period.");
 }
 
 }  // namespace hexatwist::python

@@ -30,9 +30,12 @@ void expose_stream(py::module_& m) {
              auto s = std::make_unique<PyStream>();
              s->model = std::move(model);
              s->settings.strategy = strategy_from(strategy);
-             if (on_reject == "hold") s->settings.on_reject = RejectPolicy::Hold;
-             else if (on_reject == "skip") s->settings.on_reject = RejectPolicy::Skip;
-             else raise_input("on_reject: expected 'hold' or 'skip', got '" + on_reject + "'");
+             if (on_reject == "hold")
+               s->settings.on_reject = RejectPolicy::Hold;
+             else if (on_reject == "skip")
+               s->settings.on_reject = RejectPolicy::Skip;
+             else
+               raise_input("on_reject: expected 'hold' or 'skip', got '" + on_reject + "'");
              s->settings.period = period;
              s->settings.max_velocity = max_velocity;
              s->settings.max_acceleration = max_acceleration;
@@ -43,27 +46,33 @@ void expose_stream(py::module_& m) {
            py::arg("period") = 1e-3, py::arg("max_velocity") = std::numeric_limits<double>::infinity(),
            py::arg("max_acceleration") = std::numeric_limits<double>::infinity(),
            "period [s], max_velocity [m/s], max_acceleration [m/s^2] per leg command.")
-      .def("start", [](PyStream& s, const py::object& pose) {
-        const Status st = start_stream(*s.model, s.settings, pose_of(pose), *s.state);
-        if (st != Status::Ok) raise_status(st, "start pose");
-      }, py::arg("pose"), "Starts the stream at a pose the platform stands at [m, rad] (e.g. home).")
-      .def("pose", [](PyStream& s, const py::object& pose) {
-        StreamOutput out;
-        const Status st = stream_pose(*s.model, s.settings, pose_of(pose), *s.state, out);
-        py::dict d;
-        d["input"] = out.input;
-        d["status"] = std::string(to_string(st));
-        d["action"] = std::string(to_string(out.action));
-        d["rate_limited"] = out.rate_limited;
-        d["command"] = out.action == CommandAction::None ? py::object(py::none())
-                                                         : py::object(py::array_t<double>(6, out.command.data()));
-        d["leg"] = out.limit.leg;
-        d["value"] = out.limit.value;
-        d["bound"] = out.limit.bound;
-        return d;
-      }, py::arg("pose"),
-           "One input pose [x, y, z m, roll, pitch, yaw rad]: dict with input, status, action "
-           "('new'|'held'|'none'), rate_limited, command (6,) [m] or None, and leg/value/bound of a limit.");
+      .def(
+          "start",
+          [](PyStream& s, const py::object& pose) {
+            const Status st = start_stream(*s.model, s.settings, pose_of(pose), *s.state);
+            if (st != Status::Ok) raise_status(st, "start pose");
+          },
+          py::arg("pose"), "Starts the stream at a pose the platform stands at [m, rad] (e.g. home).")
+      .def(
+          "pose",
+          [](PyStream& s, const py::object& pose) {
+            StreamOutput out;
+            const Status st = stream_pose(*s.model, s.settings, pose_of(pose), *s.state, out);
+            py::dict d;
+            d["input"] = out.input;
+            d["status"] = std::string(to_string(st));
+            d["action"] = std::string(to_string(out.action));
+            d["rate_limited"] = out.rate_limited;
+            d["command"] = out.action == CommandAction::None ? py::object(py::none())
+                                                             : py::object(py::array_t<double>(6, out.command.data()));
+            d["leg"] = out.limit.leg;
+            d["value"] = out.limit.value;
+            d["bound"] = out.limit.bound;
+            return d;
+          },
+          py::arg("pose"),
+          "One input pose [x, y, z m, roll, pitch, yaw rad]: dict with input, status, action "
+          "('new'|'held'|'none'), rate_limited, command (6,) [m] or None, and leg/value/bound of a limit.");
 }
 
 }  // namespace hexatwist::python

@@ -48,8 +48,7 @@ py::dict axis_range_py(const Model& model, const py::object& coordinate, const s
     py::gil_scoped_release release;
     s = axis_range(model, k, st, r, o);
   }
-  if (s == Status::NonFiniteInput)
-    raise_input("axis_range: steps, bounds and tolerance must be finite and > 0");
+  if (s == Status::NonFiniteInput) raise_input("axis_range: steps, bounds and tolerance must be finite and > 0");
   if (s != Status::Ok) raise_status(s, "axis_range: home is outside a limit");
   py::dict d;
   d["coordinate"] = kCoordinates[static_cast<std::size_t>(k)];

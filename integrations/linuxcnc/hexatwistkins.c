@@ -43,26 +43,26 @@ struct leg_pins {
 
 struct pins {
   struct leg_pins leg[HEXATWIST_LEGS];
-  hal_s32_t* ik_status;         /* hexatwist status of the last inverse kinematics (0 ok) */
-  hal_u32_t* ik_refused;        /* poses refused by the inverse kinematics since load */
-  hal_s32_t* limit_status;      /* kind of the limit nearest to being hit (a hexatwist status code) */
-  hal_s32_t* limit_leg;         /* its leg, 1..6; 0 for the platform (Jacobian) limit */
-  hal_float_t* limit_margin;    /* fraction of that limit's range left: 1 far, 0 on it */
-  hal_float_t* condition;       /* condition number of the motor-side Jacobian at the commanded pose */
-  hal_s32_t* fk_status;         /* hexatwist status of the last forward kinematics (0 ok) */
-  hal_s32_t* fk_iterations;     /* its Newton iterations */
-  hal_float_t* fk_residual;     /* its largest length residual [machine unit] */
-  hal_bit_t* fk_fail;           /* the last forward kinematics failed */
-  hal_u32_t* fk_failures;       /* forward-kinematics failures since load */
-  hal_u32_t* fk_recoveries;     /* calls solved only from a fallback start (see README) */
+  hal_s32_t* ik_status;      /* hexatwist status of the last inverse kinematics (0 ok) */
+  hal_u32_t* ik_refused;     /* poses refused by the inverse kinematics since load */
+  hal_s32_t* limit_status;   /* kind of the limit nearest to being hit (a hexatwist status code) */
+  hal_s32_t* limit_leg;      /* its leg, 1..6; 0 for the platform (Jacobian) limit */
+  hal_float_t* limit_margin; /* fraction of that limit's range left: 1 far, 0 on it */
+  hal_float_t* condition;    /* condition number of the motor-side Jacobian at the commanded pose */
+  hal_s32_t* fk_status;      /* hexatwist status of the last forward kinematics (0 ok) */
+  hal_s32_t* fk_iterations;  /* its Newton iterations */
+  hal_float_t* fk_residual;  /* its largest length residual [machine unit] */
+  hal_bit_t* fk_fail;        /* the last forward kinematics failed */
+  hal_u32_t* fk_failures;    /* forward-kinematics failures since load */
+  hal_u32_t* fk_recoveries;  /* calls solved only from a fallback start (see README) */
 };
 
 static int comp_id = -1;
 static hexatwist_model* model = NULL;
 static struct pins* pins = NULL;
 static hexatwist_strategy command_strategy = HEXATWIST_COMPENSATED;
-static double unit_per_m = 1000.0; /* machine length units per metre */
-static double home_height = 0.0;   /* [m] */
+static double unit_per_m = 1000.0;   /* machine length units per metre */
+static double home_height = 0.0;     /* [m] */
 static hexatwist_fk_tracker tracker; /* the last forward solution and its assembly mode */
 
 /* World pose [machine unit, deg] to a hexatwist pose relative to home [m, rad]. */
@@ -169,7 +169,8 @@ int kinematicsHome(EmcPose* world, double* joints, KINEMATICS_FORWARD_FLAGS* ffl
   *fflags = 0;
   *iflags = 0;
   to_pose(world, pose);
-  if (hexatwist_fk_tracker_set(model, &tracker, pose, HEXATWIST_MOTOR) != HEXATWIST_OK) hexatwist_fk_tracker_reset(&tracker);
+  if (hexatwist_fk_tracker_set(model, &tracker, pose, HEXATWIST_MOTOR) != HEXATWIST_OK)
+    hexatwist_fk_tracker_reset(&tracker);
   return kinematicsInverse(world, joints, iflags, fflags);
 }
 

@@ -15,9 +15,9 @@ hexatwist_status hexatwist_motor_commands(const hexatwist_model* model, const do
     return HEXATWIST_INVALID_ARGUMENT;
   Vector6d cmd;
   LimitReport report;
-  const Status s = motor_commands(model->model, c_api::to_pose(pose),
-                                  strategy == HEXATWIST_COMPENSATED ? Strategy::Compensated : Strategy::Conventional,
-                                  cmd, report);
+  const Status s =
+      motor_commands(model->model, c_api::to_pose(pose),
+                     strategy == HEXATWIST_COMPENSATED ? Strategy::Compensated : Strategy::Conventional, cmd, report);
   c_api::from_limit(report, limit);
   if (s == Status::Ok) c_api::from_vector(cmd, command);
   return c_api::to_c(s);

@@ -1,6 +1,6 @@
 // C API: forward kinematics from a guess and along a motion (the tracker); real-time.
-#include "c_api.hpp"
 #include "hexatwist/kinematics/forward.hpp"
+#include "c_api.hpp"
 
 using namespace hexatwist;
 
@@ -57,25 +57,27 @@ hexatwist_fk_options hexatwist_fk_default_options(void) {
 hexatwist_status hexatwist_forward_kinematics(const hexatwist_model* model, const double lengths[HEXATWIST_LEGS],
                                               hexatwist_length_kind kind, const double guess[6],
                                               const hexatwist_fk_options* options, hexatwist_fk_result* result) {
-  if (model == nullptr || lengths == nullptr || result == nullptr || !valid_kind(kind)) return HEXATWIST_INVALID_ARGUMENT;
+  if (model == nullptr || lengths == nullptr || result == nullptr || !valid_kind(kind))
+    return HEXATWIST_INVALID_ARGUMENT;
   const Placement start = guess != nullptr ? placement_from_pose(c_api::to_pose(guess)) : Placement{};
   FkResult r;
-  const Status s = forward_kinematics(model->model, c_api::to_vector(lengths), to_kind(kind), start, r, to_options(options));
+  const Status s =
+      forward_kinematics(model->model, c_api::to_vector(lengths), to_kind(kind), start, r, to_options(options));
   from_result(r, result);
   return c_api::to_c(s);
 }
 
 hexatwist_status hexatwist_forward_kinematics_tracked(const hexatwist_model* model,
-                                                      const double lengths[HEXATWIST_LEGS],
-                                                      hexatwist_length_kind kind, hexatwist_fk_tracker* tracker,
+                                                      const double lengths[HEXATWIST_LEGS], hexatwist_length_kind kind,
+                                                      hexatwist_fk_tracker* tracker,
                                                       const hexatwist_fk_options* options,
                                                       hexatwist_fk_result* result) {
   if (model == nullptr || lengths == nullptr || tracker == nullptr || result == nullptr || !valid_kind(kind))
     return HEXATWIST_INVALID_ARGUMENT;
   FkTracker t = to_tracker(*tracker);
   FkResult r;
-  const Status s = forward_kinematics_tracked(model->model, c_api::to_vector(lengths), to_kind(kind), t, r,
-                                              to_options(options));
+  const Status s =
+      forward_kinematics_tracked(model->model, c_api::to_vector(lengths), to_kind(kind), t, r, to_options(options));
   from_result(r, result);
   if (s == Status::Ok) from_tracker(t, *tracker);
   return c_api::to_c(s);

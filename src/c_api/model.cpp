@@ -7,8 +7,8 @@
 #include <sstream>
 
 #include "c_api.hpp"
-#include "hexatwist/io/config.hpp"
 #include "hexatwist/error.hpp"
+#include "hexatwist/io/config.hpp"
 
 namespace {
 
@@ -48,8 +48,8 @@ hexatwist_model* hexatwist_model_from_file(const char* path, char* error, size_t
         std::ostringstream text;
         if (in) text << in.rdbuf();
         if (!in || in.bad())
-          throw Error(std::string(path) + ": cannot read the configuration file: " +
-                      (errno != 0 ? std::strerror(errno) : "cannot open"));
+          throw Error(std::string(path) +
+                      ": cannot read the configuration file: " + (errno != 0 ? std::strerror(errno) : "cannot open"));
         return load_model(text.str(), path);
       },
       error, error_size);

@@ -10,11 +10,11 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "io/csv.hpp"
-#include "hexatwist/kinematics/compensation.hpp"
-#include "hexatwist/error.hpp"
-#include "hexatwist/kinematics/forward.hpp"
 #include "calibration/random.hpp"
+#include "hexatwist/error.hpp"
+#include "hexatwist/kinematics/compensation.hpp"
+#include "hexatwist/kinematics/forward.hpp"
+#include "io/csv.hpp"
 
 namespace hexatwist {
 namespace {
@@ -226,16 +226,17 @@ Trajectory stations_trajectory(const Model& model, Strategy strategy, const Stat
     throw Error(fmt::format("stations: expected 1 to {} stations, got {}", kMaxStations, spec.count));
   if (!(std::isfinite(spec.translation) && spec.translation >= 0.0 && std::isfinite(spec.rotation) &&
         spec.rotation >= 0.0))
-    throw Error(fmt::format("stations: expected finite ranges >= 0, got ±{} m and ±{} rad", spec.translation,
-                            spec.rotation));
+    throw Error(
+        fmt::format("stations: expected finite ranges >= 0, got ±{} m and ±{} rad", spec.translation, spec.rotation));
   detail::Random rng(spec.seed);
   std::vector<Vector6d> waypoints{Vector6d::Zero()};
   for (int i = 0; i < spec.count; ++i) {
     for (int draw = 0;; ++draw) {
       if (draw == kMaxDraws)
-        throw Error(fmt::format("station {}: no pose within ±{} m and ±{} rad drawn in {} tries is "
-                                "reachable inside the limits; give smaller ranges",
-                                i + 1, spec.translation, spec.rotation, kMaxDraws));
+        throw Error(
+            fmt::format("station {}: no pose within ±{} m and ±{} rad drawn in {} tries is "
+                        "reachable inside the limits; give smaller ranges",
+                        i + 1, spec.translation, spec.rotation, kMaxDraws));
       Vector6d q;
       for (int c = 0; c < 6; ++c) q[c] = (c < 3 ? spec.translation : spec.rotation) * rng.symmetric();
       // The way home from the last station is checked with it.
@@ -291,12 +292,11 @@ std::vector<double> aligned_times(const TimedPoses& commanded, const PointLog& l
   const double front = commanded.t.front(), back = commanded.t.back();
   for (std::size_t k = 0; k < times.size(); ++k) {
     if (!(times[k] >= front - kTimeTolerance && times[k] <= back + kTimeTolerance))
-      throw Error(
-          fmt::format("{}: point at t = {} s{} is outside the commanded trajectory's time span [{}, {}] s (check the "
-                      "time offset{})",
-                      point_location(log, k), times[k],
-                      log.indexed ? fmt::format(" (index {})", log.stamps[k]) : std::string(), front, back,
-                      log.indexed ? " and the sample rate" : ""));
+      throw Error(fmt::format(
+          "{}: point at t = {} s{} is outside the commanded trajectory's time span [{}, {}] s (check the "
+          "time offset{})",
+          point_location(log, k), times[k], log.indexed ? fmt::format(" (index {})", log.stamps[k]) : std::string(),
+          front, back, log.indexed ? " and the sample rate" : ""));
     times[k] = std::clamp(times[k], front, back);
   }
   return times;
@@ -471,7 +471,8 @@ ObservationSet observations_at_rest(const Model& model, const TimedPoses& comman
         "{}: only {} of the {} points {}; an identification needs at least {} (lower the settle time, or record "
         "a run that stops at more poses: a stations run)",
         log.source, set.observations.size(), times.size(),
-        settle > 0.0 ? fmt::format("are at rest (commanded pose unchanged for {} s)", settle) : std::string("are usable"),
+        settle > 0.0 ? fmt::format("are at rest (commanded pose unchanged for {} s)", settle)
+                     : std::string("are usable"),
         kMinObservations));
   return set;
 }

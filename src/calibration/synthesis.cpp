@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "hexatwist/error.hpp"
 #include "calibration/random.hpp"
+#include "hexatwist/error.hpp"
 
 namespace hexatwist {
 using detail::Random;

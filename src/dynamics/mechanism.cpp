@@ -7,8 +7,8 @@
 #include <Eigen/LU>
 #include <cmath>
 
-#include "hexatwist/kinematics/twist.hpp"
 #include "dynamics/mechanism_internal.hpp"
+#include "hexatwist/kinematics/twist.hpp"
 
 namespace hexatwist {
 namespace {
@@ -43,13 +43,13 @@ Vector3d spin_f_dot(const Vector3d& j, const Vector3d& j_dot, const Vector3d& s,
 
 // One leg's velocity-level state (theory §14, "Velocities").
 struct LegMotion {
-  Vector3d s, a;            // unit leg axis; pivot to platform joint [m, B]
-  Vector3d u;               // velocity of the platform joint P_i [m/s]
-  Vector3d s_dot;           // s'
-  Vector3d s_dot_rel;       // s' - w x s: s' seen from the platform
-  Vector3d omega;           // the platform's angular velocity [rad/s]
-  SpinCoefficient fa, fd;   // spin coefficients of the housing (ja) and the rod (jd)
-  Vector3d ja, jd;          // base and platform axes [B]
+  Vector3d s, a;           // unit leg axis; pivot to platform joint [m, B]
+  Vector3d u;              // velocity of the platform joint P_i [m/s]
+  Vector3d s_dot;          // s'
+  Vector3d s_dot_rel;      // s' - w x s: s' seen from the platform
+  Vector3d omega;          // the platform's angular velocity [rad/s]
+  SpinCoefficient fa, fd;  // spin coefficients of the housing (ja) and the rod (jd)
+  Vector3d ja, jd;         // base and platform axes [B]
   bool has_axes = true;
   double l = 0, l_dot = 0;  // length and its rate
   double wh = 0, wr = 0;    // spin rates of housing and rod about s [rad/s]
@@ -251,16 +251,16 @@ Vector3d gravity_vector(const Rig& rig) noexcept { return Vector3d(0.0, 0.0, -ri
 // are computed once, split into the part linear in the platform's acceleration and the
 // velocity-product part (theory §14).
 struct Forces {
-  Vector6d gravity = Vector6d::Zero();          // -m g of every body
-  Vector6d platform = Vector6d::Zero();         // the platform's inertia, linear part
-  Vector6d velocity = Vector6d::Zero();         // velocity products of the platform and the leg bodies
-  Vector6d legs = Vector6d::Zero();             // the leg bodies' inertia, linear part
-  Vector6d drives = Vector6d::Zero();           // rotors and screws, linear part (generalised) ...
-  Vector6d cphi_drives = Vector6d::Zero();      // ... and through the motor angles
-  Vector6d drives_velocity = Vector6d::Zero();  // rotors and screws, velocity products (generalised) ...
+  Vector6d gravity = Vector6d::Zero();               // -m g of every body
+  Vector6d platform = Vector6d::Zero();              // the platform's inertia, linear part
+  Vector6d velocity = Vector6d::Zero();              // velocity products of the platform and the leg bodies
+  Vector6d legs = Vector6d::Zero();                  // the leg bodies' inertia, linear part
+  Vector6d drives = Vector6d::Zero();                // rotors and screws, linear part (generalised) ...
+  Vector6d cphi_drives = Vector6d::Zero();           // ... and through the motor angles
+  Vector6d drives_velocity = Vector6d::Zero();       // rotors and screws, velocity products (generalised) ...
   Vector6d cphi_drives_velocity = Vector6d::Zero();  // ... and through the motor angles
-  Vector6d phi_dd = Vector6d::Zero();           // motor acceleration [rad/s^2]
-  Vector6d phi_dd_bias = Vector6d::Zero();      // its velocity-product part, J_phi' x'
+  Vector6d phi_dd = Vector6d::Zero();                // motor acceleration [rad/s^2]
+  Vector6d phi_dd_bias = Vector6d::Zero();           // its velocity-product part, J_phi' x'
 };
 
 // `linear` false: zero platform acceleration (only gravity and velocity products are computed).
@@ -328,10 +328,11 @@ void mass_matrix_of(const Rig& rig, const Mechanism& mech, Matrix6d& M_load, Mat
   for (const LegMotion& m : mech.legs) {
     const double il = 1.0 / m.l;
     // Translation and tumbling of the leg bodies: K_uu = gamma I - beta s s^T with s' = P u / l.
-    const double tumble = (h.mass * h.center * h.center + h.transverse_inertia + r.transverse_inertia +
-                           r.mass * r.center * r.center) * il * il;
+    const double tumble =
+        (h.mass * h.center * h.center + h.transverse_inertia + r.transverse_inertia + r.mass * r.center * r.center) *
+        il * il;
     const double across = r.mass - 2.0 * r.mass * r.center * il + tumble;  // along P = I - s s^T
-    const double gamma = across, beta = across - r.mass;                  // K_uu = gamma I - beta s s^T
+    const double gamma = across, beta = across - r.mass;                   // K_uu = gamma I - beta s s^T
     const Matrix3d A = detail::skew(m.a);
     M_load.topLeftCorner<3, 3>() += gamma * Matrix3d::Identity();
     M_load.topRightCorner<3, 3>() -= gamma * A;
@@ -390,23 +391,23 @@ Vector6d smoothed_sign(const Rig& rig, const Vector6d& speed) noexcept {
 
 }  // namespace
 
-PlatformMotion platform_motion(const Pose& pose, const Vector6d& pose_rate, const Vector6d& pose_acceleration) noexcept {
+PlatformMotion platform_motion(const Pose& pose, const Vector6d& pose_rate,
+                               const Vector6d& pose_acceleration) noexcept {
   PlatformMotion out;
   out.placement = placement_from_pose(pose);
   const double roll = pose.rpy.x(), pitch = pose.rpy.y(), yaw = pose.rpy.z();
   const Vector3d ez = Vector3d::UnitZ();
   const Matrix3d Rz = Eigen::AngleAxisd(yaw, ez).toRotationMatrix();
   const Matrix3d Ry = Eigen::AngleAxisd(pitch, Vector3d::UnitY()).toRotationMatrix();
-  const Vector3d e_pitch = Rz * Vector3d::UnitY();        // pitch axis after yaw
-  const Vector3d e_roll = Rz * Ry * Vector3d::UnitX();    // roll axis after yaw and pitch
+  const Vector3d e_pitch = Rz * Vector3d::UnitY();      // pitch axis after yaw
+  const Vector3d e_roll = Rz * Ry * Vector3d::UnitX();  // roll axis after yaw and pitch
   const double rd = pose_rate[3], pd = pose_rate[4], yd = pose_rate[5];
   const Vector3d w_zy = yd * ez + pd * e_pitch;
   out.velocity.head<3>() = pose_rate.head<3>();
   out.velocity.tail<3>() = w_zy + rd * e_roll;
   out.acceleration.head<3>() = pose_acceleration.head<3>();
   out.acceleration.tail<3>() = pose_acceleration[5] * ez + pose_acceleration[4] * e_pitch +
-                               pose_acceleration[3] * e_roll + pd * (yd * ez).cross(e_pitch) +
-                               rd * w_zy.cross(e_roll);
+                               pose_acceleration[3] * e_roll + pd * (yd * ez).cross(e_pitch) + rd * w_zy.cross(e_roll);
   (void)roll;
   return out;
 }

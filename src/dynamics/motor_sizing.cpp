@@ -75,8 +75,8 @@ void summarize(const Rig& rig, const std::vector<MotorSample>& samples, double d
   m.speed_usage = m.peak_speed / servo.max_speed;
   m.rms_usage = m.rms_torque / servo.continuous_torque;
   if (m.rms_torque > accepted_max(servo.continuous_torque) && m.violation.check == EnvelopeCheck::None)
-    m.violation = {EnvelopeCheck::ContinuousTorque, leg,        samples.size() - 1, samples.back().time,
-                   m.rms_torque,                    servo.continuous_torque};
+    m.violation = {EnvelopeCheck::ContinuousTorque, leg, samples.size() - 1, samples.back().time, m.rms_torque,
+                   servo.continuous_torque};
 }
 
 }  // namespace
@@ -175,7 +175,8 @@ TorqueSpeedFigure torque_speed_figure(const Rig& rig, const MotorSizing& sizing,
   const int count = std::max(envelope_points, 2);
   std::vector<double> half;
   for (int j = 0; j < count; ++j) half.push_back(servo.max_speed * j / (count - 1));
-  if (servo.peak_corner_speed > 0.0 && servo.peak_corner_speed < servo.max_speed) half.push_back(servo.peak_corner_speed);
+  if (servo.peak_corner_speed > 0.0 && servo.peak_corner_speed < servo.max_speed)
+    half.push_back(servo.peak_corner_speed);
   std::sort(half.begin(), half.end());
   half.erase(std::unique(half.begin(), half.end()), half.end());
   // The top from -max to +max, the bottom back; peak_torque_at at max_speed itself is the

@@ -26,11 +26,16 @@ std::string one_line(std::string_view s, std::size_t max = std::string_view::npo
   std::string out;
   for (const char c : s.substr(0, n)) {
     const auto u = static_cast<unsigned char>(c);
-    if (c == '\n') out += "\\n";
-    else if (c == '\r') out += "\\r";
-    else if (c == '\t') out += "\\t";
-    else if (u < 0x20 || u == 0x7f) out += fmt::format("\\x{:02x}", u);
-    else out += c;
+    if (c == '\n')
+      out += "\\n";
+    else if (c == '\r')
+      out += "\\r";
+    else if (c == '\t')
+      out += "\\t";
+    else if (u < 0x20 || u == 0x7f)
+      out += fmt::format("\\x{:02x}", u);
+    else
+      out += c;
   }
   if (n < s.size()) out += "...";
   return out;
@@ -42,10 +47,14 @@ std::string quoted(const YAML::Node& n) { return "'" + one_line(n.Scalar(), 40) 
 // "a list", "a mapping", ... for messages about a value of the wrong kind.
 const char* kind(const YAML::Node& n) {
   switch (n.Type()) {
-    case YAML::NodeType::Sequence: return "a list";
-    case YAML::NodeType::Map: return "a mapping";
-    case YAML::NodeType::Null: return "nothing";
-    default: return "a scalar";
+    case YAML::NodeType::Sequence:
+      return "a list";
+    case YAML::NodeType::Map:
+      return "a mapping";
+    case YAML::NodeType::Null:
+      return "nothing";
+    default:
+      return "a scalar";
   }
 }
 
@@ -191,7 +200,7 @@ struct Screw {
   DrivenSide driven = DrivenSide::Base;
   bool thread_given = false;  // thread / driven_side were written (here or in `screw`)
   bool driven_given = false;
-  Loc lead_at;                // where the lead came from
+  Loc lead_at;  // where the lead came from
 };
 
 constexpr const char* kThreadWhat = "thread hand; needed when lead > 0";
@@ -273,14 +282,16 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
                             r.where(docs[1].Mark()), docs.size()));
   const YAML::Node root = docs.empty() ? YAML::Node() : docs[0];
   if (root.IsNull())
-    throw Error(fmt::format("{}:1:1: empty document; expected a mapping with 'symmetric' or 'legs', 'screw' and 'limits'",
-                            one_line(source)));
+    throw Error(
+        fmt::format("{}:1:1: empty document; expected a mapping with 'symmetric' or 'legs', 'screw' and 'limits'",
+                    one_line(source)));
   if (!root.IsMap())
-    throw Error(fmt::format("{}: expected a mapping with 'symmetric' or 'legs', 'screw' and 'limits' at top level, got {}",
-                            r.where(root.Mark()), kind(root)));
+    throw Error(
+        fmt::format("{}: expected a mapping with 'symmetric' or 'legs', 'screw' and 'limits' at top level, got {}",
+                    r.where(root.Mark()), kind(root)));
   const Field top{root, "", root.Mark()};
   r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "length_offsets", "limits",
-                   "observation_point", "pivot", "servo", "load", "simulation", "study", "mechanism"});
+                    "observation_point", "pivot", "servo", "load", "simulation", "study", "mechanism"});
 
   ModelSpec spec;
   const Field name = Reader::child(top, "name");
@@ -300,8 +311,8 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
     const bool legs_later = legs.key.line > sym.key.line;
     const Field& second = legs_later ? legs : sym;
     const Field& first = legs_later ? sym : legs;
-    r.fail(second.key, second.path, fmt::format("not allowed together with '{}' (line {}); {}", first.path,
-                                                first.key.line + 1, kOneOf));
+    r.fail(second.key, second.path,
+           fmt::format("not allowed together with '{}' (line {}); {}", first.path, first.key.line + 1, kOneOf));
   }
   if (!sym.present() && !legs.present()) throw Error(fmt::format("{}: {}; found neither", r.where(top.key), kOneOf));
 
@@ -313,7 +324,8 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
     auto length = [&](const char* key, const char* what, bool zero_ok) {
       const Field f = Reader::child(sym, key);
       const double v = r.number(f, what);
-      if (zero_ok ? v < 0.0 : v <= 0.0) r.fail(f.at(), f.path, fmt::format("expected {} 0 m, got {}", zero_ok ? ">=" : ">", v));
+      if (zero_ok ? v < 0.0 : v <= 0.0)
+        r.fail(f.at(), f.path, fmt::format("expected {} 0 m, got {}", zero_ok ? ">=" : ">", v));
       return v;
     };
     SymmetricSpec ss;
@@ -356,8 +368,8 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
     for (int i = 0; i < kLegs; ++i) {
       const Field n = Reader::item(legs, static_cast<std::size_t>(i), fmt::format("legs[{}] (leg {})", i, i + 1));
       if (!n.node.IsMap())
-        r.fail(n.at(), n.path, fmt::format("expected a mapping with base, platform, base_axis, platform_axis, got {}",
-                                           kind(n.node)));
+        r.fail(n.at(), n.path,
+               fmt::format("expected a mapping with base, platform, base_axis, platform_axis, got {}", kind(n.node)));
       r.only_keys(n, {"base", "platform", "base_axis", "platform_axis", "lead", "thread", "driven_side"});
       const std::string who = fmt::format("leg {}", i + 1);
       locs[who] = Loc{n.path, n.key};
@@ -381,7 +393,8 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
       }
       const Field platform_axis = Reader::child(n, "platform_axis");
       if (need_axes || platform_axis.present()) {
-        leg.axis_platform_P = r.vec3(platform_axis, "platform U-joint fixed axis x, y, z, platform frame; needed when lead > 0");
+        leg.axis_platform_P =
+            r.vec3(platform_axis, "platform U-joint fixed axis x, y, z, platform frame; needed when lead > 0");
         locs[who + ": platform_axis"] = loc(platform_axis);
       }
       // Default observation point: the platform joint farthest from the platform centre.
@@ -470,11 +483,11 @@ void read_extras(const Reader& r, const Field& top, Locations& locs, ConfigSpec&
   constexpr double kRpm = 2.0 * kPi / 60.0;
 
   ServoSpec& sv = out.rig.servo;
-  const Field servo = section("servo", {"motor_inertia", "screw_inertia", "viscous_friction", "coulomb_friction",
-                                        "friction_speed", "torque_time_constant", "torque_limit",
-                                        "max_speed_rpm", "encoder_counts", "gear_ratio", "pole_frequency_hz", "kp", "ki",
-                                        "kd", "velocity_feedforward", "acceleration_feedforward",
-                                        "peak_corner_rpm", "peak_torque_at_max_speed", "continuous_torque"});
+  const Field servo =
+      section("servo", {"motor_inertia", "screw_inertia", "viscous_friction", "coulomb_friction", "friction_speed",
+                        "torque_time_constant", "torque_limit", "max_speed_rpm", "encoder_counts", "gear_ratio",
+                        "pole_frequency_hz", "kp", "ki", "kd", "velocity_feedforward", "acceleration_feedforward",
+                        "peak_corner_rpm", "peak_torque_at_max_speed", "continuous_torque"});
   num(servo, "motor_inertia", "rotor inertia [kg m^2]", Positive, sv.motor_inertia);
   num(servo, "screw_inertia", "screw and coupling inertia [kg m^2]", NonNegative, sv.screw_inertia);
   num(servo, "viscous_friction", "at the motor shaft [N m s/rad]", NonNegative, sv.viscous_friction);
@@ -485,7 +498,8 @@ void read_extras(const Reader& r, const Field& top, Locations& locs, ConfigSpec&
   num(servo, "max_speed_rpm", "motor speed limit [rpm]", Positive, sv.max_speed, kRpm, "servo.max_speed");
   num(servo, "encoder_counts", "counts per motor revolution", Positive, sv.encoder_counts);
   num(servo, "gear_ratio", "motor revolutions per screw revolution", Positive, sv.gear_ratio);
-  num(servo, "pole_frequency_hz", "closed-loop pole frequency of the position loop [Hz]", Positive, sv.pole_frequency, 1.0, "servo.pole_frequency");
+  num(servo, "pole_frequency_hz", "closed-loop pole frequency of the position loop [Hz]", Positive, sv.pole_frequency,
+      1.0, "servo.pole_frequency");
   num(servo, "kp", "[N m/rad]; 0 = from pole_frequency_hz", NonNegative, sv.kp);
   num(servo, "ki", "[N m/(rad s)]; 0 = from pole_frequency_hz", NonNegative, sv.ki);
   num(servo, "kd", "[N m s/rad]; 0 = from pole_frequency_hz", NonNegative, sv.kd);
@@ -638,10 +652,11 @@ std::string corrected_config_yaml(std::string_view yaml_text, std::string_view s
   for (int i = 1; i < kLegs; ++i) {
     const LegSpec& leg = corrected.legs[static_cast<std::size_t>(i)];
     if (leg.lead != first.lead || leg.thread != first.thread)
-      throw Error(fmt::format("{}: corrected model: leg {} has lead {} m ({}) but leg 1 has {} m ({}); one screw "
-                              "block cannot hold both",
-                              one_line(source), i + 1, leg.lead, leg.thread == ThreadSense::Right ? "right" : "left",
-                              first.lead, first.thread == ThreadSense::Right ? "right" : "left"));
+      throw Error(
+          fmt::format("{}: corrected model: leg {} has lead {} m ({}) but leg 1 has {} m ({}); one screw "
+                      "block cannot hold both",
+                      one_line(source), i + 1, leg.lead, leg.thread == ThreadSense::Right ? "right" : "left",
+                      first.lead, first.thread == ThreadSense::Right ? "right" : "left"));
   }
   // Shortest text that reads back to the same double.
   const auto number = [](double v) { return YAML::Node(fmt::format("{}", v)); };

@@ -16,8 +16,8 @@ namespace {
 // the centre of mass of the leg body that carries them, carry 1/3 of that body's mass each.
 // kTinyMass stands in for a mass of 0 (MuJoCo needs > mjMINVAL); kTinyInertia keeps a disc's
 // inertia on the right side of MuJoCo's check A + B >= C after rounding.
-constexpr double kTinyMass = 1e-6;      // [kg]
-constexpr double kTinyInertia = 1e-9;   // [kg m^2]
+constexpr double kTinyMass = 1e-6;        // [kg]
+constexpr double kTinyInertia = 1e-9;     // [kg m^2]
 constexpr double kLoadShare = 1.0 / 7.0;  // of the load, in the platform body and in each rod end
 // Solver settings (docs/theory.md §15: the step and the constraints' stiffness were chosen by
 // the study of bench/bench_dynamics.cpp and the residuals of tests/test_mjcf.cpp).
@@ -56,10 +56,11 @@ Matrix3d leg_body_inertia(const LegBodySpec& b, double lumped, const char* field
   const double transverse = b.transverse_inertia - lumped;
   const double axial = std::max(b.axial_inertia, kTinyInertia);
   if (!(transverse >= kTinyInertia) || axial > 2.0 * transverse * (1.0 + 1e-12))
-    throw Error(fmt::format("{}: MuJoCo needs a rigid body's inertia: the transverse inertia {:.6g} kg m^2 minus the "
-                            "rotor's and screw's {:.6g} kg m^2 must be positive and at least half the axial {:.6g} "
-                            "kg m^2",
-                            field, b.transverse_inertia, lumped, b.axial_inertia));
+    throw Error(
+        fmt::format("{}: MuJoCo needs a rigid body's inertia: the transverse inertia {:.6g} kg m^2 minus the "
+                    "rotor's and screw's {:.6g} kg m^2 must be positive and at least half the axial {:.6g} "
+                    "kg m^2",
+                    field, b.transverse_inertia, lumped, b.axial_inertia));
   return Matrix3d(Vector3d(transverse, transverse, axial).asDiagonal());
 }
 
@@ -80,19 +81,21 @@ std::string mjcf_model(const Rig& rig) {
   for (int i = 0; i < kLegs; ++i) {
     const Leg& leg = model.leg(i);
     if (!(leg.lead > 0.0))
-      throw Error(fmt::format("leg {}: the MuJoCo model needs a lead screw on every leg (lead 0 has no screw to "
-                              "couple the motor to the leg)", i + 1));
+      throw Error(
+          fmt::format("leg {}: the MuJoCo model needs a lead screw on every leg (lead 0 has no screw to "
+                      "couple the motor to the leg)",
+                      i + 1));
     if (!(leg.axis_base_B.squaredNorm() > 0.0) || !(leg.axis_platform_P.squaredNorm() > 0.0))
       throw Error(fmt::format("leg {}: the MuJoCo model needs both U-joint axes", i + 1));
   }
   // Which leg body carries motor and screw decides the inertia lumped into it.
   bool any_base = false, any_platform = false;
   for (const Leg& leg : model.legs()) (leg.driven == DrivenSide::Base ? any_base : any_platform) = true;
-  const Matrix3d I_housing_base = any_base ? leg_body_inertia(mech.housing, lumped, "mechanism.housing.transverse_inertia")
-                                           : Matrix3d::Zero();
+  const Matrix3d I_housing_base =
+      any_base ? leg_body_inertia(mech.housing, lumped, "mechanism.housing.transverse_inertia") : Matrix3d::Zero();
   const Matrix3d I_housing_plain = leg_body_inertia(mech.housing, 0.0, "mechanism.housing.transverse_inertia");
-  const Matrix3d I_rod_platform = any_platform ? leg_body_inertia(mech.rod, lumped, "mechanism.rod.transverse_inertia")
-                                               : Matrix3d::Zero();
+  const Matrix3d I_rod_platform =
+      any_platform ? leg_body_inertia(mech.rod, lumped, "mechanism.rod.transverse_inertia") : Matrix3d::Zero();
   const Matrix3d I_rod_plain = leg_body_inertia(mech.rod, 0.0, "mechanism.rod.transverse_inertia");
   // The mass of the body carrying motor and screw is split in three (itself, rotor, screw).
   const double housing_share = std::max(mech.housing.mass / 3.0, kTinyMass);
@@ -117,19 +120,20 @@ std::string mjcf_model(const Rig& rig) {
       "     centre of mass; the rotor's and screw's transverse inertia (J/2, a disc's) is taken out of that body.\n"
       "     docs/theory.md section 14 describes the model. -->\n",
       comment_text(model.spec().name));
-  t += fmt::format("<mujoco model=\"hexatwist\">\n"
-                   "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>\n"
-                   "  <option timestep=\"{}\" gravity=\"0 0 {}\" integrator=\"Euler\" solver=\"Newton\" "
-                   "iterations=\"100\" tolerance=\"1e-12\" jacobian=\"dense\">\n"
-                   "    <flag contact=\"disable\"/>\n"
-                   "  </option>\n"
-                   "  <default>\n"
-                   "    <equality solref=\"{} 1\" solimp=\"0.9999 0.9999 0.001 0.5 2\"/>\n"
-                   "    <geom contype=\"0\" conaffinity=\"0\" group=\"1\"/>\n"
-                   "  </default>\n"
-                   "  <worldbody>\n"
-                   "    <light pos=\"0 0 6\" dir=\"0 0 -1\" directional=\"true\"/>\n",
-                   num(kTimestep), num(-load.gravity), num(kTimeConstant));
+  t += fmt::format(
+      "<mujoco model=\"hexatwist\">\n"
+      "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>\n"
+      "  <option timestep=\"{}\" gravity=\"0 0 {}\" integrator=\"Euler\" solver=\"Newton\" "
+      "iterations=\"100\" tolerance=\"1e-12\" jacobian=\"dense\">\n"
+      "    <flag contact=\"disable\"/>\n"
+      "  </option>\n"
+      "  <default>\n"
+      "    <equality solref=\"{} 1\" solimp=\"0.9999 0.9999 0.001 0.5 2\"/>\n"
+      "    <geom contype=\"0\" conaffinity=\"0\" group=\"1\"/>\n"
+      "  </default>\n"
+      "  <worldbody>\n"
+      "    <light pos=\"0 0 6\" dir=\"0 0 -1\" directional=\"true\"/>\n",
+      num(kTimestep), num(-load.gravity), num(kTimeConstant));
   for (int i = 0; i < kLegs; ++i) {
     const Leg& leg = model.leg(i);
     const int n = i + 1;
@@ -147,68 +151,74 @@ std::string mjcf_model(const Rig& rig) {
     frame.col(1) = s.cross(jb);
     const Matrix3d I_h = frame * (base_driven ? I_housing_base : I_housing_plain) * frame.transpose();
     const Matrix3d I_r = frame * (base_driven ? I_rod_plain : I_rod_platform) * frame.transpose();
-    const Vector3d c_h = mech.housing.center * s;          // from the base joint [m, B]
-    const Vector3d c_r = (L - mech.rod.center) * s;        // from the base joint, at home [m, B]
+    const Vector3d c_h = mech.housing.center * s;    // from the base joint [m, B]
+    const Vector3d c_r = (L - mech.rod.center) * s;  // from the base joint, at home [m, B]
     const auto indent = [](int level) { return std::string(static_cast<std::size_t>(2 * level), ' '); };
     const double motor_body_share = base_driven ? housing_share : rod_share;
     const auto rotor_body = [&](int level, const Vector3d& com) {
-      return fmt::format("{0}<body name=\"rotor{1}\">\n"
-                         "{0}  <joint name=\"leg{1}_rotor\" type=\"hinge\" axis=\"{2}\" damping=\"{4}\" frictionloss=\"{5}\"/>\n"
-                         "{0}  {3}\n"
-                         "{0}</body>\n",
-                         indent(level), n, vec(s), inertial(com, motor_body_share, axisymmetric(s, Jm, disc(Jm))),
-                         num(rig.servo().viscous_friction), num(rig.servo().coulomb_friction));
+      return fmt::format(
+          "{0}<body name=\"rotor{1}\">\n"
+          "{0}  <joint name=\"leg{1}_rotor\" type=\"hinge\" axis=\"{2}\" damping=\"{4}\" frictionloss=\"{5}\"/>\n"
+          "{0}  {3}\n"
+          "{0}</body>\n",
+          indent(level), n, vec(s), inertial(com, motor_body_share, axisymmetric(s, Jm, disc(Jm))),
+          num(rig.servo().viscous_friction), num(rig.servo().coulomb_friction));
     };
     const auto end_body = [&](int level) {
-      return fmt::format("{0}<body name=\"end{1}\">\n"
-                         "{0}  <joint name=\"leg{1}_je\" type=\"hinge\" axis=\"{2}\"/>\n"
-                         "{0}  <joint name=\"leg{1}_jd\" type=\"hinge\" axis=\"{3}\"/>\n"
-                         "{0}  {4}\n"
-                         "{0}</body>\n",
-                         indent(level), n, vec(je), vec(jd),
-                         inertial(load.center_of_mass_P - leg.platform_P, load_share, load_inertia_share));
+      return fmt::format(
+          "{0}<body name=\"end{1}\">\n"
+          "{0}  <joint name=\"leg{1}_je\" type=\"hinge\" axis=\"{2}\"/>\n"
+          "{0}  <joint name=\"leg{1}_jd\" type=\"hinge\" axis=\"{3}\"/>\n"
+          "{0}  {4}\n"
+          "{0}</body>\n",
+          indent(level), n, vec(je), vec(jd),
+          inertial(load.center_of_mass_P - leg.platform_P, load_share, load_inertia_share));
     };
-    const std::string rod_geom = fmt::format("<geom type=\"capsule\" fromto=\"0 0 0 {}\" size=\"0.02\" rgba=\"0.7 0.7 0.75 1\"/>",
-                                             vec(-0.5 * L * s));
+    const std::string rod_geom = fmt::format(
+        "<geom type=\"capsule\" fromto=\"0 0 0 {}\" size=\"0.02\" rgba=\"0.7 0.7 0.75 1\"/>", vec(-0.5 * L * s));
     const std::string housing_geom = fmt::format(
         "<geom type=\"capsule\" fromto=\"0 0 0 {}\" size=\"0.04\" rgba=\"0.3 0.3 0.35 1\"/>", vec(0.6 * L * s));
     t += fmt::format("    <!-- leg {}: {}-driven, {}-hand thread, lead {} m, home length {} m -->\n", n,
                      base_driven ? "base" : "platform", leg.thread == ThreadSense::Right ? "right" : "left",
                      num(leg.lead), num(L));
-    t += fmt::format("    <body name=\"housing{0}\" pos=\"{1}\">\n"
-                     "      <joint name=\"leg{0}_ja\" type=\"hinge\" axis=\"{2}\"/>\n"
-                     "      <joint name=\"leg{0}_jb\" type=\"hinge\" axis=\"{3}\"/>\n"
-                     "      {4}\n"
-                     "      {5}\n",
-                     n, vec(leg.base_B), vec(ja), vec(jb), inertial(c_h, base_driven ? housing_share : housing_whole, I_h), housing_geom);
+    t += fmt::format(
+        "    <body name=\"housing{0}\" pos=\"{1}\">\n"
+        "      <joint name=\"leg{0}_ja\" type=\"hinge\" axis=\"{2}\"/>\n"
+        "      <joint name=\"leg{0}_jb\" type=\"hinge\" axis=\"{3}\"/>\n"
+        "      {4}\n"
+        "      {5}\n",
+        n, vec(leg.base_B), vec(ja), vec(jb), inertial(c_h, base_driven ? housing_share : housing_whole, I_h),
+        housing_geom);
     if (base_driven) {
       // Motor and screw in the housing, nut in the rod.
       t += rotor_body(3, c_h);
-      t += fmt::format("      <body name=\"screw{0}\">\n"
-                       "        <joint name=\"leg{0}_screw\" type=\"hinge\" axis=\"{1}\"/>\n"
-                       "        {2}\n"
-                       "        <body name=\"rod{0}\" pos=\"{3}\">\n"
-                       "          <joint name=\"leg{0}_nut\" type=\"hinge\" axis=\"{1}\"/>\n"
-                       "          <joint name=\"leg{0}_slide\" type=\"slide\" axis=\"{1}\"/>\n"
-                       "          {4}\n"
-                       "          {5}\n",
-                       n, vec(s), inertial(c_h, housing_share, axisymmetric(s, Js, disc(Js))), vec(L * s),
-                       inertial(-mech.rod.center * s, rod_whole, I_r), rod_geom);
+      t += fmt::format(
+          "      <body name=\"screw{0}\">\n"
+          "        <joint name=\"leg{0}_screw\" type=\"hinge\" axis=\"{1}\"/>\n"
+          "        {2}\n"
+          "        <body name=\"rod{0}\" pos=\"{3}\">\n"
+          "          <joint name=\"leg{0}_nut\" type=\"hinge\" axis=\"{1}\"/>\n"
+          "          <joint name=\"leg{0}_slide\" type=\"slide\" axis=\"{1}\"/>\n"
+          "          {4}\n"
+          "          {5}\n",
+          n, vec(s), inertial(c_h, housing_share, axisymmetric(s, Js, disc(Js))), vec(L * s),
+          inertial(-mech.rod.center * s, rod_whole, I_r), rod_geom);
       t += end_body(5);
       t += "        </body>\n      </body>\n";
     } else {
       // Motor and screw in the rod, nut in the housing: the screw turns in the nut and slides
       // with the rod.
-      t += fmt::format("      <body name=\"screw{0}\">\n"
-                       "        <joint name=\"leg{0}_nut\" type=\"hinge\" axis=\"{1}\"/>\n"
-                       "        <joint name=\"leg{0}_slide\" type=\"slide\" axis=\"{1}\"/>\n"
-                       "        {2}\n"
-                       "        <body name=\"rod{0}\" pos=\"{3}\">\n"
-                       "          <joint name=\"leg{0}_screw\" type=\"hinge\" axis=\"{1}\"/>\n"
-                       "          {4}\n"
-                       "          {5}\n",
-                       n, vec(s), inertial(c_r, rod_share, axisymmetric(s, Js, disc(Js))), vec(L * s),
-                       inertial(-mech.rod.center * s, rod_share, I_r), rod_geom);
+      t += fmt::format(
+          "      <body name=\"screw{0}\">\n"
+          "        <joint name=\"leg{0}_nut\" type=\"hinge\" axis=\"{1}\"/>\n"
+          "        <joint name=\"leg{0}_slide\" type=\"slide\" axis=\"{1}\"/>\n"
+          "        {2}\n"
+          "        <body name=\"rod{0}\" pos=\"{3}\">\n"
+          "          <joint name=\"leg{0}_screw\" type=\"hinge\" axis=\"{1}\"/>\n"
+          "          {4}\n"
+          "          {5}\n",
+          n, vec(s), inertial(c_r, rod_share, axisymmetric(s, Js, disc(Js))), vec(L * s),
+          inertial(-mech.rod.center * s, rod_share, I_r), rod_geom);
       t += rotor_body(5, -mech.rod.center * s);
       t += end_body(5);
       t += "        </body>\n      </body>\n";
@@ -217,14 +227,15 @@ std::string mjcf_model(const Rig& rig) {
   }
   // The platform with its payload: P's origin, aligned with B at home.
   const Vector3d com_P = load.center_of_mass_P;
-  t += fmt::format("    <body name=\"platform\" pos=\"{}\">\n"
-                   "      <freejoint name=\"platform\"/>\n"
-                   "      {}\n"
-                   "      <geom type=\"cylinder\" pos=\"{}\" size=\"{} 0.03\" rgba=\"0.2 0.45 0.7 0.6\"/>\n"
-                   "    </body>\n"
-                   "  </worldbody>\n",
-                   vec(platform_home_B), inertial(com_P, load_share, load_inertia_share),
-                   vec(model.spec().pivot_P), num(model.condition_length()));
+  t += fmt::format(
+      "    <body name=\"platform\" pos=\"{}\">\n"
+      "      <freejoint name=\"platform\"/>\n"
+      "      {}\n"
+      "      <geom type=\"cylinder\" pos=\"{}\" size=\"{} 0.03\" rgba=\"0.2 0.45 0.7 0.6\"/>\n"
+      "    </body>\n"
+      "  </worldbody>\n",
+      vec(platform_home_B), inertial(com_P, load_share, load_inertia_share), vec(model.spec().pivot_P),
+      num(model.condition_length()));
   t += "  <equality>\n";
   for (int i = 0; i < kLegs; ++i) {
     const Leg& leg = model.leg(i);
@@ -235,18 +246,20 @@ std::string mjcf_model(const Rig& rig) {
     // The rotor's angle relative to the body carrying the motor is -sigma phi (base-driven) or
     // +sigma phi (platform-driven), phi the motor angle that lengthens the leg (theory §4).
     const double gear_sign = leg.driven == DrivenSide::Base ? 1.0 : -1.0;
-    t += fmt::format("    <weld name=\"leg{0}_weld\" body1=\"platform\" body2=\"end{0}\"/>\n"
-                     "    <joint name=\"leg{0}_helix\" joint1=\"leg{0}_nut\" joint2=\"leg{0}_slide\" polycoef=\"0 {1} 0 0 0\"/>\n"
-                     "    <joint name=\"leg{0}_gear\" joint1=\"leg{0}_screw\" joint2=\"leg{0}_rotor\" polycoef=\"0 {2} 0 0 0\"/>\n",
-                     n, num(1.0 / leg.twist_gain), num(gear_sign / N));
+    t += fmt::format(
+        "    <weld name=\"leg{0}_weld\" body1=\"platform\" body2=\"end{0}\"/>\n"
+        "    <joint name=\"leg{0}_helix\" joint1=\"leg{0}_nut\" joint2=\"leg{0}_slide\" polycoef=\"0 {1} 0 0 0\"/>\n"
+        "    <joint name=\"leg{0}_gear\" joint1=\"leg{0}_screw\" joint2=\"leg{0}_rotor\" polycoef=\"0 {2} 0 0 0\"/>\n",
+        n, num(1.0 / leg.twist_gain), num(gear_sign / N));
   }
   t += "  </equality>\n  <actuator>\n";
   for (int i = 0; i < kLegs; ++i) {
     const Leg& leg = model.leg(i);
     const double gear = (leg.driven == DrivenSide::Base ? -1.0 : 1.0) * leg.twist_sign;
-    t += fmt::format("    <motor name=\"motor{0}\" joint=\"leg{0}_rotor\" gear=\"{1}\" ctrllimited=\"true\" "
-                     "ctrlrange=\"{2} {3}\" forcelimited=\"true\" forcerange=\"{2} {3}\"/>\n",
-                     i + 1, num(gear), num(-servo.torque_limit), num(servo.torque_limit));
+    t += fmt::format(
+        "    <motor name=\"motor{0}\" joint=\"leg{0}_rotor\" gear=\"{1}\" ctrllimited=\"true\" "
+        "ctrlrange=\"{2} {3}\" forcelimited=\"true\" forcerange=\"{2} {3}\"/>\n",
+        i + 1, num(gear), num(-servo.torque_limit), num(servo.torque_limit));
   }
   t += "  </actuator>\n</mujoco>\n";
   return t;

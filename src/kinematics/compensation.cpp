@@ -95,8 +95,7 @@ bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, V
   PaddedRows rows;
   J.rows(rows);
   const double perturbation = sum_lanes(twist_share) * (1.0 + 1e-6) + 1e-13;
-  if (!condition_below(rows, model.condition_reference(), model.condition_max_accepted(), perturbation))
-    return false;
+  if (!condition_below(rows, model.condition_reference(), model.condition_max_accepted(), perturbation)) return false;
   command = out;
   return true;
 }

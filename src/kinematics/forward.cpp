@@ -108,8 +108,8 @@ Status length_jacobian(const Model& model, const LegState& legs, LengthKind kind
   return detail::motor_length_jacobian(model, legs, J);
 }
 
-Status fk_residual(const Model& model, const Placement& x, const Vector6d& lengths, LengthKind kind,
-                   LegState& legs, Vector6d& f, Matrix6d* J) noexcept {
+Status fk_residual(const Model& model, const Placement& x, const Vector6d& lengths, LengthKind kind, LegState& legs,
+                   Vector6d& f, Matrix6d* J) noexcept {
   if (const Status s = residual(model, x, lengths, kind, legs, f); s != Status::Ok) return s;
   return J != nullptr ? length_jacobian(model, legs, kind, *J) : Status::Ok;
 }

@@ -27,10 +27,10 @@ struct Columns {
 /// The row operations X that take J to a permutation: X J = Q with Q(pivot_row[k], k) = 1, so that
 /// row k of J^-1 = Q^T X is row pivot_row[k] of X.
 struct Inverse6 {
-  Columns x;             ///< X's columns in pivot order: x.c[k] is column pivot_row[k]
-  int pivot_row[6];      ///< the row that column k's pivot was taken from
-  double pivot_ratio;    ///< min |pivot| / max |pivot|: 0 for a singular (or non-finite) matrix
-  double det_sign;       ///< sign of det J (0 when singular)
+  Columns x;           ///< X's columns in pivot order: x.c[k] is column pivot_row[k]
+  int pivot_row[6];    ///< the row that column k's pivot was taken from
+  double pivot_ratio;  ///< min |pivot| / max |pivot|: 0 for a singular (or non-finite) matrix
+  double det_sign;     ///< sign of det J (0 when singular)
 };
 
 namespace gj {
@@ -104,7 +104,8 @@ inline bool eliminate(const Columns& J, Inverse6& out) noexcept {
     // Row p /= pivot, every other row i -= a(i, k) * (new row p): on each column,
     // col -= m * col(p) with m(i) = a(i, k) / pivot and m(p) = 1 - 1 / pivot.
     lane_v m[kPackets];
-    for (int q = 0; q < kPackets; ++q) m[q] = blend(row[q] == static_cast<double>(p), splat<lane_v>(1.0 - inv), a.c[k][q] * inv);
+    for (int q = 0; q < kPackets; ++q)
+      m[q] = blend(row[q] == static_cast<double>(p), splat<lane_v>(1.0 - inv), a.c[k][q] * inv);
     for (int c = k + 1; c < 6; ++c) {
       const lane_v b = broadcast_row(a.c[c], p);
       for (int q = 0; q < kPackets; ++q) a.c[c][q] -= m[q] * b;
@@ -113,7 +114,9 @@ inline bool eliminate(const Columns& J, Inverse6& out) noexcept {
       const lane_v b = broadcast_row(out.x.c[j], p);
       for (int q = 0; q < kPackets; ++q) out.x.c[j][q] -= m[q] * b;
     }
-    for (int q = 0; q < kPackets; ++q) out.x.c[k][q] = blend(row[q] == static_cast<double>(p), splat<lane_v>(1.0), splat<lane_v>(0.0)) - m[q];  // e_p - m
+    for (int q = 0; q < kPackets; ++q)
+      out.x.c[k][q] =
+          blend(row[q] == static_cast<double>(p), splat<lane_v>(1.0), splat<lane_v>(0.0)) - m[q];  // e_p - m
   }
   for (int k = 0; k < 6; ++k)
     for (int j = k + 1; j < 6; ++j)
@@ -158,7 +161,8 @@ inline double norm1(const Columns& m) noexcept {
   // of the result is the sum of column c (a transpose and row sums would take twice the shuffles).
   const v8d zero = {};
 #define HEXATWIST_FOLD(a, b, i0, i1, i2, i3, i4, i5, i6, i7, j0, j1, j2, j3, j4, j5, j6, j7) \
-  (__builtin_shufflevector(a, b, i0, i1, i2, i3, i4, i5, i6, i7) + __builtin_shufflevector(a, b, j0, j1, j2, j3, j4, j5, j6, j7))
+  (__builtin_shufflevector(a, b, i0, i1, i2, i3, i4, i5, i6, i7) +                           \
+   __builtin_shufflevector(a, b, j0, j1, j2, j3, j4, j5, j6, j7))
   const v8d p0 = HEXATWIST_FOLD(v[0][0], v[1][0], 0, 8, 2, 10, 4, 12, 6, 14, 1, 9, 3, 11, 5, 13, 7, 15);
   const v8d p1 = HEXATWIST_FOLD(v[2][0], v[3][0], 0, 8, 2, 10, 4, 12, 6, 14, 1, 9, 3, 11, 5, 13, 7, 15);
   const v8d p2 = HEXATWIST_FOLD(v[4][0], v[5][0], 0, 8, 2, 10, 4, 12, 6, 14, 1, 9, 3, 11, 5, 13, 7, 15);

@@ -10,8 +10,8 @@ using detail::Array6d;
 Status inverse_kinematics(const Model& model, const Placement& x, LegState& out) noexcept {
   if (!detail::all_finite(x.t) || !detail::all_finite(x.R_BP)) return Status::NonFiniteInput;
   out.R_BP = x.R_BP;
-  // Eq. (1)-(4), all legs at once (lanes.hpp).
-  #pragma GCC unroll 4
+// Eq. (1)-(4), all legs at once (lanes.hpp).
+#pragma GCC unroll 4
   for (int k = 0; k < detail::kPackets; ++k) {
     const detail::LegsAt legs = detail::legs_at(model, x.R_BP, x.t, k);
     detail::store6(out.arm_B, legs.arm, k);

@@ -9,10 +9,10 @@
 
 #include <cstring>
 
-#include "kinematics/fast_math.hpp"
-#include "kinematics/linear_solve.hpp"
 #include "hexatwist/kinematics/kinematics.hpp"
 #include "hexatwist/kinematics/model.hpp"
+#include "kinematics/fast_math.hpp"
+#include "kinematics/linear_solve.hpp"
 
 namespace hexatwist::detail {
 
@@ -149,8 +149,9 @@ inline LimitTerms limit_terms(const Model& model, const Matrix3d& R_BP, const la
 inline lane_m within_limits(const Model& model, const LimitTerms& t) noexcept {
   const lane_v cos_bend = model.cos_bend_max() * t.scale;
   const lane_v cos2_margin = model.cos2_singularity_margin() * (t.scale * t.scale);
-  return (t.length >= model.length_min_accepted()) & (t.length <= model.length_max_accepted()) & (t.cos_base >= cos_bend) &
-         (t.cos_platform >= cos_bend) & (t.dot_a * t.dot_a <= cos2_margin) & (t.dot_d * t.dot_d <= cos2_margin);
+  return (t.length >= model.length_min_accepted()) & (t.length <= model.length_max_accepted()) &
+         (t.cos_base >= cos_bend) & (t.cos_platform >= cos_bend) & (t.dot_a * t.dot_a <= cos2_margin) &
+         (t.dot_d * t.dot_d <= cos2_margin);
 }
 
 /// Lanes whose command is within the stroke, ends included with the tolerance of limits.hpp. NaN
@@ -200,9 +201,9 @@ inline lane_v twist_angle(const Model& model, lane_v x, lane_v y, bool relative,
 /// as six column vectors (lane i: leg i's row). From the unit leg direction s, 1/|L|, the arm, the
 /// joint axes ja, jd, ja.s, jd.s and the twist terms of s (twist_terms with u = s, u2 = 1). Where
 /// a leg is near a U-joint singularity (twist_regular fails) its row is unspecified.
-inline void jacobian_columns(const Model& model, const lanes3& s, lane_v inv_length, const lanes3& arm, const lanes3& ja,
-                             const lanes3& jd, lane_v ja_s, lane_v jd_s, const TwistTerms& t, bool motor, int k,
-                             lane_v (&col)[6]) noexcept {
+inline void jacobian_columns(const Model& model, const lanes3& s, lane_v inv_length, const lanes3& arm,
+                             const lanes3& ja, const lanes3& jd, lane_v ja_s, lane_v jd_s, const TwistTerms& t,
+                             bool motor, int k, lane_v (&col)[6]) noexcept {
   const LegLanes& g = model.geometry().lanes;
   const lane_v mask = load_lanes(g.has_axes, k);
   // d atan2(y, x) = (x dy - y dx) / (x^2 + y^2), with the partials of y and x in s and jd:

@@ -71,7 +71,7 @@ Status check_limits(const Model& model, const LegState& state, LimitReport& r) n
   // All legs at once (lanes.hpp).
   detail::LimitTerms terms[detail::kPackets];
   detail::lane_m ok = detail::all_set();
-  #pragma GCC unroll 4
+#pragma GCC unroll 4
   for (int k = 0; k < detail::kPackets; ++k) {
     const detail::lanes3 u = detail::load6(s, k);
     terms[k] = detail::limit_terms(model, state.R_BP, u, detail::splat<detail::lane_v>(1.0),
@@ -112,14 +112,15 @@ Status check_limits(const Model& model, const LegState& state, LimitReport& r) n
     if (!(cos_base[i] >= cos_bend))
       return report_violation(r, Status::BendBase, i, angle_between(si, model.leg(i).s_home_B), lim.bend_max);
     if (!(cos_platform[i] >= cos_bend))
-      return report_violation(r, Status::BendPlatform, i, angle_between(state.R_BP.transpose() * si, model.leg(i).s_home_B),
-                              lim.bend_max);
+      return report_violation(r, Status::BendPlatform, i,
+                              angle_between(state.R_BP.transpose() * si, model.leg(i).s_home_B), lim.bend_max);
     if (g.has_axes[i] == 0.0) continue;
     if (dot_a[i] * dot_a[i] > cos2_margin)
-      return report_violation(r, Status::SingularBase, i, line_axis_angle(si, model.leg(i).axis_base_B), lim.singularity_margin);
-    if (dot_d[i] * dot_d[i] > cos2_margin)
-      return report_violation(r, Status::SingularPlatform, i, line_axis_angle(si, state.axis_platform_B.row(i).transpose()),
+      return report_violation(r, Status::SingularBase, i, line_axis_angle(si, model.leg(i).axis_base_B),
                               lim.singularity_margin);
+    if (dot_d[i] * dot_d[i] > cos2_margin)
+      return report_violation(r, Status::SingularPlatform, i,
+                              line_axis_angle(si, state.axis_platform_B.row(i).transpose()), lim.singularity_margin);
   }
   return report_violation(r, Status::NonFiniteInput, -1, 0.0, 0.0);  // NaN in the leg axes
 }
@@ -154,15 +155,14 @@ void nearest_limit(const Model& model, const LegState& state, double condition, 
   }
   const double log_max = std::log(lim.jacobian_condition_max);
   const double c = std::isnan(condition) ? INFINITY : std::max(condition, 1.0);  // NaN: no Jacobian there
-  consider(1.0 - std::log(c) / log_max, Status::PlatformSingularity, -1, condition,
-           lim.jacobian_condition_max);
+  consider(1.0 - std::log(c) / log_max, Status::PlatformSingularity, -1, condition, lim.jacobian_condition_max);
 }
 
 Status check_stroke(const Model& model, const Vector6d& command, LimitReport& r) noexcept {
   r = LimitReport{};
   const LimitSpec& lim = model.spec().limits;
   detail::lane_m ok = detail::all_set();
-  #pragma GCC unroll 4
+#pragma GCC unroll 4
   for (int k = 0; k < detail::kPackets; ++k) ok &= detail::within_stroke(model, detail::load6(command.data(), k));
   if (detail::all_lanes(ok)) return Status::Ok;
   for (int i = 0; i < kLegs; ++i) {

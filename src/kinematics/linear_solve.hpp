@@ -8,9 +8,9 @@
 #include <cstring>
 #include <utility>
 
-#include "kinematics/fast_math.hpp"
 #include "hexatwist/kinematics/model.hpp"
 #include "hexatwist/types.hpp"
+#include "kinematics/fast_math.hpp"
 
 namespace hexatwist::detail {
 
@@ -37,7 +37,7 @@ inline double lu6_factor(const Matrix6d& A, Lu6& lu) noexcept {
     for (int i = k + 1; i < 6; ++i)
       if (std::abs(a[i][k]) > std::abs(a[p][k])) p = i;
     if (p != k) {
-      for (int j = k; j < 6; ++j) std::swap(a[k][j], a[p][j]);  // left of k: eliminated, unused
+      for (int j = k; j < 6; ++j) std::swap(a[k][j], a[p][j]);        // left of k: eliminated, unused
       for (int j = 0; j < k; ++j) std::swap(lu.l[k][j], lu.l[p][j]);  // the multipliers set so far
       std::swap(lu.perm[k], lu.perm[p]);
     }
@@ -216,7 +216,7 @@ inline bool condition_below(const PaddedRows& a, const ConditionReference& ref, 
   // entry of G rounds by less than 8 u (|Y| |A|) (u the unit roundoff); 1e-13 ||Y||_1 ||A||_1
   // covers it a hundred times over.
   alignas(64) double g[6][8];
-  const auto residual_norm = [&](const double (&y)[6][8], double norm_y) {
+  const auto residual_norm = [&](const double(&y)[6][8], double norm_y) {
     lane_v abs_g[6][kP];
 #pragma GCC unroll 6
     for (int i = 0; i < 6; ++i) {
@@ -231,7 +231,8 @@ inline bool condition_below(const PaddedRows& a, const ConditionReference& ref, 
       }
     }
     lane_v sum_g[kP];
-    for (int q = 0; q < kP; ++q) sum_g[q] = (abs_g[0][q] + abs_g[1][q]) + (abs_g[2][q] + abs_g[3][q]) + (abs_g[4][q] + abs_g[5][q]);
+    for (int q = 0; q < kP; ++q)
+      sum_g[q] = (abs_g[0][q] + abs_g[1][q]) + (abs_g[2][q] + abs_g[3][q]) + (abs_g[4][q] + abs_g[5][q]);
     return max_lane(sum_g) + norm_y * perturbation + 1e-13 * norm_y * norm_a;
   };
   // A^-1 = (I - G)^-1 Y, so ||A^-1||_1 <= ||Y||_1 / (1 - ||G||_1) for ||G||_1 < 1. The products,

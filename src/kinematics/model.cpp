@@ -61,7 +61,8 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
                      rad2deg(lim.singularity_margin)));
   require_finite(lim.jacobian_condition_max, "limits.jacobian_condition_max");
   if (!(lim.jacobian_condition_max > 1.0))
-    fail(fmt::format("limits.jacobian_condition_max: expected a condition number > 1, got {}", lim.jacobian_condition_max));
+    fail(fmt::format("limits.jacobian_condition_max: expected a condition number > 1, got {}",
+                     lim.jacobian_condition_max));
   require_finite(spec.observation_P, "observation_point");
   require_finite(spec.pivot_P, "pivot");
 
@@ -163,7 +164,8 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
     geometry_.has_axes[i] = axes ? 1.0 : 0.0;
     condition_length_ = std::max(i == 0 ? 0.0 : condition_length_, leg.arm_P.norm());
   }
-  if (!(condition_length_ > 0.0)) fail("legs: every platform joint sits at the pivot; expected a platform of some size");
+  if (!(condition_length_ > 0.0))
+    fail("legs: every platform joint sits at the pivot; expected a platform of some size");
   LegLanes& lanes = geometry_.lanes;
   for (int lane = 0; lane < 8; ++lane) {
     const int i = lane < kLegs ? lane : 0;
@@ -199,8 +201,10 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
   double condition = INFINITY;
   if (inverse_kinematics(*this, Placement{}, home) == Status::Ok &&
       jacobian_condition(*this, home, condition) == Status::PlatformSingularity)
-    fail(fmt::format("limits.jacobian_condition_max: the Jacobian's condition number at home is {:.4g}, above the "
-                     "limit {:.4g}", condition, lim.jacobian_condition_max));
+    fail(
+        fmt::format("limits.jacobian_condition_max: the Jacobian's condition number at home is {:.4g}, above the "
+                    "limit {:.4g}",
+                    condition, lim.jacobian_condition_max));
   // The cheap condition proof's reference: the scaled Jacobian's inverse at home (left at zero,
   // with an infinite norm, where home has no regular Jacobian: every proof then fails).
   Matrix6d J_home = Matrix6d::Zero();

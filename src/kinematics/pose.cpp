@@ -29,7 +29,8 @@ Vector3d rpy_from_rotation(const Matrix3d& R) noexcept {
   const double c5 = std::sqrt(R(0, 0) * R(0, 0) + R(1, 0) * R(1, 0));
 #if HEXATWIST_LANE_WIDTH >= 4
   // One 4-lane call where the target has them: the forward kinematics ends with it.
-  const detail::v4d a = detail::atan2(detail::v4d{R(2, 1), -R(2, 0), R(1, 0), 0.0}, detail::v4d{R(2, 2), c5, R(0, 0), 1.0});
+  const detail::v4d a =
+      detail::atan2(detail::v4d{R(2, 1), -R(2, 0), R(1, 0), 0.0}, detail::v4d{R(2, 2), c5, R(0, 0), 1.0});
   return {a[0], a[1], a[2]};
 #else
   const detail::v2d a = detail::atan2(detail::v2d{R(2, 1), -R(2, 0)}, detail::v2d{R(2, 2), c5});

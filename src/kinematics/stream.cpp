@@ -12,14 +12,22 @@ namespace hexatwist {
 
 std::string_view to_string(LineError e) noexcept {
   switch (e) {
-    case LineError::None: return "none";
-    case LineError::Empty: return "empty";
-    case LineError::TooLong: return "too_long";
-    case LineError::MissingFields: return "missing_fields";
-    case LineError::ExtraFields: return "extra_fields";
-    case LineError::EmptyField: return "empty_field";
-    case LineError::NotANumber: return "not_a_number";
-    case LineError::OutOfRange: return "out_of_range";
+    case LineError::None:
+      return "none";
+    case LineError::Empty:
+      return "empty";
+    case LineError::TooLong:
+      return "too_long";
+    case LineError::MissingFields:
+      return "missing_fields";
+    case LineError::ExtraFields:
+      return "extra_fields";
+    case LineError::EmptyField:
+      return "empty_field";
+    case LineError::NotANumber:
+      return "not_a_number";
+    case LineError::OutOfRange:
+      return "out_of_range";
   }
   return "unknown";
 }
@@ -92,9 +100,12 @@ std::string_view check_stream_settings(const StreamSettings& s) noexcept {
 
 std::string_view to_string(CommandAction a) noexcept {
   switch (a) {
-    case CommandAction::New: return "new";
-    case CommandAction::Held: return "held";
-    case CommandAction::None: return "none";
+    case CommandAction::New:
+      return "new";
+    case CommandAction::Held:
+      return "held";
+    case CommandAction::None:
+      return "none";
   }
   return "unknown";
 }
@@ -192,8 +203,7 @@ Status reject(const Model& model, const StreamSettings& s, StreamState& state, S
 
 }  // namespace
 
-Status start_stream(const Model& model, const StreamSettings& settings, const Pose& pose,
-                    StreamState& state) noexcept {
+Status start_stream(const Model& model, const StreamSettings& settings, const Pose& pose, StreamState& state) noexcept {
   state.has_command = false;
   state.velocity.setZero();
   LimitReport report;
@@ -271,14 +281,22 @@ constexpr std::string_view kFieldNames[kLegs] = {"x", "y", "z", "roll", "pitch",
 
 std::string_view line_error_words(LineError e) noexcept {
   switch (e) {
-    case LineError::None: return "";
-    case LineError::Empty: return "empty line";
-    case LineError::TooLong: return "line longer than 1024 characters";
-    case LineError::MissingFields: return "missing (a pose has six fields: x y z roll pitch yaw)";
-    case LineError::ExtraFields: return "extra field (more than six)";
-    case LineError::EmptyField: return "empty field";
-    case LineError::NotANumber: return "not a number";
-    case LineError::OutOfRange: return "number out of range";
+    case LineError::None:
+      return "";
+    case LineError::Empty:
+      return "empty line";
+    case LineError::TooLong:
+      return "line longer than 1024 characters";
+    case LineError::MissingFields:
+      return "missing (a pose has six fields: x y z roll pitch yaw)";
+    case LineError::ExtraFields:
+      return "extra field (more than six)";
+    case LineError::EmptyField:
+      return "empty field";
+    case LineError::NotANumber:
+      return "not a number";
+    case LineError::OutOfRange:
+      return "number out of range";
   }
   return "";
 }
@@ -376,8 +394,10 @@ void write_json(LineWriter& w, const StreamOutput& out) noexcept {
 std::size_t format_stream_output(const StreamOutput& out, StreamFormat format, std::span<char> buffer) noexcept {
   if (buffer.size() < kMaxOutputLength) return 0;
   LineWriter w(buffer.first(kMaxOutputLength));
-  if (format == StreamFormat::Csv) write_csv(w, out);
-  else write_json(w, out);
+  if (format == StreamFormat::Csv)
+    write_csv(w, out);
+  else
+    write_json(w, out);
   return w.size();
 }
 

@@ -17,8 +17,8 @@ Status singular_joint(const Model& model, const LegState& st) noexcept {
   double worst_n2 = INFINITY;
   for (int i = 0; i < kLegs; ++i) {
     if (model.geometry().has_axes[i] == 0.0) continue;
-    const auto xy = detail::twist_xy(st.s_B.row(i).transpose(), model.leg(i).axis_base_B,
-                                     st.axis_platform_B.row(i).transpose());
+    const auto xy =
+        detail::twist_xy(st.s_B.row(i).transpose(), model.leg(i).axis_base_B, st.axis_platform_B.row(i).transpose());
     const double n2 = xy.x * xy.x + xy.y * xy.y;
     if (!(n2 >= worst_n2)) {  // also picks a NaN leg
       worst = i;
@@ -62,13 +62,13 @@ Status twist_angles(const Model& model, const LegState& state, bool relative, Ve
   using namespace detail;
   TwistTerms t[kPackets];
   lane_m regular = all_set();
-  #pragma GCC unroll 4
+#pragma GCC unroll 4
   for (int k = 0; k < kPackets; ++k) {
     t[k] = terms_of(leg_twist(model, state, k));
     regular &= twist_regular(model, t[k].x, t[k].y, splat<lane_v>(1.0), k);
   }
   if (!all_lanes(regular)) return singular_joint(model, state);
-  #pragma GCC unroll 4
+#pragma GCC unroll 4
   for (int k = 0; k < kPackets; ++k) store6(out.data(), twist_angle(model, t[k].x, t[k].y, relative, k), k);
   return Status::Ok;
 }
@@ -100,7 +100,7 @@ template <bool kMotor>
 Status jacobian(const Model& model, const LegState& state, Matrix6d& J) noexcept {
   using namespace detail;
   lane_m regular = all_set();
-  #pragma GCC unroll 4
+#pragma GCC unroll 4
   for (int k = 0; k < kPackets; ++k) {
     const LegTwist l = leg_twist(model, state, k);
     const TwistTerms t = terms_of(l);

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <utility>
 
-#include "hexatwist/kinematics/kinematics.hpp"
 #include "dynamics/mechanism_internal.hpp"
 #include "hexatwist/error.hpp"
+#include "hexatwist/kinematics/kinematics.hpp"
 
 namespace hexatwist {
 namespace {
@@ -29,8 +29,7 @@ constexpr double kMaxBandwidthRatio = 0.5;
 
 }  // namespace
 
-Rig::Rig(const RigSpec& spec)
-    : Rig(Model(spec.model), spec.servo, spec.load, spec.simulation, spec.mechanism) {}
+Rig::Rig(const RigSpec& spec) : Rig(Model(spec.model), spec.servo, spec.load, spec.simulation, spec.mechanism) {}
 
 Rig::Rig(Model model, const ServoSpec& servo, const LoadSpec& load, const SimulationSpec& simulation,
          const MechanismSpec& mechanism)
@@ -68,13 +67,12 @@ void Rig::validate_and_derive() {
   non_negative(s.acceleration_feedforward, "servo.acceleration_feedforward", "(fraction)");
   positive(s.peak_corner_speed, "servo.peak_corner_speed", "rad/s");
   if (s.peak_corner_speed > s.max_speed)
-    fail("servo.peak_corner_speed", fmt::format("{} rad/s is above servo.max_speed ({} rad/s)", s.peak_corner_speed,
-                                                s.max_speed));
+    fail("servo.peak_corner_speed",
+         fmt::format("{} rad/s is above servo.max_speed ({} rad/s)", s.peak_corner_speed, s.max_speed));
   non_negative(s.peak_torque_at_max_speed, "servo.peak_torque_at_max_speed", "N m");
   if (s.peak_torque_at_max_speed > s.torque_limit)
-    fail("servo.peak_torque_at_max_speed",
-         fmt::format("{} N m is above the peak torque servo.torque_limit ({} N m)", s.peak_torque_at_max_speed,
-                     s.torque_limit));
+    fail("servo.peak_torque_at_max_speed", fmt::format("{} N m is above the peak torque servo.torque_limit ({} N m)",
+                                                       s.peak_torque_at_max_speed, s.torque_limit));
   positive(s.continuous_torque, "servo.continuous_torque", "N m");
   if (s.continuous_torque > s.torque_limit)
     fail("servo.continuous_torque", fmt::format("{} N m is above the peak torque servo.torque_limit ({} N m)",
@@ -109,7 +107,8 @@ void Rig::validate_and_derive() {
        "mechanism.rod.transverse_inertia");
   for (const auto& [v, field] : {std::pair{mechanism_.efficiency, "mechanism.efficiency"},
                                  std::pair{mechanism_.back_efficiency, "mechanism.back_efficiency"}})
-    if (!std::isfinite(v) || !(v > 0.0) || v > 1.0) fail(field, fmt::format("expected a fraction in (0, 1], got {}", v));
+    if (!std::isfinite(v) || !(v > 0.0) || v > 1.0)
+      fail(field, fmt::format("expected a fraction in (0, 1], got {}", v));
 
   positive(simulation_.control_rate, "simulation.control_rate", "Hz");
   positive(simulation_.plant_step, "simulation.plant_step", "s");
@@ -146,8 +145,8 @@ void Rig::validate_and_derive() {
     const double w = 2.0 * kPi * s.pole_frequency;
     if (w * control_period_ > kMaxBandwidthRatio)
       fail("servo.pole_frequency",
-           fmt::format("{} Hz is too high for the control rate {} Hz (keep 2 pi pole_frequency / rate <= {})", s.pole_frequency,
-                       simulation_.control_rate, kMaxBandwidthRatio));
+           fmt::format("{} Hz is too high for the control rate {} Hz (keep 2 pi pole_frequency / rate <= {})",
+                       s.pole_frequency, simulation_.control_rate, kMaxBandwidthRatio));
     // J s^3 + (b + kd) s^2 + kp s + ki = J (s + w)^3: three closed-loop poles at -w (docs/theory.md §9).
     kp_ = 3.0 * w * w * nominal_inertia_;
     ki_ = w * w * w * nominal_inertia_;

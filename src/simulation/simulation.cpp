@@ -3,9 +3,9 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "dynamics/mechanism_internal.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
 #include "hexatwist/simulation/servo.hpp"
-#include "dynamics/mechanism_internal.hpp"
 
 namespace hexatwist {
 namespace {
@@ -201,12 +201,13 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
     // The load at the current state, held over the control period; the efficiency loss from the
     // screw torque at the last period's motor acceleration.
     if (k > 0)
-      if (const Status s = detail::drive_load(rig, fk.legs, drives.speed, motor_acceleration, options.twist_in_plant, load);
+      if (const Status s =
+              detail::drive_load(rig, fk.legs, drives.speed, motor_acceleration, options.twist_in_plant, load);
           s != Status::Ok)
         return fail(issue, s, k, trajectory);
     const Vector6d speed_before = drives.speed;
-    integrate_drives(rig, load.inverse_inertia, load.load - detail::efficiency_loss(rig, drives.speed, load.screw_torque),
-                     torque, drives);
+    integrate_drives(rig, load.inverse_inertia,
+                     load.load - detail::efficiency_loss(rig, drives.speed, load.screw_torque), torque, drives);
     motor_acceleration = (drives.speed - speed_before) / rig.control_period();
     motor = model.length_home() + gain.cwiseProduct(drives.angle);
     const Placement previous = fk.placement;  // warm start from the last tick

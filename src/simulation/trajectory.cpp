@@ -8,8 +8,8 @@
 #include <span>
 #include <string>
 
-#include "io/csv.hpp"
 #include "hexatwist/error.hpp"
+#include "io/csv.hpp"
 
 namespace hexatwist {
 namespace {
@@ -148,8 +148,7 @@ namespace {
 
 // Straight-line jerk-limited moves through `waypoints` with `dwell` before, between and after
 // them (see waypoint_trajectory). Messages name no routine: the caller names its option or field.
-Trajectory through_waypoints(std::span<const Vector6d> waypoints, const MotionLimits& limits, double dwell,
-                             double dt) {
+Trajectory through_waypoints(std::span<const Vector6d> waypoints, const MotionLimits& limits, double dwell, double dt) {
   struct Stage {
     JerkLimitedMove move;
     double start_time;  // [s]
@@ -170,8 +169,8 @@ Trajectory through_waypoints(std::span<const Vector6d> waypoints, const MotionLi
   // Rounded up, but a total that is a whole number of dt up to rounding is not pushed one further.
   const double steps = std::ceil(total / dt - 1e-9);
   if (!(steps + 1.0 <= kMaxSamples))
-    throw Error(fmt::format("the motion takes {:g} s: at a period of {:g} s that is more than {:.0f} samples", total, dt,
-                            kMaxSamples));
+    throw Error(fmt::format("the motion takes {:g} s: at a period of {:g} s that is more than {:.0f} samples", total,
+                            dt, kMaxSamples));
   const auto n = static_cast<std::size_t>(std::max(steps, 1.0));
 
   Trajectory traj;
@@ -402,8 +401,10 @@ class Pchip {
     // Finite samples whose differences or rates overflow a double (1e308 m next to 0 m) give an
     // infinite slope: no pose can be interpolated there.
     if (!q.allFinite())
-      throw Error(fmt::format("between {} and {}: the interpolation overflows a double (a value or its rate of "
-                              "change beyond 1e308)", where(i), where(i + 1)));
+      throw Error(
+          fmt::format("between {} and {}: the interpolation overflows a double (a value or its rate of "
+                      "change beyond 1e308)",
+                      where(i), where(i + 1)));
     return Pose::from_vector(q);
   }
 

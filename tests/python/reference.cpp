@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "hexatwist/hexatwist.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
+#include "hexatwist/hexatwist.hpp"
 #include "hexatwist/io/mjcf.hpp"
 
 namespace {
@@ -59,9 +59,9 @@ int dynamics(const char* in, const char* path) {
                                              Eigen::Map<const Vector6d>(r + 6), Eigen::Map<const Vector6d>(r + 12));
     InverseDynamics id;
     const Status s = inverse_dynamics(rig, m, id);
-    for (const Vector6d* v : {&id.torque, &id.angle, &id.speed, &id.acceleration, &id.power, &id.gravity,
-                              &id.platform_inertia, &id.velocity_product, &id.legs, &id.drives, &id.friction,
-                              &id.screw_force})
+    for (const Vector6d* v :
+         {&id.torque, &id.angle, &id.speed, &id.acceleration, &id.power, &id.gravity, &id.platform_inertia,
+          &id.velocity_product, &id.legs, &id.drives, &id.friction, &id.screw_force})
       put(out, s == Status::Ok ? *v : Vector6d::Constant(NAN));
     out.push_back(static_cast<double>(s));
     Matrix6d M = Matrix6d::Constant(NAN);
@@ -99,14 +99,14 @@ int sizing(const char* csv, const char* path) {
     for (const Vector6d& t : x.terms) put(out, t);
   }
   for (const MotorSummary& m : s.motors) {
-    out.insert(out.end(), {m.peak_torque, m.rms_torque, m.peak_speed, m.peak_power, m.energy_driven,
-                           m.energy_regenerated});
+    out.insert(out.end(),
+               {m.peak_torque, m.rms_torque, m.peak_speed, m.peak_power, m.energy_driven, m.energy_regenerated});
     out.insert(out.end(), m.share.begin(), m.share.end());
     out.insert(out.end(), {m.peak_usage, m.speed_usage, m.rms_usage});
   }
   const EnvelopeViolation& v = s.violation;
-  out.insert(out.end(), {static_cast<double>(v.check), static_cast<double>(v.leg), static_cast<double>(v.index),
-                         v.time, v.value, v.bound, static_cast<double>(status)});
+  out.insert(out.end(), {static_cast<double>(v.check), static_cast<double>(v.leg), static_cast<double>(v.index), v.time,
+                         v.value, v.bound, static_cast<double>(status)});
   return write_doubles(path, out);
 }
 
@@ -146,8 +146,8 @@ int tracked(const char* in, const char* path) {
   FkResult r;
   std::vector<double> out;
   for (std::size_t i = 0; i < q.size() / 6; ++i) {
-    const Status s = forward_kinematics_tracked(model, Eigen::Map<const Vector6d>(&q[6 * i]), LengthKind::Motor,
-                                                tracker, r);
+    const Status s =
+        forward_kinematics_tracked(model, Eigen::Map<const Vector6d>(&q[6 * i]), LengthKind::Motor, tracker, r);
     put(out, s == Status::Ok ? r.pose.to_vector() : Vector6d::Constant(NAN));
     out.insert(out.end(), {static_cast<double>(s), static_cast<double>(r.iterations), r.residual});
   }

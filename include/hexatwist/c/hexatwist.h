@@ -27,18 +27,18 @@ extern "C" {
 /** Outcome of a call; 0 is the only success. The values are those of hexatwist::Status. */
 typedef enum hexatwist_status {
   HEXATWIST_OK = 0,
-  HEXATWIST_NON_FINITE_INPUT = 1,      /**< a pose, length or guess holds NaN or inf */
-  HEXATWIST_STROKE_BELOW_MIN = 2,      /**< a leg is shorter than its minimum length */
-  HEXATWIST_STROKE_ABOVE_MAX = 3,      /**< a leg is longer than its maximum length */
-  HEXATWIST_BEND_BASE = 4,             /**< a base U-joint bends past its limit */
-  HEXATWIST_BEND_PLATFORM = 5,         /**< a platform U-joint bends past its limit */
-  HEXATWIST_SINGULAR_BASE = 6,         /**< a leg is too close to its base U-joint's fixed axis */
-  HEXATWIST_SINGULAR_PLATFORM = 7,     /**< a leg is too close to its platform U-joint's fixed axis */
-  HEXATWIST_NO_CONVERGENCE = 8,        /**< forward kinematics did not reach its tolerance */
-  HEXATWIST_SINGULAR_JACOBIAN = 9,     /**< forward kinematics met a singular Jacobian */
-  HEXATWIST_PLATFORM_SINGULARITY = 17, /**< the pose is too close to a platform (Jacobian) singularity */
-  HEXATWIST_ASSEMBLY_MODE_CHANGED = 18,/**< forward kinematics would land on another assembly mode */
-  HEXATWIST_INVALID_ARGUMENT = 100,    /**< a null pointer or an unknown enum value was passed */
+  HEXATWIST_NON_FINITE_INPUT = 1,       /**< a pose, length or guess holds NaN or inf */
+  HEXATWIST_STROKE_BELOW_MIN = 2,       /**< a leg is shorter than its minimum length */
+  HEXATWIST_STROKE_ABOVE_MAX = 3,       /**< a leg is longer than its maximum length */
+  HEXATWIST_BEND_BASE = 4,              /**< a base U-joint bends past its limit */
+  HEXATWIST_BEND_PLATFORM = 5,          /**< a platform U-joint bends past its limit */
+  HEXATWIST_SINGULAR_BASE = 6,          /**< a leg is too close to its base U-joint's fixed axis */
+  HEXATWIST_SINGULAR_PLATFORM = 7,      /**< a leg is too close to its platform U-joint's fixed axis */
+  HEXATWIST_NO_CONVERGENCE = 8,         /**< forward kinematics did not reach its tolerance */
+  HEXATWIST_SINGULAR_JACOBIAN = 9,      /**< forward kinematics met a singular Jacobian */
+  HEXATWIST_PLATFORM_SINGULARITY = 17,  /**< the pose is too close to a platform (Jacobian) singularity */
+  HEXATWIST_ASSEMBLY_MODE_CHANGED = 18, /**< forward kinematics would land on another assembly mode */
+  HEXATWIST_INVALID_ARGUMENT = 100,     /**< a null pointer or an unknown enum value was passed */
   HEXATWIST_STATUS_MAX_ENUM = 0x7FFFFFFF
 } hexatwist_status;
 
@@ -96,19 +96,19 @@ typedef struct hexatwist_fk_options {
 
 /** Outcome of forward kinematics. */
 typedef struct hexatwist_fk_result {
-  double pose[6];  /**< the solution (the best iterate when not converged) [m, rad] */
-  int iterations;  /**< Newton iterations taken */
-  double residual; /**< largest |length residual| at `pose` [m] */
-  double condition;/**< condition number of the Jacobian at `pose` [-] */
+  double pose[6];   /**< the solution (the best iterate when not converged) [m, rad] */
+  int iterations;   /**< Newton iterations taken */
+  double residual;  /**< largest |length residual| at `pose` [m] */
+  double condition; /**< condition number of the Jacobian at `pose` [-] */
 } hexatwist_fk_result;
 
 /** Forward kinematics along a motion: the last solution and its assembly mode. Caller-owned;
  * zero-initialise it (or call hexatwist_fk_tracker_reset) to start from home. */
 typedef struct hexatwist_fk_tracker {
-  double t[3];    /**< displacement of the last solution from home [m, B] */
-  double R[9];    /**< its orientation, row-major [-] */
-  double det_sign;/**< sign of the Jacobian's determinant there: the assembly mode */
-  int valid;      /**< 0: no solution yet (home is the start and the reference mode) */
+  double t[3];     /**< displacement of the last solution from home [m, B] */
+  double R[9];     /**< its orientation, row-major [-] */
+  double det_sign; /**< sign of the Jacobian's determinant there: the assembly mode */
+  int valid;       /**< 0: no solution yet (home is the start and the reference mode) */
 } hexatwist_fk_tracker;
 
 /* ---- Model (not real-time: these allocate and read files) ---------------------------------- */
@@ -118,8 +118,7 @@ typedef struct hexatwist_fk_tracker {
 hexatwist_model* hexatwist_model_from_file(const char* path, char* error, size_t error_size);
 
 /** Model from YAML text; `source` names it in error messages (may be NULL). */
-hexatwist_model* hexatwist_model_from_yaml(const char* yaml_text, const char* source, char* error,
-                                           size_t error_size);
+hexatwist_model* hexatwist_model_from_yaml(const char* yaml_text, const char* source, char* error, size_t error_size);
 
 /** The embedded seed platform (configs/seed.yaml: the paper's platform, lead 10 mm). */
 hexatwist_model* hexatwist_model_default(char* error, size_t error_size);
@@ -154,8 +153,7 @@ hexatwist_status hexatwist_compute_commands(const hexatwist_model* model, const 
                                             hexatwist_command_report* report);
 
 /** Twist of each leg relative to home [rad] at `pose` (limits not checked). */
-hexatwist_status hexatwist_twist(const hexatwist_model* model, const double pose[6],
-                                 double twist[HEXATWIST_LEGS]);
+hexatwist_status hexatwist_twist(const hexatwist_model* model, const double pose[6], double twist[HEXATWIST_LEGS]);
 
 /** Default forward-kinematics settings (the library's). */
 hexatwist_fk_options hexatwist_fk_default_options(void);
@@ -169,10 +167,9 @@ hexatwist_status hexatwist_forward_kinematics(const hexatwist_model* model, cons
 /** Forward kinematics along a motion: starts at the tracker's last solution (home at first) and
  * succeeds only on the tracker's assembly mode; updates the tracker on HEXATWIST_OK only. */
 hexatwist_status hexatwist_forward_kinematics_tracked(const hexatwist_model* model,
-                                                      const double lengths[HEXATWIST_LEGS],
-                                                      hexatwist_length_kind kind, hexatwist_fk_tracker* tracker,
-                                                      const hexatwist_fk_options* options,
-                                                      hexatwist_fk_result* result);
+                                                      const double lengths[HEXATWIST_LEGS], hexatwist_length_kind kind,
+                                                      hexatwist_fk_tracker* tracker,
+                                                      const hexatwist_fk_options* options, hexatwist_fk_result* result);
 
 /** Forgets the tracker's solution: the next tracked call starts from home. */
 void hexatwist_fk_tracker_reset(hexatwist_fk_tracker* tracker);

@@ -13,8 +13,8 @@
 
 #include <Eigen/Core>
 
-#include "hexatwist/kinematics/forward.hpp"
 #include "hexatwist/calibration/registration.hpp"
+#include "hexatwist/kinematics/forward.hpp"
 
 namespace hexatwist {
 

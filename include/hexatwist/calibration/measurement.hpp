@@ -93,12 +93,12 @@ Trajectory measured_test_trajectory(const StudySpec& study, const StudyTest& tes
 /// offsets and the observation point from many directions. The paper's tests alone leave some leg
 /// offsets undetermined to ±0.1 mm; 40 stations with a 1 s rest fix them to a few µm.
 struct StationsSpec {
-  int count = 40;                         ///< stations, not counting home at the start and the end
-  double translation = 0.25;              ///< each of x, y, z drawn uniformly in ±translation [m]
-  double rotation = deg2rad(15.0);        ///< each of roll, pitch, yaw drawn uniformly in ±rotation [rad]
-  MotionLimits limits{0.2, 0.5, 2.5};     ///< the moves, on the distance in pose coordinates [m or rad /s, /s^2, /s^3]
-  double dwell = 1.0;                     ///< rest at each station [s]
-  std::uint64_t seed = 1;                 ///< the same seed gives the same stations everywhere
+  int count = 40;                      ///< stations, not counting home at the start and the end
+  double translation = 0.25;           ///< each of x, y, z drawn uniformly in ±translation [m]
+  double rotation = deg2rad(15.0);     ///< each of roll, pitch, yaw drawn uniformly in ±rotation [rad]
+  MotionLimits limits{0.2, 0.5, 2.5};  ///< the moves, on the distance in pose coordinates [m or rad /s, /s^2, /s^3]
+  double dwell = 1.0;                  ///< rest at each station [s]
+  std::uint64_t seed = 1;              ///< the same seed gives the same stations everywhere
 };
 
 /// Home, then `spec.count` stations, then home: straight moves in pose coordinates (jerk-limited,
@@ -157,8 +157,8 @@ struct Measurement {
   /// The points that registered, in the order of the registration's pairs: points[registered[i]]
   /// is pair i (so the worst is points[registered[registration.max_residual_index]]).
   std::vector<std::size_t> registered;
-  std::size_t window = 0;     ///< points in the registration window (points[0 .. window-1])
-  double window_end = 0.0;    ///< trajectory time of the window's last point [s]
+  std::size_t window = 0;   ///< points in the registration window (points[0 .. window-1])
+  double window_end = 0.0;  ///< trajectory time of the window's last point [s]
   /// The evaluated points are those after the window (the registration fits the window's
   /// points, so their errors are not measured but fitted): points[window ..].
   ErrorStats error;                ///< |error_B| over the evaluated points [m], as the study's

@@ -16,9 +16,9 @@ namespace hexatwist {
 
 /// The platform's motion at one instant.
 struct PlatformMotion {
-  Placement placement;                        ///< pose [m, B]
-  Vector6d velocity = Vector6d::Zero();       ///< [v of the pivot; w] [m/s, rad/s, B]
-  Vector6d acceleration = Vector6d::Zero();   ///< time derivative of velocity [m/s^2, rad/s^2, B]
+  Placement placement;                       ///< pose [m, B]
+  Vector6d velocity = Vector6d::Zero();      ///< [v of the pivot; w] [m/s, rad/s, B]
+  Vector6d acceleration = Vector6d::Zero();  ///< time derivative of velocity [m/s^2, rad/s^2, B]
 };
 
 /// The motion of a pose given in roll-pitch-yaw with its time derivatives: w = E(rpy) rpy',
@@ -35,12 +35,14 @@ struct InverseDynamics {
   Vector6d power;             ///< torque * speed [W]; negative = the load drives the motor
   Vector6d gravity;           ///< share of gravity (platform, payload and legs) [N m]
   Vector6d platform_inertia;  ///< share of the platform's inertia, linear in the acceleration [N m]
-  Vector6d velocity_product;  ///< share of the velocity-product (Coriolis, centripetal, gyroscopic) terms of the platform and the leg bodies [N m]
+  Vector6d velocity_product;  ///< share of the velocity-product (Coriolis, centripetal, gyroscopic) terms of the
+                              ///< platform and the leg bodies [N m]
   Vector6d legs;              ///< share of the leg bodies' inertia, linear in the acceleration [N m]
-  Vector6d drives;            ///< share of rotor, gear and screw inertia: all of it, velocity-product part of the motor's acceleration included [N m]
-  Vector6d friction;          ///< viscous and dry friction and the screw's efficiency losses [N m]
-  Vector6d screw_force;       ///< axial force the nut carries, tension positive [N]
-  LegState legs_state;        ///< inverse kinematics at the pose
+  Vector6d drives;       ///< share of rotor, gear and screw inertia: all of it, velocity-product part of the motor's
+                         ///< acceleration included [N m]
+  Vector6d friction;     ///< viscous and dry friction and the screw's efficiency losses [N m]
+  Vector6d screw_force;  ///< axial force the nut carries, tension positive [N]
+  LegState legs_state;   ///< inverse kinematics at the pose
 };
 
 /// Motor torques for `motion` (Newton-Euler on every body, projected by virtual power;

@@ -9,8 +9,8 @@
 #include <string_view>
 #include <vector>
 
-#include "hexatwist/kinematics/limits.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
+#include "hexatwist/kinematics/limits.hpp"
 #include "hexatwist/simulation/trajectory.hpp"
 
 namespace hexatwist {
@@ -31,19 +31,19 @@ std::string_view to_string(TorqueTerm term) noexcept;
 
 /// One sample of the trajectory.
 struct MotorSample {
-  double time = 0.0;                    ///< [s]
-  Vector6d torque = Vector6d::Zero();   ///< motor torque [N m], positive lengthens the leg
-  Vector6d speed = Vector6d::Zero();    ///< motor speed [rad/s]
-  Vector6d power = Vector6d::Zero();    ///< torque * speed [W]; negative = the load drives the motor
+  double time = 0.0;                           ///< [s]
+  Vector6d torque = Vector6d::Zero();          ///< motor torque [N m], positive lengthens the leg
+  Vector6d speed = Vector6d::Zero();           ///< motor speed [rad/s]
+  Vector6d power = Vector6d::Zero();           ///< torque * speed [W]; negative = the load drives the motor
   std::array<Vector6d, kTorqueTerms> terms{};  ///< the torque's parts, indexed by TorqueTerm [N m]
 };
 
 /// The checks of a motor's operating points against its envelope (ServoSpec).
 enum class EnvelopeCheck : int {
-  None,             ///< no violation
-  Speed,            ///< |speed| <= servo.max_speed at every sample
-  PeakTorque,       ///< |torque| <= peak_torque_at(servo, |speed|) at every sample
-  ContinuousTorque, ///< RMS torque over the trajectory <= servo.continuous_torque
+  None,              ///< no violation
+  Speed,             ///< |speed| <= servo.max_speed at every sample
+  PeakTorque,        ///< |torque| <= peak_torque_at(servo, |speed|) at every sample
+  ContinuousTorque,  ///< RMS torque over the trajectory <= servo.continuous_torque
 };
 
 /// Stable snake_case name of a check ("peak_torque").
@@ -63,15 +63,15 @@ struct EnvelopeViolation {
 /// One motor over the whole trajectory. RMS values are over the samples (equal weights: the
 /// trajectory is sampled at a fixed period), sqrt(mean(x^2)).
 struct MotorSummary {
-  double peak_torque = 0.0;              ///< largest |torque| [N m]
-  double peak_torque_time = 0.0;         ///< when [s] (the first such sample)
-  double rms_torque = 0.0;               ///< RMS torque [N m]
-  double peak_speed = 0.0;               ///< largest |speed| [rad/s]
-  double peak_speed_time = 0.0;          ///< [s]
-  double peak_power = 0.0;               ///< largest torque * speed, the motor driving [W] (0 if it never drives)
-  double peak_power_time = 0.0;          ///< [s]
-  double energy_driven = 0.0;            ///< integral of max(power, 0) dt: work the motor does [J]
-  double energy_regenerated = 0.0;       ///< integral of max(-power, 0) dt: work the load does on the motor [J], >= 0
+  double peak_torque = 0.0;         ///< largest |torque| [N m]
+  double peak_torque_time = 0.0;    ///< when [s] (the first such sample)
+  double rms_torque = 0.0;          ///< RMS torque [N m]
+  double peak_speed = 0.0;          ///< largest |speed| [rad/s]
+  double peak_speed_time = 0.0;     ///< [s]
+  double peak_power = 0.0;          ///< largest torque * speed, the motor driving [W] (0 if it never drives)
+  double peak_power_time = 0.0;     ///< [s]
+  double energy_driven = 0.0;       ///< integral of max(power, 0) dt: work the motor does [J]
+  double energy_regenerated = 0.0;  ///< integral of max(-power, 0) dt: work the load does on the motor [J], >= 0
   /// Share of each term: the RMS of that term divided by the RMS torque, both over the trajectory
   /// [-]. Each share is between 0 and (for terms that cancel each other) above 1; the shares do
   /// not add up to 1 (RMS is not additive), but the squares add up to 1 when the terms are
@@ -81,25 +81,25 @@ struct MotorSummary {
   /// Largest |torque| / peak_torque_at(|speed|) over the samples within servo.max_speed [-]: 1 is
   /// on the peak envelope (the samples beyond max_speed fail the speed check instead).
   double peak_usage = 0.0;
-  double peak_usage_time = 0.0;          ///< when [s]
-  double speed_usage = 0.0;              ///< peak_speed / servo.max_speed [-]
-  double rms_usage = 0.0;                ///< rms_torque / servo.continuous_torque [-]
-  EnvelopeViolation violation;           ///< this motor's first violation (check None if none)
+  double peak_usage_time = 0.0;  ///< when [s]
+  double speed_usage = 0.0;      ///< peak_speed / servo.max_speed [-]
+  double rms_usage = 0.0;        ///< rms_torque / servo.continuous_torque [-]
+  EnvelopeViolation violation;   ///< this motor's first violation (check None if none)
 };
 
 /// The result of motor sizing. On a failure (status not Ok) `samples` holds the samples before
 /// the failing one and the summaries are not computed.
 struct MotorSizing {
-  std::vector<MotorSample> samples;       ///< one per trajectory sample
-  std::array<MotorSummary, 6> motors{};   ///< per leg
+  std::vector<MotorSample> samples;      ///< one per trajectory sample
+  std::array<MotorSummary, 6> motors{};  ///< per leg
   /// The first violation over all motors: the earliest sample, legs in order, at one sample the
   /// speed check before the peak torque check; the continuous torque checks (at the last sample)
   /// come after every pointwise one. check None if every motor stays inside its envelope.
   EnvelopeViolation violation;
-  Status status = Status::Ok;   ///< Ok, a pose limit (limit says which), or the failure of inverse_dynamics
-  std::size_t failed_index = 0; ///< sample where status arose
-  double failed_time = 0.0;     ///< its time [s]
-  LimitReport limit;            ///< leg, value and bound when status is a pose limit
+  Status status = Status::Ok;    ///< Ok, a pose limit (limit says which), or the failure of inverse_dynamics
+  std::size_t failed_index = 0;  ///< sample where status arose
+  double failed_time = 0.0;      ///< its time [s]
+  LimitReport limit;             ///< leg, value and bound when status is a pose limit
 };
 
 /// Motor sizing of `trajectory` on `rig`. At each sample k: the pose rate and acceleration by

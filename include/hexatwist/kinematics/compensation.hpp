@@ -19,12 +19,12 @@ void length_error(const Model& model, const Vector6d& dtheta, Vector6d& error) n
 
 /// Everything about one commanded pose (caller-owned workspace).
 struct CommandReport {
-  LegState legs;                            ///< inverse kinematics
-  Vector6d twist = Vector6d::Zero();        ///< dtheta relative to home [rad]
-  Vector6d length_error = Vector6d::Zero(); ///< Eq. (10) [m]
-  Vector6d conventional = Vector6d::Zero(); ///< motor-side command, twist ignored [m]
-  Vector6d compensated = Vector6d::Zero();  ///< motor-side command, Eq. (12) [m]
-  LimitReport limit;                        ///< first limit violated, if any
+  LegState legs;                             ///< inverse kinematics
+  Vector6d twist = Vector6d::Zero();         ///< dtheta relative to home [rad]
+  Vector6d length_error = Vector6d::Zero();  ///< Eq. (10) [m]
+  Vector6d conventional = Vector6d::Zero();  ///< motor-side command, twist ignored [m]
+  Vector6d compensated = Vector6d::Zero();   ///< motor-side command, Eq. (12) [m]
+  LimitReport limit;                         ///< first limit violated, if any
 };
 
 /// Full computation for a pose: IK, twist, Eq. (10), both commands and the limit check (pose
@@ -34,7 +34,7 @@ struct CommandReport {
 
 /// Real-time path: the motor-side commands for one strategy [m], limits checked. `command` is
 /// written only when the result is Ok; `report` says which leg and limit otherwise.
-[[nodiscard]] Status motor_commands(const Model& model, const Pose& pose, Strategy strategy,
-                                    Vector6d& command, LimitReport& report) noexcept;
+[[nodiscard]] Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, Vector6d& command,
+                                    LimitReport& report) noexcept;
 
 }  // namespace hexatwist

@@ -14,8 +14,8 @@ enum class LengthKind {
 
 /// Newton settings.
 struct FkOptions {
-  int max_iterations = 30;     ///< Newton iterations before NoConvergence
-  double tolerance = 1e-12;    ///< max |residual| accepted [m]
+  int max_iterations = 30;   ///< Newton iterations before NoConvergence
+  double tolerance = 1e-12;  ///< max |residual| accepted [m]
   /// Smallest min |pivot| / max |pivot| of the elimination of the scaled Jacobian (its columns
   /// in m per m, docs/theory.md §6) before SingularJacobian.
   double singular_ratio = 1e-12;
@@ -27,11 +27,11 @@ struct FkOptions {
 
 /// Result of forward kinematics (caller-owned).
 struct FkResult {
-  Placement placement;       ///< solution as displacement + rotation matrix
-  Pose pose;                 ///< the same as roll-pitch-yaw
-  int iterations = 0;        ///< Newton iterations taken
-  double residual = 0.0;     ///< max_i |residual_i| at `placement` [m]
-  LegState legs;             ///< inverse kinematics at the solution
+  Placement placement;    ///< solution as displacement + rotation matrix
+  Pose pose;              ///< the same as roll-pitch-yaw
+  int iterations = 0;     ///< Newton iterations taken
+  double residual = 0.0;  ///< max_i |residual_i| at `placement` [m]
+  LegState legs;          ///< inverse kinematics at the solution
   /// Condition number of the Jacobian of the lengths of `kind` at the solution, defined as in
   /// jacobian_condition (limits.hpp) [-]; NaN unless the status is Ok or AssemblyModeChanged.
   double condition = 0.0;
@@ -42,9 +42,9 @@ struct FkResult {
 
 /// Caller-owned state of forward kinematics along a motion (forward_kinematics_tracked).
 struct FkTracker {
-  Placement last;        ///< the last solution, the next call's start [m, B]
-  double det_sign = 0;   ///< its assembly mode, the sign of the Jacobian's determinant [-]
-  bool valid = false;    ///< false until the first solution (the start is then home)
+  Placement last;       ///< the last solution, the next call's start [m, B]
+  double det_sign = 0;  ///< its assembly mode, the sign of the Jacobian's determinant [-]
+  bool valid = false;   ///< false until the first solution (the start is then home)
 };
 
 /// Jacobian of the lengths of `kind` at the state `legs` (inverse kinematics done) for the
@@ -55,8 +55,8 @@ struct FkTracker {
 /// Residual f(x) = g(x) - lengths, with g the geometric or motor-side lengths, and its Jacobian
 /// J_f_x for the perturbation t += dt, R = exp(dw) R. The motor-side rows include the twist's
 /// derivative.
-[[nodiscard]] Status fk_residual(const Model& model, const Placement& x, const Vector6d& lengths,
-                                 LengthKind kind, LegState& legs, Vector6d& f, Matrix6d* J_f_x) noexcept;
+[[nodiscard]] Status fk_residual(const Model& model, const Placement& x, const Vector6d& lengths, LengthKind kind,
+                                 LegState& legs, Vector6d& f, Matrix6d* J_f_x) noexcept;
 
 /// Forward kinematics from `guess` (home by default in the CLI). Returns Ok, NoConvergence,
 /// SingularJacobian, SingularBase/SingularPlatform (an iterate crossed a U-joint singularity),
@@ -65,8 +65,7 @@ struct FkTracker {
 /// it is not the pose the guess was near). `out.residual` and `out.iterations` are set in every
 /// case; on failure `out.placement` is the best iterate.
 [[nodiscard]] Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKind kind,
-                                        const Placement& guess, FkResult& out,
-                                        const FkOptions& options = {}) noexcept;
+                                        const Placement& guess, FkResult& out, const FkOptions& options = {}) noexcept;
 
 /// Forward kinematics along a motion: from tracker.last (home while !tracker.valid), Ok only when
 /// converged on the same assembly mode as the tracker's (home's while !valid) and with the
@@ -81,6 +80,7 @@ struct FkTracker {
 /// Sets `tracker` to a known placement (after homing, or as a fallback start) with that
 /// placement's assembly mode for lengths of `kind`. Returns the status of inverse kinematics or of
 /// the Jacobian (SingularJacobian where its determinant is zero); `tracker` is unchanged then.
-[[nodiscard]] Status fk_tracker_set(const Model& model, const Placement& x, LengthKind kind, FkTracker& tracker) noexcept;
+[[nodiscard]] Status fk_tracker_set(const Model& model, const Placement& x, LengthKind kind,
+                                    FkTracker& tracker) noexcept;
 
 }  // namespace hexatwist

@@ -22,8 +22,7 @@ struct LimitReport {
 
 /// U-joint bend angles: base, angle between s_i and its home direction; platform, the same seen
 /// from the platform frame [rad].
-void bend_angles(const Model& model, const LegState& state, Vector6d& bend_base,
-                 Vector6d& bend_platform) noexcept;
+void bend_angles(const Model& model, const LegState& state, Vector6d& bend_base, Vector6d& bend_platform) noexcept;
 
 /// Condition number of the platform Jacobian at `state` (inverse kinematics done): the motor-side
 /// Jacobian when the model has twist, else the geometric one, rotation columns divided by

@@ -18,14 +18,14 @@ enum class DrivenSide { Base, Platform };
 
 /// One leg as given by the user (unvalidated).
 struct LegSpec {
-  Vector3d base_B = Vector3d::Zero();         ///< base U-joint centre, A2 [m, B]
-  Vector3d platform_P = Vector3d::Zero();     ///< platform U-joint centre, A1 [m, P]
-  Vector3d axis_base_B = Vector3d::Zero();    ///< base U-joint fixed axis ja, Eq. (6) [-, B]
-  Vector3d axis_platform_P = Vector3d::Zero();///< platform U-joint fixed axis jd, Eq. (6) [-, P]
-  double lead = 0.0;                          ///< screw lead, travel per revolution [m]
-  ThreadSense thread = ThreadSense::Right;    ///< thread hand
-  DrivenSide driven = DrivenSide::Base;       ///< side whose motor turns the screw
-  double length_offset = 0.0;                 ///< real minus motor-side length at zero twist (theory §4) [m]
+  Vector3d base_B = Vector3d::Zero();           ///< base U-joint centre, A2 [m, B]
+  Vector3d platform_P = Vector3d::Zero();       ///< platform U-joint centre, A1 [m, P]
+  Vector3d axis_base_B = Vector3d::Zero();      ///< base U-joint fixed axis ja, Eq. (6) [-, B]
+  Vector3d axis_platform_P = Vector3d::Zero();  ///< platform U-joint fixed axis jd, Eq. (6) [-, P]
+  double lead = 0.0;                            ///< screw lead, travel per revolution [m]
+  ThreadSense thread = ThreadSense::Right;      ///< thread hand
+  DrivenSide driven = DrivenSide::Base;         ///< side whose motor turns the screw
+  double length_offset = 0.0;                   ///< real minus motor-side length at zero twist (theory §4) [m]
 };
 
 /// Default of LimitSpec::jacobian_condition_max (docs/theory.md §6: chosen on the seed platform).
@@ -55,12 +55,12 @@ struct LimitSpec {
 /// Everything a Model is built from. Frames: B is the base frame; P is the platform frame, equal
 /// to B translated by `home_height` along z at home.
 struct ModelSpec {
-  std::string name;                        ///< free text shown by the CLI
-  PerLeg<LegSpec> legs;                    ///< the six legs
-  double home_height = 0.0;                ///< height of P's origin above B's origin at home [m]
-  LimitSpec limits;                        ///< motion limits
-  Vector3d observation_P = Vector3d::Zero();///< observation point "A" [m, P]
-  Vector3d pivot_P = Vector3d::Zero();     ///< point about which pose rotations act [m, P]
+  std::string name;                           ///< free text shown by the CLI
+  PerLeg<LegSpec> legs;                       ///< the six legs
+  double home_height = 0.0;                   ///< height of P's origin above B's origin at home [m]
+  LimitSpec limits;                           ///< motion limits
+  Vector3d observation_P = Vector3d::Zero();  ///< observation point "A" [m, P]
+  Vector3d pivot_P = Vector3d::Zero();        ///< point about which pose rotations act [m, P]
 };
 
 /// A leg with everything that depends only on the geometry precomputed.
@@ -191,7 +191,7 @@ struct SymmetricSpec {
   double db = 0.0;  ///< distance between the two base joints of a pair [m]
   double H = 0.0;   ///< height of the platform joint plane above the base joint plane at home [m]
   std::array<double, 3> base_pair_angles{deg2rad(60), deg2rad(-60), deg2rad(180)};  ///< pairs (1,6),(2,3),(4,5) [rad]
-  std::array<double, 3> platform_pair_angles{0.0, deg2rad(240), deg2rad(120)};    ///< pairs (1,2),(3,4),(5,6) [rad]
+  std::array<double, 3> platform_pair_angles{0.0, deg2rad(240), deg2rad(120)};      ///< pairs (1,2),(3,4),(5,6) [rad]
 };
 
 /// Leg geometry (positions and fixed axes) of a symmetric platform; lead, thread and driven side

@@ -31,8 +31,8 @@ Matrix3d exp_so3(const Vector3d& w) noexcept;
 
 /// Pose as a displacement and a rotation matrix: the representation forward kinematics updates.
 struct Placement {
-  Vector3d t = Vector3d::Zero();            ///< displacement from home [m, B]
-  Matrix3d R_BP = Matrix3d::Identity();     ///< platform orientation relative to home
+  Vector3d t = Vector3d::Zero();         ///< displacement from home [m, B]
+  Matrix3d R_BP = Matrix3d::Identity();  ///< platform orientation relative to home
 };
 
 /// Placement of a pose (computes Eq. 3 once).

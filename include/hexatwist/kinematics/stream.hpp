@@ -47,8 +47,8 @@ std::string_view to_string(LineError e) noexcept;
 /// Where and why a pose line failed to parse.
 struct LineParse {
   LineError error = LineError::None;
-  int field = -1;   ///< offending field, 0-based (0 = x ... 5 = yaw); -1 for the whole line
-  int column = 0;   ///< 1-based character position of the offending field (0 for the whole line)
+  int field = -1;  ///< offending field, 0-based (0 = x ... 5 = yaw); -1 for the whole line
+  int column = 0;  ///< 1-based character position of the offending field (0 for the whole line)
 };
 
 /// Longest pose line accepted [characters].
@@ -111,13 +111,13 @@ std::string_view to_string(CommandAction a) noexcept;
 
 /// Answer to one input.
 struct StreamOutput {
-  std::uint64_t input = 0;             ///< 1-based number of the input (its line or datagram)
-  Status status = Status::Ok;          ///< Ok, or why the input was rejected
+  std::uint64_t input = 0;     ///< 1-based number of the input (its line or datagram)
+  Status status = Status::Ok;  ///< Ok, or why the input was rejected
   CommandAction action = CommandAction::None;
-  bool rate_limited = false;           ///< the command was slowed down by the rate limits
-  Vector6d command = Vector6d::Zero(); ///< the command to send [m]; meaningful unless action is None
-  LimitReport limit;                   ///< which leg broke which limit, when status is a limit
-  LineParse parse;                     ///< where the line is malformed, when status is MalformedInput
+  bool rate_limited = false;            ///< the command was slowed down by the rate limits
+  Vector6d command = Vector6d::Zero();  ///< the command to send [m]; meaningful unless action is None
+  LimitReport limit;                    ///< which leg broke which limit, when status is a limit
+  LineParse parse;                      ///< where the line is malformed, when status is MalformedInput
 };
 
 /// Starts (or restarts) a stream at a pose the platform stands at, e.g. home: its command becomes
@@ -145,8 +145,7 @@ struct StreamOutput {
 enum class StreamFormat { Csv, Json };
 
 /// Header of the CSV format, with its newline.
-inline constexpr std::string_view kStreamCsvHeader =
-    "input,status,command,m1,m2,m3,m4,m5,m6,leg,value,bound,detail\n";
+inline constexpr std::string_view kStreamCsvHeader = "input,status,command,m1,m2,m3,m4,m5,m6,leg,value,bound,detail\n";
 
 /// Longest line `format_stream_output` writes [characters].
 inline constexpr std::size_t kMaxOutputLength = 640;

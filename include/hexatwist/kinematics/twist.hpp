@@ -18,12 +18,11 @@ namespace hexatwist {
 
 /// Twist relative to home on the branch closest to `reference` [rad]: continuous along a motion
 /// when `reference` is the previous sample's twist, also past +-pi.
-[[nodiscard]] Status twist_continued(const Model& model, const LegState& state,
-                                     const Vector6d& reference, Vector6d& dtheta) noexcept;
+[[nodiscard]] Status twist_continued(const Model& model, const LegState& state, const Vector6d& reference,
+                                     Vector6d& dtheta) noexcept;
 
 /// Jacobian of the twist with respect to the platform twist (dt [m, B], dw [rad, B]), same
 /// perturbation as length_jacobian. Rows of legs without axes are zero.
-[[nodiscard]] Status twist_jacobian(const Model& model, const LegState& state,
-                                    Matrix6d& J_twist_x) noexcept;
+[[nodiscard]] Status twist_jacobian(const Model& model, const LegState& state, Matrix6d& J_twist_x) noexcept;
 
 }  // namespace hexatwist

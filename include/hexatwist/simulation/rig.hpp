@@ -30,16 +30,16 @@ struct ServoSpec {
   /// Largest RMS torque the motor carries without overheating [N m]. NaN = torque_limit / 2.95
   /// (9.5 of 28 N m: 3 kW at 3000 rpm).
   double continuous_torque = std::numeric_limits<double>::quiet_NaN();
-  double encoder_counts = 1048576;               ///< encoder counts per motor revolution (20 bit)
-  double gear_ratio = 1.0;                       ///< motor revolutions per screw revolution
+  double encoder_counts = 1048576;  ///< encoder counts per motor revolution (20 bit)
+  double gear_ratio = 1.0;          ///< motor revolutions per screw revolution
   /// Frequency of the closed-loop poles from which the PID gains are derived when kp, ki and kd
   /// are all 0: all three poles at -2 pi pole_frequency on each leg's nominal inertia [Hz]. The
   /// loop's -3 dB bandwidth is then about 3.9 times this (docs/theory.md §9).
   double pole_frequency = 10.0;
-  double kp = 0.0;                        ///< proportional gain on the motor angle error [N m/rad]; 0 = from pole_frequency
-  double ki = 0.0;                        ///< integral gain [N m/(rad s)]; 0 = from pole_frequency
-  double kd = 0.0;                        ///< derivative gain on the motor speed error [N m s/rad]; 0 = from pole_frequency
-  double velocity_feedforward = 1.0;      ///< fraction of the model's viscous torque fed forward [-]
+  double kp = 0.0;                    ///< proportional gain on the motor angle error [N m/rad]; 0 = from pole_frequency
+  double ki = 0.0;                    ///< integral gain [N m/(rad s)]; 0 = from pole_frequency
+  double kd = 0.0;                    ///< derivative gain on the motor speed error [N m s/rad]; 0 = from pole_frequency
+  double velocity_feedforward = 1.0;  ///< fraction of the model's viscous torque fed forward [-]
   double acceleration_feedforward = 1.0;  ///< fraction of the nominal inertia torque fed forward [-]
 };
 

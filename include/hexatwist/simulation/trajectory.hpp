@@ -129,9 +129,9 @@ struct TimedPoses {
 TimedPoses parse_trajectory_csv(std::string_view text, std::string_view source);
 
 /// Resamples every `dt` [s] from t.front() to t.back() (t0 = t.front(); the last sample at, or
-/// within dt after, t.back(), holding the last pose: a last time between two ticks is not lost) with the monotone piecewise-cubic Hermite interpolation of
-/// Fritsch and Carlson ("PCHIP") per coordinate: C1, and never beyond the samples (a hold stays
-/// flat, a move does not overshoot its end), so waypoint files are safe. Lines are reproduced
+/// within dt after, t.back(), holding the last pose: a last time between two ticks is not lost) with the monotone
+/// piecewise-cubic Hermite interpolation of Fritsch and Carlson ("PCHIP") per coordinate: C1, and never beyond the
+/// samples (a hold stays flat, a move does not overshoot its end), so waypoint files are safe. Lines are reproduced
 /// exactly; the acceleration jumps at the samples, so sparse files show up in the servo's
 /// acceleration feed-forward (give samples at the control rate for the smoothest run). A grid
 /// time within 1e-9 dt of an input time gives that input pose exactly. Angles are interpolated as

@@ -44,8 +44,15 @@ const Motion& motion() {
     const double w = 2 * 3.14159265358979323846 * 0.5;
     for (int k = 0; k <= 4000; ++k) {
       const double t = 1e-3 * k;
-      WorldPose p{200 * std::sin(w * t), 150 * std::sin(1.3 * w * t), kHomeZ + 150 * std::sin(0.7 * w * t),
-                  6 * std::sin(0.9 * w * t), 10 * std::sin(1.1 * w * t), 15 * std::sin(w * t), 0, 0, 0};
+      WorldPose p{200 * std::sin(w * t),
+                  150 * std::sin(1.3 * w * t),
+                  kHomeZ + 150 * std::sin(0.7 * w * t),
+                  6 * std::sin(0.9 * w * t),
+                  10 * std::sin(1.1 * w * t),
+                  15 * std::sin(w * t),
+                  0,
+                  0,
+                  0};
       if (kinematicsInverse(&p, j.data(), &i, &f) != 0) std::abort();
       out.world.push_back(p);
       out.joints.push_back(j);
@@ -104,8 +111,12 @@ void BM_CApiCompensatedCommand(benchmark::State& state) {
   std::size_t k = 0;
   for (auto _ : state) {
     const WorldPose& p = m.world[k];
-    const double pose[6] = {p.x / 1000, p.y / 1000, p.z / 1000 - kHomeZ / 1000, p.a * 0.017453292519943295,
-                            p.b * 0.017453292519943295, p.c * 0.017453292519943295};
+    const double pose[6] = {p.x / 1000,
+                            p.y / 1000,
+                            p.z / 1000 - kHomeZ / 1000,
+                            p.a * 0.017453292519943295,
+                            p.b * 0.017453292519943295,
+                            p.c * 0.017453292519943295};
     benchmark::DoNotOptimize(hexatwist_motor_commands(model, pose, HEXATWIST_COMPENSATED, command, nullptr));
     if (++k == m.world.size()) k = 0;
   }

@@ -8,16 +8,27 @@
 #include "hal.h"
 #include "rtapi.h"
 
-int hal_init(const char* name) { (void)name; return 1; }
-int hal_exit(int comp_id) { (void)comp_id; return 0; }
-int hal_ready(int comp_id) { (void)comp_id; return 0; }
+int hal_init(const char* name) {
+  (void)name;
+  return 1;
+}
+int hal_exit(int comp_id) {
+  (void)comp_id;
+  return 0;
+}
+int hal_ready(int comp_id) {
+  (void)comp_id;
+  return 0;
+}
 void* hal_malloc(long int size) { return calloc(1, (size_t)size); }
 
-#define PIN(type, name)                                                                       \
-  int name(hal_pin_dir_t dir, type** data_ptr_addr, int comp_id, const char* fmt, ...) {     \
-    (void)dir; (void)comp_id; (void)fmt;                                                      \
-    *data_ptr_addr = calloc(1, sizeof(type));                                                 \
-    return *data_ptr_addr ? 0 : -1;                                                           \
+#define PIN(type, name)                                                                  \
+  int name(hal_pin_dir_t dir, type** data_ptr_addr, int comp_id, const char* fmt, ...) { \
+    (void)dir;                                                                           \
+    (void)comp_id;                                                                       \
+    (void)fmt;                                                                           \
+    *data_ptr_addr = calloc(1, sizeof(type));                                            \
+    return *data_ptr_addr ? 0 : -1;                                                      \
   }
 PIN(hal_float_t, hal_pin_float_newf)
 PIN(hal_s32_t, hal_pin_s32_newf)
