@@ -7,7 +7,7 @@
 
 #include "hexatwist/dynamics/mechanism.hpp"
 #if defined(HEXATWIST_BENCH_MUJOCO)
-#include "../tests/mjcf_support.hpp"
+#include "../tests/io/mjcf_support.hpp"
 #endif
 
 namespace {

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "fuzz_support.hpp"
-#include "hexatwist/simulation/trajectory.hpp"
+#include "hexatwist/motion/trajectory.hpp"
 
 namespace {
 

@@ -6,6 +6,6 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 # Build progress goes to stderr (the first build takes several minutes); stdout is hexatwist's.
-bash "$root/scripts/build.sh" >&2
+bash "$root/scripts/build.sh" hexatwist_cli >&2
 if [ $# -eq 0 ]; then set -- study; fi
 exec "$root/build/hexatwist" "$@"

@@ -12,6 +12,7 @@ packages=(
   libmujoco-dev                                     # MuJoCo 2.2: the tests and benchmark of the MJCF export
   gnuplot-nox                                       # figures
   clang libclang-rt-dev                             # fuzzing and sanitizer builds (libFuzzer, ASan, UBSan)
+  clang-format python3-mypy                         # the format check and the Python stubs' type check (tests)
   linuxcnc-uspace linuxcnc-uspace-dev               # the LinuxCNC kinematics module and its tests (LinuxCNC 2.9)
   python3-pytest                                    # the tests that drive LinuxCNC and the Python package (Debian's python3)
   pybind11-dev python3-pybind11 python3-dev python3-numpy  # the Python package (bindings/python)

@@ -150,4 +150,7 @@ Command make_identify_command(CLI::App& root);
 Command make_linuxcnc_command(CLI::App& root);
 Command make_mjcf_command(CLI::App& root);
 
+/// Registers every subcommand on the root app, in the order --help lists them.
+std::vector<Command> add_commands(CLI::App& app);
+
 }  // namespace hexatwist::cli

@@ -31,7 +31,8 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
   const Strategy strategy = o.strategy == "conventional" ? Strategy::Conventional : Strategy::Compensated;
   const LimitSpec& lim = model.spec().limits;
   const double home_z = model.spec().home_height;
-  const Vector6d home_motor = model.length_home() - model.geometry().length_offset;
+  // The drives' reference: the joints read these after homing (home_commands, theory §4).
+  const Vector6d home_motor = model.home_command();
 
   std::string kins = "hexatwistkins";
   if (!o.model.config.empty()) kins += " config=" + std::filesystem::absolute(o.model.config).string();

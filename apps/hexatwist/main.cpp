@@ -35,10 +35,7 @@ int main(int argc, char** argv) {
       "the data do not determine the parameters."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
-  const std::vector<Command> commands{make_study_command(app),  make_simulate_command(app), make_dynamics_command(app),
-                                      make_synth_command(app),  make_measure_command(app),  make_identify_command(app),
-                                      make_stream_command(app), make_ik_command(app),       make_fk_command(app),
-                                      make_config_command(app), make_linuxcnc_command(app), make_mjcf_command(app)};
+  const std::vector<Command> commands = add_commands(app);
   // Help and version go to standard output like every result: a failed write is exit 4.
   const auto print_and_check = [&](const CLI::Error& e) {
     const int code = app.exit(e);

@@ -1,16 +1,10 @@
-// Umbrella header: the whole hexatwist library.
+// Umbrella header: the whole hexatwist library, in the order its subsystems depend on each other.
 #pragma once
 
-#include "hexatwist/calibration/identification.hpp"
-#include "hexatwist/calibration/measurement.hpp"
-#include "hexatwist/calibration/parameter_errors.hpp"
-#include "hexatwist/calibration/registration.hpp"
-#include "hexatwist/calibration/synthesis.hpp"
-#include "hexatwist/dynamics/dynamics.hpp"
-#include "hexatwist/dynamics/motor_sizing.hpp"
 #include "hexatwist/error.hpp"
-#include "hexatwist/io/config.hpp"
-#include "hexatwist/io/mjcf.hpp"
+#include "hexatwist/status.hpp"
+#include "hexatwist/types.hpp"
+
 #include "hexatwist/kinematics/compensation.hpp"
 #include "hexatwist/kinematics/forward.hpp"
 #include "hexatwist/kinematics/kinematics.hpp"
@@ -20,10 +14,23 @@
 #include "hexatwist/kinematics/stream.hpp"
 #include "hexatwist/kinematics/twist.hpp"
 #include "hexatwist/kinematics/workspace.hpp"
-#include "hexatwist/simulation/rig.hpp"
+
+#include "hexatwist/motion/trajectory.hpp"
+
+#include "hexatwist/dynamics/dynamics.hpp"
+#include "hexatwist/dynamics/mechanism.hpp"
+#include "hexatwist/dynamics/motor_sizing.hpp"
+#include "hexatwist/dynamics/rig.hpp"
+
 #include "hexatwist/simulation/servo.hpp"
 #include "hexatwist/simulation/simulation.hpp"
 #include "hexatwist/simulation/study.hpp"
-#include "hexatwist/simulation/trajectory.hpp"
-#include "hexatwist/status.hpp"
-#include "hexatwist/types.hpp"
+
+#include "hexatwist/calibration/identification.hpp"
+#include "hexatwist/calibration/measurement.hpp"
+#include "hexatwist/calibration/parameter_errors.hpp"
+#include "hexatwist/calibration/registration.hpp"
+#include "hexatwist/calibration/synthesis.hpp"
+
+#include "hexatwist/io/config.hpp"
+#include "hexatwist/io/mjcf.hpp"

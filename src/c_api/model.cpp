@@ -79,9 +79,15 @@ void hexatwist_model_home_lengths(const hexatwist_model* model, double geometric
                                   double motor[HEXATWIST_LEGS]) {
   if (model == nullptr) return;
   const Model& m = model->model;
-  // At home the twist is zero by definition: motor-side = geometric - offset (theory §4).
+  // At home the twist is zero by definition: motor-side = geometric - offset, through the drives'
+  // reference and scale (theory §4).
   if (geometric != nullptr) c_api::from_vector(m.length_home(), geometric);
-  if (motor != nullptr) c_api::from_vector(m.length_home() - m.geometry().length_offset, motor);
+  if (motor != nullptr) c_api::from_vector(m.motor_from_travel(m.length_home() - m.geometry().length_offset), motor);
+}
+
+void hexatwist_model_home_commands(const hexatwist_model* model, double motor[HEXATWIST_LEGS]) {
+  if (model == nullptr || motor == nullptr) return;
+  c_api::from_vector(model->model.home_command(), motor);
 }
 
 void hexatwist_model_stroke(const hexatwist_model* model, double* length_min, double* length_max) {

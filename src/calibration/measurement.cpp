@@ -14,7 +14,7 @@
 #include "hexatwist/error.hpp"
 #include "hexatwist/kinematics/compensation.hpp"
 #include "hexatwist/kinematics/forward.hpp"
-#include "io/csv.hpp"
+#include "motion/csv.hpp"
 
 namespace hexatwist {
 namespace {

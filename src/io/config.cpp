@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <initializer_list>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <vector>
@@ -196,6 +197,8 @@ class Reader {
 
 struct Screw {
   double lead = 0.0;
+  double drive_lead = std::numeric_limits<double>::quiet_NaN();  // NaN: the lead (no drive scale)
+  Loc drive_lead_at;
   ThreadSense thread = ThreadSense::Right;
   DrivenSide driven = DrivenSide::Base;
   bool thread_given = false;  // thread / driven_side were written (here or in `screw`)
@@ -214,6 +217,13 @@ Screw read_screw(const Reader& r, const Field& n, Screw s, bool top) {
     s.lead = r.number(lead, "screw travel per revolution [m], >= 0; 0 = no twist");
     if (s.lead < 0.0) r.fail(lead.at(), lead.path, fmt::format("expected >= 0 m, got {}", s.lead));
     s.lead_at = loc(lead);
+    s.drive_lead = std::numeric_limits<double>::quiet_NaN();  // a leg's own lead has its own drive lead
+  }
+  // The lead the drive converts lengths with (an identification's contract, theory §4).
+  if (const Field drive = Reader::child(n, "drive_lead"); drive.present()) {
+    s.drive_lead = r.number(drive, "lead the drive converts lengths to motor angles with [m], > 0");
+    if (!(s.drive_lead > 0.0)) r.fail(drive.at(), drive.path, fmt::format("expected > 0 m, got {}", s.drive_lead));
+    s.drive_lead_at = loc(drive);
   }
   const bool need_sense = top && s.lead > 0.0;
   const Field thread = Reader::child(n, "thread");
@@ -290,7 +300,7 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
         fmt::format("{}: expected a mapping with 'symmetric' or 'legs', 'screw' and 'limits' at top level, got {}",
                     r.where(root.Mark()), kind(root)));
   const Field top{root, "", root.Mark()};
-  r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "length_offsets", "limits",
+  r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "length_offsets", "home_commands", "limits",
                     "observation_point", "pivot", "servo", "load", "simulation", "study", "mechanism"});
 
   ModelSpec spec;
@@ -301,7 +311,7 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
 
   const Field screw_f = Reader::child(top, "screw");
   r.require_map(screw_f, "lead, thread, driven_side");
-  r.only_keys(screw_f, {"lead", "thread", "driven_side"});
+  r.only_keys(screw_f, {"lead", "thread", "driven_side", "drive_lead"});
   const Screw screw = read_screw(r, screw_f, Screw{}, true);
 
   const Field sym = Reader::child(top, "symmetric");
@@ -349,9 +359,13 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
       leg.lead = screw.lead;
       leg.thread = screw.thread;
       leg.driven = screw.driven;
+      leg.drive_lead = screw.drive_lead;
     }
     // A leg's lead is the screw block's: its errors point at screw.lead.
-    for (int i = 0; i < kLegs; ++i) locs[fmt::format("leg {}: lead", i + 1)] = screw.lead_at;
+    for (int i = 0; i < kLegs; ++i) {
+      locs[fmt::format("leg {}: lead", i + 1)] = screw.lead_at;
+      locs[fmt::format("leg {}: drive_lead", i + 1)] = screw.drive_lead_at;
+    }
     // The legs are derived from the whole block: their errors point at it.
     locs["legs"] = Loc{"symmetric", sym.key};
     locs["home_height"] = loc(Reader::child(sym, "H"));
@@ -370,7 +384,7 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
       if (!n.node.IsMap())
         r.fail(n.at(), n.path,
                fmt::format("expected a mapping with base, platform, base_axis, platform_axis, got {}", kind(n.node)));
-      r.only_keys(n, {"base", "platform", "base_axis", "platform_axis", "lead", "thread", "driven_side"});
+      r.only_keys(n, {"base", "platform", "base_axis", "platform_axis", "lead", "thread", "driven_side", "drive_lead"});
       const std::string who = fmt::format("leg {}", i + 1);
       locs[who] = Loc{n.path, n.key};
       LegSpec& leg = spec.legs[static_cast<std::size_t>(i)];
@@ -384,7 +398,9 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
       leg.lead = ls.lead;
       leg.thread = ls.thread;
       leg.driven = ls.driven;
+      leg.drive_lead = ls.drive_lead;
       locs[who + ": lead"] = ls.lead_at;
+      locs[who + ": drive_lead"] = ls.drive_lead_at;
       const bool need_axes = leg.lead > 0.0;
       const Field base_axis = Reader::child(n, "base_axis");
       if (need_axes || base_axis.present()) {
@@ -418,6 +434,21 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
       const Field f = Reader::item(offsets, static_cast<std::size_t>(i), fmt::format("{}[{}]", offsets.path, i));
       spec.legs[static_cast<std::size_t>(i)].length_offset = r.number(f, kWhat);
       locs[fmt::format("leg {}: length_offset", i + 1)] = loc(f);
+    }
+  }
+
+  // The drives' reference (an identification's contract, theory §4), one list for either layout.
+  if (const Field homes = Reader::child(top, "home_commands"); homes.present()) {
+    constexpr const char* kWhat = "motor-side length each drive reads at its reference (homing), legs 1..6 [m]";
+    if (!homes.node.IsSequence() || homes.node.size() != kLegs)
+      r.fail(homes.at(), homes.path,
+             fmt::format("expected a list of 6 numbers ({}), got {}", kWhat,
+                         homes.node.IsSequence() ? fmt::format("{} numbers", homes.node.size())
+                                                 : std::string(kind(homes.node))));
+    for (int i = 0; i < kLegs; ++i) {
+      const Field f = Reader::item(homes, static_cast<std::size_t>(i), fmt::format("{}[{}]", homes.path, i));
+      spec.legs[static_cast<std::size_t>(i)].home_command = r.number(f, kWhat);
+      locs[fmt::format("leg {}: home_command", i + 1)] = loc(f);
     }
   }
 
@@ -577,7 +608,8 @@ std::string locate(const Reader& r, const Locations& locs, std::string_view sour
   std::string sub;
   const bool leg_field = field.starts_with("leg ");
   if (leg_field)
-    for (const char* s : {"base_axis", "platform_axis", "base", "platform", "lead", "length_offset"}) {
+    for (const char* s :
+         {"base_axis", "platform_axis", "base", "platform", "lead", "length_offset", "drive_lead", "home_command"}) {
       const std::size_t n = std::strlen(s);
       if (what.starts_with(s) && what.substr(n).starts_with(": ")) {
         sub = s;

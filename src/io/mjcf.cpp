@@ -20,7 +20,7 @@ constexpr double kTinyMass = 1e-6;        // [kg]
 constexpr double kTinyInertia = 1e-9;     // [kg m^2]
 constexpr double kLoadShare = 1.0 / 7.0;  // of the load, in the platform body and in each rod end
 // Solver settings (docs/theory.md §15: the step and the constraints' stiffness were chosen by
-// the study of bench/bench_dynamics.cpp and the residuals of tests/test_mjcf.cpp).
+// the study of bench/bench_dynamics.cpp and the residuals of tests/io/test_mjcf.cpp).
 constexpr double kTimestep = 4e-4;      // [s]
 constexpr double kTimeConstant = 8e-4;  // equality constraints' time constant, 2 timesteps [s]
 

@@ -35,7 +35,11 @@ Status compute_commands(const Model& model, const Pose& pose, CommandReport& out
   out.conventional = out.legs.length - model.geometry().length_offset;
   out.compensated = out.conventional - out.length_error;
   if (pose_status != Status::Ok) return pose_status;
-  return check_stroke(model, out.compensated, out.limit);
+  // The stroke is the nut's travel; the drives' commands follow from it (theory §4).
+  const Status stroke = check_stroke(model, out.compensated, out.limit);
+  out.conventional = model.motor_from_travel(out.conventional);
+  out.compensated = model.motor_from_travel(out.compensated);
+  return stroke;
 }
 
 namespace {
@@ -108,6 +112,7 @@ Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, V
   const bool compensated = strategy == Strategy::Compensated && model.has_twist();
   if (commands_in_lanes(model, pose, compensated, command)) {
     report = LimitReport{};
+    command = model.motor_from_travel(command);  // the drives' reference and scale (theory §4)
     return Status::Ok;
   }
   // Some test failed: the same computation through a LegState, which names the leg and limit.
@@ -118,14 +123,14 @@ Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, V
   if (const Status s = check_limits(model, legs, report); s != Status::Ok) return s;
   const Vector6d& offset = model.geometry().length_offset;
   if (!compensated) {
-    command = legs.length - offset;
+    command = model.motor_from_travel(legs.length - offset);
     return Status::Ok;
   }
   Vector6d dtheta;
   if (const Status s = twist(model, legs, dtheta); s != Status::Ok) return fail(report, s);
   Vector6d compensated_command = legs.length - offset - model.geometry().twist_gain.cwiseProduct(dtheta);  // Eq. (12)
   if (const Status s = check_stroke(model, compensated_command, report); s != Status::Ok) return s;
-  command = compensated_command;
+  command = model.motor_from_travel(compensated_command);
   return Status::Ok;
 }
 

@@ -4,7 +4,7 @@
 // vector extensions with bitwise blends, for any lane count: two or four doubles for a few
 // angles, the machine's widest vector for the legs (src/kinematics/lanes.hpp). Both use exact range reduction followed
 // by a Taylor series (sin, cos) or its Pade approximant (atan), truncated where the error is
-// below 1e-17; tests/test_kernels.cpp checks them against libm.
+// below 1e-17; tests/kinematics/test_kernels.cpp checks them against libm.
 #pragma once
 
 #include <cmath>

@@ -110,12 +110,16 @@ Status length_jacobian(const Model& model, const LegState& legs, LengthKind kind
 
 Status fk_residual(const Model& model, const Placement& x, const Vector6d& lengths, LengthKind kind, LegState& legs,
                    Vector6d& f, Matrix6d* J) noexcept {
-  if (const Status s = residual(model, x, lengths, kind, legs, f); s != Status::Ok) return s;
+  const Vector6d target = kind == LengthKind::Motor ? model.travel_from_motor(lengths) : lengths;
+  if (const Status s = residual(model, x, target, kind, legs, f); s != Status::Ok) return s;
   return J != nullptr ? length_jacobian(model, legs, kind, *J) : Status::Ok;
 }
 
-Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKind kind, const Placement& guess,
-                          FkResult& out, const FkOptions& options) noexcept {
+Status forward_kinematics(const Model& model, const Vector6d& motor_or_geometric, LengthKind kind,
+                          const Placement& guess, FkResult& out, const FkOptions& options) noexcept {
+  // Motor-side lengths as the nut's travel (the drives' reference and scale, theory §4): the
+  // equations below are in it.
+  const Vector6d lengths = kind == LengthKind::Motor ? model.travel_from_motor(motor_or_geometric) : motor_or_geometric;
   out.iterations = 0;
   out.residual = INFINITY;
   out.placement = guess;

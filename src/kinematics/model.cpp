@@ -42,7 +42,18 @@ Vector3d unit_axis(const Vector3d& axis, const std::string& what) {
 
 }  // namespace
 
+// A drive scale further from 1 than this is not a lead error but a wrong drive_lead (a typing error).
+constexpr double kMaxDriveScaleError = 0.5;
+
 Model::Model(const ModelSpec& spec) : spec_(spec) {
+  check_limits_spec();
+  for (int i = 0; i < kLegs; ++i) build_leg(i);
+  lay_out_geometry();
+  check_home_and_reference();
+}
+
+void Model::check_limits_spec() {
+  const ModelSpec& spec = spec_;
   const LimitSpec& lim = spec.limits;
   require_finite(spec.home_height, "home_height");
   if (spec.home_height <= 0.0) fail(fmt::format("home_height: expected > 0 m, got {}", spec.home_height));
@@ -72,83 +83,109 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
   length_min_accepted_ = accepted_min(lim.length_min);
   length_max_accepted_ = accepted_max(lim.length_max);
   condition_max_accepted_ = accepted_max(lim.jacobian_condition_max);
-  const Vector3d home_B(0.0, 0.0, spec.home_height);
-  pivot_home_B_ = home_B + spec.pivot_P;
+  pivot_home_B_ = Vector3d(0.0, 0.0, spec.home_height) + spec.pivot_P;
+}
 
-  for (int i = 0; i < kLegs; ++i) {
-    const LegSpec& ls = spec.legs[static_cast<std::size_t>(i)];
-    Leg& leg = legs_[static_cast<std::size_t>(i)];
-    const std::string who = fmt::format("leg {}", i + 1);
-    require_finite(ls.base_B, who + ": base");
-    require_finite(ls.platform_P, who + ": platform");
-    require_finite(ls.lead, who + ": lead");
-    if (ls.lead < 0.0) fail(fmt::format("{}: lead: expected >= 0 m, got {}", who, ls.lead));
-    // A screw turns at least once over its stroke: a longer lead (1e30 m) is a typing error.
-    if (!(ls.lead <= lim.length_max - lim.length_min))
-      fail(fmt::format("{}: lead: expected at most the stroke ({} m), got {} m", who, lim.length_max - lim.length_min,
-                       ls.lead));
+void Model::build_leg(int i) {
+  const LimitSpec& lim = spec_.limits;
+  const LegSpec& ls = spec_.legs[static_cast<std::size_t>(i)];
+  Leg& leg = legs_[static_cast<std::size_t>(i)];
+  const std::string who = fmt::format("leg {}", i + 1);
+  const double stroke = lim.length_max - lim.length_min;
+  require_finite(ls.base_B, who + ": base");
+  require_finite(ls.platform_P, who + ": platform");
+  require_finite(ls.lead, who + ": lead");
+  if (ls.lead < 0.0) fail(fmt::format("{}: lead: expected >= 0 m, got {}", who, ls.lead));
+  // A screw turns at least once over its stroke: a longer lead (1e30 m) is a typing error.
+  if (!(ls.lead <= stroke))
+    fail(fmt::format("{}: lead: expected at most the stroke ({} m), got {} m", who, stroke, ls.lead));
 
-    leg.base_B = ls.base_B;
-    leg.platform_P = ls.platform_P;
-    leg.arm_P = ls.platform_P - spec.pivot_P;
-    const Vector3d L0 = home_B + ls.platform_P - ls.base_B;
-    leg.length_home = L0.norm();
-    if (!(leg.length_home > 0.0)) fail(fmt::format("{}: base and platform joints coincide at home", who));
-    leg.s_home_B = L0 / leg.length_home;
-    if (leg.length_home < length_min_accepted_ || leg.length_home > length_max_accepted_)
-      fail(fmt::format("{}: home length {:.6f} m is outside the stroke [{}, {}] m", who, leg.length_home,
-                       lim.length_min, lim.length_max));
+  leg.base_B = ls.base_B;
+  leg.platform_P = ls.platform_P;
+  leg.arm_P = ls.platform_P - spec_.pivot_P;
+  const Vector3d L0 = Vector3d(0.0, 0.0, spec_.home_height) + ls.platform_P - ls.base_B;
+  leg.length_home = L0.norm();
+  if (!(leg.length_home > 0.0)) fail(fmt::format("{}: base and platform joints coincide at home", who));
+  leg.s_home_B = L0 / leg.length_home;
+  if (leg.length_home < length_min_accepted_ || leg.length_home > length_max_accepted_)
+    fail(fmt::format("{}: home length {:.6f} m is outside the stroke [{}, {}] m", who, leg.length_home, lim.length_min,
+                     lim.length_max));
 
-    // An offset is a zero error of the motor-side length: one as long as the stroke is not.
-    require_finite(ls.length_offset, who + ": length_offset");
-    if (!(std::abs(ls.length_offset) < lim.length_max - lim.length_min))
-      fail(fmt::format("{}: length_offset: expected less than the stroke ({} m) in magnitude, got {} m", who,
-                       lim.length_max - lim.length_min, ls.length_offset));
-    leg.length_offset = ls.length_offset;
-    // The motor must reach home: its command there, real length minus offset, inside the stroke.
-    if (const double command = leg.length_home - ls.length_offset;
-        command < length_min_accepted_ || command > length_max_accepted_)
-      fail(fmt::format("{}: length_offset: {} m puts the home command {:.6f} m outside the stroke [{}, {}] m", who,
-                       ls.length_offset, command, lim.length_min, lim.length_max));
+  // An offset is a zero error of the motor-side length: one as long as the stroke is not.
+  require_finite(ls.length_offset, who + ": length_offset");
+  if (!(std::abs(ls.length_offset) < stroke))
+    fail(fmt::format("{}: length_offset: expected less than the stroke ({} m) in magnitude, got {} m", who, stroke,
+                     ls.length_offset));
+  leg.length_offset = ls.length_offset;
+  // The motor must reach home: its command there, real length minus offset, inside the stroke.
+  if (const double command = leg.length_home - ls.length_offset;
+      command < length_min_accepted_ || command > length_max_accepted_)
+    fail(fmt::format("{}: length_offset: {} m puts the home command {:.6f} m outside the stroke [{}, {}] m", who,
+                     ls.length_offset, command, lim.length_min, lim.length_max));
 
-    leg.lead = ls.lead;
-    leg.thread = ls.thread;
-    leg.driven = ls.driven;
-    // docs/theory.md §4: real = motor-side + lead*dtheta/2pi for a right-hand thread, whichever end
-    // is driven (swapping the screw and nut between housing and rod negates both the relative
-    // rotation and the axial sense); a left-hand thread negates it.
-    leg.twist_sign = ls.thread == ThreadSense::Right ? 1.0 : -1.0;
-    leg.twist_gain = leg.twist_sign * ls.lead / (2.0 * kPi);
-    length_home_[i] = leg.length_home;
+  leg.lead = ls.lead;
+  leg.thread = ls.thread;
+  leg.driven = ls.driven;
+  // docs/theory.md §4: real = motor-side + lead*dtheta/2pi for a right-hand thread, whichever end
+  // is driven (swapping the screw and nut between housing and rod negates both the relative
+  // rotation and the axial sense); a left-hand thread negates it.
+  leg.twist_sign = ls.thread == ThreadSense::Right ? 1.0 : -1.0;
+  leg.twist_gain = leg.twist_sign * ls.lead / (2.0 * kPi);
+  length_home_[i] = leg.length_home;
 
-    // Axes are needed for the twist (lead > 0). With lead 0 they may be omitted (all zero).
-    const bool axes_given = !ls.axis_base_B.isZero(0.0) || !ls.axis_platform_P.isZero(0.0);
-    if (ls.lead > 0.0 || axes_given) {
-      leg.axis_base_B = unit_axis(ls.axis_base_B, who + ": base_axis");
-      leg.axis_platform_P = unit_axis(ls.axis_platform_P, who + ": platform_axis");
-      const double ab = detail::line_axis_angle(leg.s_home_B, leg.axis_base_B);
-      const double ap = detail::line_axis_angle(leg.s_home_B, leg.axis_platform_P);
-      constexpr const char* kTooClose =
-          "{}: {}: {:.3g} deg from the leg's home direction, inside the singularity margin {:.3g} deg "
-          "(the U-joint is singular at home)";
-      if (ab < lim.singularity_margin)
-        fail(fmt::format(kTooClose, who, "base_axis", rad2deg(ab), rad2deg(lim.singularity_margin)));
-      if (ap < lim.singularity_margin)
-        fail(fmt::format(kTooClose, who, "platform_axis", rad2deg(ap), rad2deg(lim.singularity_margin)));
-      const auto xy = detail::twist_xy(leg.s_home_B, leg.axis_base_B, leg.axis_platform_P);
-      leg.theta_home = std::atan2(xy.y, xy.x);
-      leg.cos_theta_home = std::cos(leg.theta_home);
-      leg.sin_theta_home = std::sin(leg.theta_home);
-      has_twist_ = has_twist_ || ls.lead > 0.0;
-    } else {
-      leg.axis_base_B.setZero();
-      leg.axis_platform_P.setZero();
-      leg.theta_home = std::nan("");
-      leg.cos_theta_home = 1.0;
-      leg.sin_theta_home = 0.0;
-    }
+  // The drive's reference and scale (theory §4): commands m and nut travel u = h + s (m - h).
+  leg.drive_scale = 1.0;
+  if (!std::isnan(ls.drive_lead)) {
+    require_finite(ls.drive_lead, who + ": drive_lead");
+    if (!(ls.lead > 0.0))
+      fail(fmt::format("{}: drive_lead: a drive scale needs the real lead; lead is {} m", who, ls.lead));
+    if (!(ls.drive_lead > 0.0)) fail(fmt::format("{}: drive_lead: expected > 0 m, got {} m", who, ls.drive_lead));
+    leg.drive_scale = ls.lead / ls.drive_lead;
+    if (!(std::abs(leg.drive_scale - 1.0) <= kMaxDriveScaleError))
+      fail(
+          fmt::format("{}: drive_lead: {} m is {:.3g} times the lead {} m; expected within {:g} % of it (a lead "
+                      "error, not another screw)",
+                      who, ls.drive_lead, 1.0 / leg.drive_scale, ls.lead, 100 * kMaxDriveScaleError));
   }
+  leg.home_command = leg.length_home - ls.length_offset;
+  if (!std::isnan(ls.home_command)) {
+    require_finite(ls.home_command, who + ": home_command");
+    if (ls.home_command < length_min_accepted_ || ls.home_command > length_max_accepted_)
+      fail(fmt::format("{}: home_command: {} m is outside the stroke [{}, {}] m", who, ls.home_command, lim.length_min,
+                       lim.length_max));
+    leg.home_command = ls.home_command;
+  }
+  has_drive_scale_ = has_drive_scale_ || leg.drive_scale != 1.0;
 
+  // Axes are needed for the twist (lead > 0). With lead 0 they may be omitted (all zero).
+  const bool axes_given = !ls.axis_base_B.isZero(0.0) || !ls.axis_platform_P.isZero(0.0);
+  if (ls.lead > 0.0 || axes_given) {
+    leg.axis_base_B = unit_axis(ls.axis_base_B, who + ": base_axis");
+    leg.axis_platform_P = unit_axis(ls.axis_platform_P, who + ": platform_axis");
+    const double ab = detail::line_axis_angle(leg.s_home_B, leg.axis_base_B);
+    const double ap = detail::line_axis_angle(leg.s_home_B, leg.axis_platform_P);
+    constexpr const char* kTooClose =
+        "{}: {}: {:.3g} deg from the leg's home direction, inside the singularity margin {:.3g} deg "
+        "(the U-joint is singular at home)";
+    if (ab < lim.singularity_margin)
+      fail(fmt::format(kTooClose, who, "base_axis", rad2deg(ab), rad2deg(lim.singularity_margin)));
+    if (ap < lim.singularity_margin)
+      fail(fmt::format(kTooClose, who, "platform_axis", rad2deg(ap), rad2deg(lim.singularity_margin)));
+    const auto xy = detail::twist_xy(leg.s_home_B, leg.axis_base_B, leg.axis_platform_P);
+    leg.theta_home = std::atan2(xy.y, xy.x);
+    leg.cos_theta_home = std::cos(leg.theta_home);
+    leg.sin_theta_home = std::sin(leg.theta_home);
+    has_twist_ = has_twist_ || ls.lead > 0.0;
+  } else {
+    leg.axis_base_B.setZero();
+    leg.axis_platform_P.setZero();
+    leg.theta_home = std::nan("");
+    leg.cos_theta_home = 1.0;
+    leg.sin_theta_home = 0.0;
+  }
+}
+
+void Model::lay_out_geometry() {
   for (int i = 0; i < kLegs; ++i) {
     const Leg& leg = legs_[static_cast<std::size_t>(i)];
     const bool axes = !std::isnan(leg.theta_home);
@@ -162,6 +199,8 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
     geometry_.twist_gain[i] = leg.twist_gain;
     geometry_.length_offset[i] = leg.length_offset;
     geometry_.has_axes[i] = axes ? 1.0 : 0.0;
+    geometry_.drive_scale[i] = leg.drive_scale;
+    geometry_.home_command[i] = leg.home_command;
     condition_length_ = std::max(i == 0 ? 0.0 : condition_length_, leg.arm_P.norm());
   }
   if (!(condition_length_ > 0.0))
@@ -184,7 +223,9 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
     lanes.twist_gain_bound[lane] = lane < kLegs ? std::abs(geometry_.twist_gain[i]) * geometry_.has_axes[i] : 0.0;
     lanes.arm_ratio[lane] = geometry_.arm_P.row(i).norm() / condition_length_;
   }
+}
 
+void Model::check_home_and_reference() {
   // The six legs must hold the platform: the length Jacobian at home must be well conditioned.
   Matrix6d J;
   for (int i = 0; i < kLegs; ++i) {
@@ -204,7 +245,7 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
     fail(
         fmt::format("limits.jacobian_condition_max: the Jacobian's condition number at home is {:.4g}, above the "
                     "limit {:.4g}",
-                    condition, lim.jacobian_condition_max));
+                    condition, spec_.limits.jacobian_condition_max));
   // The cheap condition proof's reference: the scaled Jacobian's inverse at home (left at zero,
   // with an infinite norm, where home has no regular Jacobian: every proof then fails).
   Matrix6d J_home = Matrix6d::Zero();

@@ -23,11 +23,12 @@ Status fail(SimulationIssue& issue, Status status, std::size_t index, const Traj
   return status;
 }
 
-// The leg lengths forward kinematics of the plant takes for motor-side lengths `motor`: these
-// themselves when the plant twists (LengthKind::Motor), the real lengths (the legs' zero errors
-// added back) when it does not (LengthKind::Geometric).
-Vector6d plant_lengths(const Model& model, const Vector6d& motor, bool twist_in_plant) noexcept {
-  return twist_in_plant ? motor : Vector6d(motor + model.geometry().length_offset);
+// The leg lengths forward kinematics of the plant takes for the nuts' travel `travel` (the motor
+// angles through the real lead, theory §4): the drives' motor-side lengths when the plant twists
+// (LengthKind::Motor), the real lengths (the legs' zero errors added back) when it does not
+// (LengthKind::Geometric).
+Vector6d plant_lengths(const Model& model, const Vector6d& travel, bool twist_in_plant) noexcept {
+  return twist_in_plant ? model.motor_from_travel(travel) : Vector6d(travel + model.geometry().length_offset);
 }
 
 // The targets of a whole trajectory, computed (and checked) before the loop runs.
@@ -74,16 +75,20 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   const double T = trajectory.dt;
   const Vector6d& gain = rig.motor_gain();
   const Vector6d inv_gain = gain.cwiseInverse();
+  // The motor angles: the drives turn the commands into angles with their own lead about their
+  // reference, and the nut travels by the real lead (theory §4: u = h + s (m - h)).
+  std::vector<Vector6d> travel(n);
+  for (std::size_t k = 0; k < n; ++k) travel[k] = model.travel_from_motor(command[k]);
   std::vector<ServoReference> reference(n);
   for (std::size_t k = 0; k < n; ++k) {
     ServoReference& r = reference[k];
-    r.angle = (command[k] - model.length_home()).cwiseProduct(inv_gain);
+    r.angle = (travel[k] - model.length_home()).cwiseProduct(inv_gain);
     if (n < 2) continue;
     const std::size_t a = k == 0 ? 0 : k - 1;
     const std::size_t b = k + 1 == n ? k : k + 1;
-    r.speed = (command[b] - command[a]).cwiseProduct(inv_gain) / (T * static_cast<double>(b - a));
+    r.speed = (travel[b] - travel[a]).cwiseProduct(inv_gain) / (T * static_cast<double>(b - a));
     if (k > 0 && k + 1 < n)
-      r.acceleration = (command[k + 1] - 2.0 * command[k] + command[k - 1]).cwiseProduct(inv_gain) / (T * T);
+      r.acceleration = (travel[k + 1] - 2.0 * travel[k] + travel[k - 1]).cwiseProduct(inv_gain) / (T * T);
     for (int i = 0; i < kLegs; ++i)
       if (std::abs(r.speed[i]) > accepted_max(rig.servo().max_speed)) {
         LimitReport limit;
@@ -102,7 +107,7 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   Placement guess = placement_from_pose(trajectory.poses[0]);
   const Vector3d& obs = model.spec().observation_P;
   for (std::size_t k = 0; k < n; ++k) {
-    if (const Status s = forward_kinematics(model, plant_lengths(model, command[k], twist_in_plant), kind, guess, fk);
+    if (const Status s = forward_kinematics(model, plant_lengths(model, travel[k], twist_in_plant), kind, guess, fk);
         s != Status::Ok)
       return fail(issue, s, k, trajectory);
     guess = fk.placement;
@@ -186,8 +191,8 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
     out.desired = trajectory.poses[k].to_vector();
     out.actual = pose_from_placement(fk.placement).to_vector();
     out.command = plan.command[k];
-    out.encoder = model.length_home() + gain.cwiseProduct(measured);
-    out.motor = motor;
+    out.encoder = model.motor_from_travel(model.length_home() + gain.cwiseProduct(measured));
+    out.motor = model.motor_from_travel(motor);
     out.length = fk.legs.length;
     if (twist_continued(model, fk.legs, twist_ref, twist_now) == Status::Ok) twist_ref = twist_now;
     out.twist = twist_ref;

@@ -136,6 +136,10 @@ double hexatwist_model_home_height(const hexatwist_model* model);
 void hexatwist_model_home_lengths(const hexatwist_model* model, double geometric[HEXATWIST_LEGS],
                                   double motor[HEXATWIST_LEGS]);
 
+/** Motor-side lengths the drives read at their reference, the homing position (LinuxCNC's joint
+ * HOME; the configuration's home_commands, by default the motor-side lengths at home) [m]. */
+void hexatwist_model_home_commands(const hexatwist_model* model, double motor[HEXATWIST_LEGS]);
+
 /** Stroke limits of the legs, shortest and longest [m] (either pointer may be NULL). */
 void hexatwist_model_stroke(const hexatwist_model* model, double* length_min, double* length_max);
 

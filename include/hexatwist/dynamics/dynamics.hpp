@@ -2,8 +2,8 @@
 // wrench, and both mapped to leg space through the (motor-side) length Jacobian (docs/theory.md §9).
 #pragma once
 
+#include "hexatwist/dynamics/rig.hpp"
 #include "hexatwist/kinematics/forward.hpp"
-#include "hexatwist/simulation/rig.hpp"
 
 namespace hexatwist {
 

@@ -9,8 +9,8 @@
 // noexcept and allocation-free.
 #pragma once
 
+#include "hexatwist/dynamics/rig.hpp"
 #include "hexatwist/kinematics/forward.hpp"
-#include "hexatwist/simulation/rig.hpp"
 
 namespace hexatwist {
 

@@ -11,7 +11,7 @@
 
 #include "hexatwist/dynamics/mechanism.hpp"
 #include "hexatwist/kinematics/limits.hpp"
-#include "hexatwist/simulation/trajectory.hpp"
+#include "hexatwist/motion/trajectory.hpp"
 
 namespace hexatwist {
 

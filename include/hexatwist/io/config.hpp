@@ -4,7 +4,7 @@
 #include <string>
 #include <string_view>
 
-#include "hexatwist/simulation/rig.hpp"
+#include "hexatwist/dynamics/rig.hpp"
 #include "hexatwist/simulation/study.hpp"
 
 namespace hexatwist {

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "hexatwist/simulation/rig.hpp"
+#include "hexatwist/dynamics/rig.hpp"
 
 namespace hexatwist {
 

@@ -9,7 +9,9 @@ namespace hexatwist {
 /// What the given lengths are.
 enum class LengthKind {
   Geometric,  ///< joint-to-joint leg lengths: solve |L_i(q)| = l_i
-  Motor,      ///< motor-side lengths: solve |L_i(q)| - length_offset_i - twist_gain_i * dtheta_i(q) = m_i
+  /// motor-side lengths: solve |L_i(q)| - length_offset_i - twist_gain_i * dtheta_i(q) = u_i, u = the nut's
+  /// travel for the drives' commands m (Model::travel_from_motor; u = m without a drive scale)
+  Motor,
 };
 
 /// Newton settings.
@@ -54,7 +56,7 @@ struct FkTracker {
 
 /// Residual f(x) = g(x) - lengths, with g the geometric or motor-side lengths, and its Jacobian
 /// J_f_x for the perturbation t += dt, R = exp(dw) R. The motor-side rows include the twist's
-/// derivative.
+/// derivative; with a drive scale they are in the nut's travel (lengths mapped by travel_from_motor).
 [[nodiscard]] Status fk_residual(const Model& model, const Placement& x, const Vector6d& lengths, LengthKind kind,
                                  LegState& legs, Vector6d& f, Matrix6d* J_f_x) noexcept;
 

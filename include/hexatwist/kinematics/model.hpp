@@ -26,6 +26,14 @@ struct LegSpec {
   ThreadSense thread = ThreadSense::Right;      ///< thread hand
   DrivenSide driven = DrivenSide::Base;         ///< side whose motor turns the screw
   double length_offset = 0.0;                   ///< real minus motor-side length at zero twist (theory §4) [m]
+  /// Lead the drive converts lengths to motor angles with: the controller's counts per metre come
+  /// from it [m]. A real `lead` that differs from it scales the nut's travel by lead / drive_lead
+  /// (theory §4, "The drives' reference and scale"). NaN = `lead` (no scale); needs lead > 0.
+  double drive_lead = std::numeric_limits<double>::quiet_NaN();
+  /// Motor-side length the drive reads at its reference, the homing position: the controller's
+  /// HOME value, about which a drive scale acts [m]. NaN = the command at home, length at home
+  /// minus length_offset.
+  double home_command = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Default of LimitSpec::jacobian_condition_max (docs/theory.md §6: chosen on the seed platform).
@@ -81,6 +89,8 @@ struct Leg {
   ThreadSense thread;        ///< thread hand
   DrivenSide driven;         ///< driven side
   double length_offset;      ///< real minus motor-side length at zero twist [m]
+  double drive_scale;        ///< real nut travel per commanded motor-side length, lead / drive_lead [-]
+  double home_command;       ///< motor-side length the drive reads at its reference (homing) [m]
 };
 
 /// The same numbers in the layout of the library's vectorised kernels: eight lanes per quantity
@@ -116,6 +126,8 @@ struct LegGeometry {
   Vector6d twist_gain;         ///< real minus motor-side length per rad of twist [m/rad]
   Vector6d length_offset;      ///< real minus motor-side length at zero twist [m]
   Vector6d has_axes;           ///< 1 for legs whose U-joint axes are given, else 0
+  Vector6d drive_scale;        ///< real nut travel per commanded motor-side length [-]
+  Vector6d home_command;       ///< motor-side length the drives read at their reference [m]
   LegLanes lanes;              ///< all of the above, padded to eight lanes
 };
 
@@ -148,6 +160,23 @@ class Model {
   bool has_twist() const noexcept { return has_twist_; }
   /// Leg lengths at home [m].
   const Vector6d& length_home() const noexcept { return length_home_; }
+  /// Motor-side lengths the drives read at their reference, the homing position (LinuxCNC's
+  /// HOME), LegSpec::home_command [m].
+  const Vector6d& home_command() const noexcept { return geometry_.home_command; }
+  /// True if a leg's drive scale differs from 1 (a real lead other than the drive's, theory §4).
+  bool has_drive_scale() const noexcept { return has_drive_scale_; }
+  /// The real nut travel as a motor-side length, u = h + s (m - h), for the drives' commanded
+  /// motor-side lengths m [m] (h = home_command, s = drive_scale; u = m without a drive scale).
+  /// The kinematics relate u to the pose: real length = u + length_offset + twist term (theory §4).
+  Vector6d travel_from_motor(const Vector6d& motor) const noexcept {
+    if (!has_drive_scale_) return motor;
+    return geometry_.home_command + geometry_.drive_scale.cwiseProduct(motor - geometry_.home_command);
+  }
+  /// The drives' motor-side lengths m = h + (u - h) / s for the travel u [m] (the inverse).
+  Vector6d motor_from_travel(const Vector6d& travel) const noexcept {
+    if (!has_drive_scale_) return travel;
+    return geometry_.home_command + (travel - geometry_.home_command).cwiseQuotient(geometry_.drive_scale);
+  }
   /// The legs one per row (the same numbers as leg(i), laid out for vectorised code).
   const LegGeometry& geometry() const noexcept { return geometry_; }
   /// cos(bend_max), precomputed for the limit check, less kLimitTolerance (a cosine of unit
@@ -167,6 +196,11 @@ class Model {
   const ConditionReference& condition_reference() const noexcept { return condition_reference_; }
 
  private:
+  void check_limits_spec();
+  void build_leg(int i);
+  void lay_out_geometry();
+  void check_home_and_reference();
+
   ModelSpec spec_;
   PerLeg<Leg> legs_;
   LegGeometry geometry_;
@@ -180,6 +214,7 @@ class Model {
   double condition_length_ = 1.0;
   ConditionReference condition_reference_;
   bool has_twist_ = false;
+  bool has_drive_scale_ = false;
 };
 
 /// Joint positions and axes of a "symmetric" platform: the seed's parameters, Eq. (6), joints in

@@ -2,7 +2,7 @@
 // feed-forward, and the drives' dynamics integrated with fixed-step RK4 (docs/theory.md §9).
 #pragma once
 
-#include "hexatwist/simulation/rig.hpp"
+#include "hexatwist/dynamics/rig.hpp"
 
 namespace hexatwist {
 

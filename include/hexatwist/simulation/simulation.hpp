@@ -6,10 +6,10 @@
 #include <functional>
 #include <vector>
 
+#include "hexatwist/dynamics/rig.hpp"
 #include "hexatwist/kinematics/compensation.hpp"
 #include "hexatwist/kinematics/forward.hpp"
-#include "hexatwist/simulation/rig.hpp"
-#include "hexatwist/simulation/trajectory.hpp"
+#include "hexatwist/motion/trajectory.hpp"
 
 namespace hexatwist {
 

@@ -1,4 +1,4 @@
-#include "hexatwist/simulation/trajectory.hpp"
+#include "hexatwist/motion/trajectory.hpp"
 
 #include <fmt/format.h>
 
@@ -9,7 +9,7 @@
 #include <string>
 
 #include "hexatwist/error.hpp"
-#include "io/csv.hpp"
+#include "motion/csv.hpp"
 
 namespace hexatwist {
 namespace {
@@ -457,6 +457,21 @@ std::vector<Pose> interpolate(const TimedPoses& samples, std::span<const double>
     poses.push_back(curve.at(tk, 0.0, i));
   }
   return poses;
+}
+
+std::string format_trajectory_csv(const Trajectory& trajectory, std::size_t every) {
+  fmt::memory_buffer b;
+  fmt::format_to(std::back_inserter(b), "t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad\n");
+  if (trajectory.poses.empty()) return fmt::to_string(b);
+  const std::size_t last = trajectory.poses.size() - 1;
+  const std::size_t step = std::max<std::size_t>(every, 1);
+  for (std::size_t k = 0;; k = std::min(k + step, last)) {
+    const Vector6d q = trajectory.poses[k].to_vector();
+    fmt::format_to(std::back_inserter(b), "{},{},{},{},{},{},{}\n", trajectory.time(k), q[0], q[1], q[2], q[3], q[4],
+                   q[5]);
+    if (k == last) break;
+  }
+  return fmt::to_string(b);
 }
 
 TimedPoses timed_poses(const Trajectory& trajectory) {

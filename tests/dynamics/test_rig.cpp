@@ -3,9 +3,9 @@
 
 #include <functional>
 
+#include "hexatwist/dynamics/rig.hpp"
 #include "hexatwist/error.hpp"
 #include "hexatwist/io/config.hpp"
-#include "hexatwist/simulation/rig.hpp"
 
 namespace hexatwist {
 namespace {

@@ -381,3 +381,64 @@ TEST(Model, SeedHomeDirectionIsTheUnitLegVector) {
 
 }  // namespace
 }  // namespace hexatwist::test
+
+namespace hexatwist::test {
+namespace {
+
+// The seed with a real lead `scale` times the drives' (theory §4) and the drives' reference at
+// `home` (NaN = the default).
+Model seed_with_drive_scale(double scale, const Vector6d& home) {
+  ModelSpec spec = seed_model().spec();
+  for (int i = 0; i < kLegs; ++i) {
+    LegSpec& leg = spec.legs[static_cast<std::size_t>(i)];
+    leg.drive_lead = leg.lead;
+    leg.lead *= scale;
+    leg.home_command = home[i];
+  }
+  return Model(spec);
+}
+
+TEST(Model, DriveReferenceDefaultsToTheHomeCommandAndMapsTravelOneToOne) {
+  const Model& seed = seed_model();
+  EXPECT_FALSE(seed.has_drive_scale());
+  EXPECT_EQ(seed.home_command(), seed.length_home() - seed.geometry().length_offset);
+  const Vector6d m = seed.length_home() + Vector6d::LinSpaced(-0.1, 0.1);
+  EXPECT_EQ(seed.travel_from_motor(m), m);  // without a scale the map is the identity, bit for bit
+  EXPECT_EQ(seed.motor_from_travel(m), m);
+}
+
+TEST(Model, DriveScaleMapsCommandsAboutTheReferenceAndBack) {
+  // u = h + s (m - h): the reference reads the same in both; a length away from it is scaled by s.
+  Vector6d home = seed_model().length_home() + Vector6d::LinSpaced(-2e-3, 3e-3);
+  const Model model = seed_with_drive_scale(1.025, home);
+  ASSERT_TRUE(model.has_drive_scale());
+  EXPECT_EQ(model.home_command(), home);
+  EXPECT_DOUBLE_EQ(model.leg(2).drive_scale, 1.025);
+  EXPECT_LE((model.travel_from_motor(home) - home).cwiseAbs().maxCoeff(), 1e-15);
+  const Vector6d m = home + Vector6d::LinSpaced(-0.2, 0.25);
+  const Vector6d u = model.travel_from_motor(m);
+  for (int i = 0; i < kLegs; ++i) EXPECT_NEAR(u[i] - home[i], 1.025 * (m[i] - home[i]), 1e-15) << "leg " << i + 1;
+  EXPECT_LE((model.motor_from_travel(u) - m).cwiseAbs().maxCoeff(), 1e-15);
+}
+
+TEST(Model, DriveScaleAndReferenceOutOfRangeAreRejectedNamingTheLeg) {
+  ModelSpec spec = seed_model().spec();
+  spec.legs[3].drive_lead = 0.0;
+  expect_rejected(spec, {"leg 4", "drive_lead", "> 0"});
+  spec.legs[3].drive_lead = kInf;
+  expect_rejected(spec, {"leg 4", "drive_lead", "finite"});
+  spec.legs[3].drive_lead = 3.0 * spec.legs[3].lead;  // a scale of 1/3: another screw, not a lead error
+  expect_rejected(spec, {"leg 4", "drive_lead", "within 50 %"});
+  spec = seed_model().spec();
+  spec.legs[1].lead = 0.0;
+  spec.legs[1].drive_lead = 0.01;
+  expect_rejected(spec, {"leg 2", "drive_lead", "needs the real lead"});
+  spec = seed_model().spec();
+  spec.legs[5].home_command = spec.limits.length_max + 1e-3;
+  expect_rejected(spec, {"leg 6", "home_command", "outside the stroke"});
+  spec.legs[5].home_command = kNaN;  // NaN is "not given"
+  EXPECT_NO_THROW(Model{spec});
+}
+
+}  // namespace
+}  // namespace hexatwist::test

@@ -73,7 +73,7 @@ TEST(Compensation, LengthErrorIsLeadTimesTwistOverTwoPiWithTheThreadHandSign) {
   const Vector6d expected = 0.010 * dtheta / (2 * kPi);  // Eq. (10), lead 10 mm
   EXPECT_LT((error_for(ThreadSense::Right, DrivenSide::Base) - expected).cwiseAbs().maxCoeff(), 1e-18);
   EXPECT_LT((error_for(ThreadSense::Left, DrivenSide::Base) + expected).cwiseAbs().maxCoeff(), 1e-18);
-  // The driven side does not change the sign (docs/theory.md §4; tests/test_model.cpp derives it).
+  // The driven side does not change the sign (docs/theory.md §4; tests/kinematics/test_model.cpp derives it).
   EXPECT_LT((error_for(ThreadSense::Right, DrivenSide::Platform) - expected).cwiseAbs().maxCoeff(), 1e-18);
   EXPECT_LT((error_for(ThreadSense::Left, DrivenSide::Platform) + expected).cwiseAbs().maxCoeff(), 1e-18);
 }
@@ -260,6 +260,44 @@ TEST(Compensation, BothCommandsTakeTheLengthOffsetsOut) {
     }
     FkResult r;
     ASSERT_EQ(forward_kinematics(offset, shifted.compensated, LengthKind::Motor, Placement{}, r), Status::Ok);
+    const PoseError e = pose_error(r.placement, placement_from_pose(p));
+    EXPECT_LT(std::max(e.position, e.rotation), 1e-11) << str(p);
+  }
+}
+
+TEST(Compensation, CommandsThroughADriveScaleMoveTheNutAsTheRealLeadDemands) {
+  // A real lead 2.5 % longer than the drives' (theory §4): the commands m are the drives' numbers,
+  // the nut travels u = h + s (m - h), and u is what the real lead's kinematics ask for. Motor-side
+  // forward kinematics of m lands on the pose.
+  std::mt19937_64 rng(kSeed + 22);
+  ModelSpec real_spec = seed_model().spec();
+  for (LegSpec& leg : real_spec.legs) leg.lead *= 1.025;
+  const Model real(real_spec);  // the nut's kinematics, commands in travel
+  ModelSpec spec = real_spec;
+  for (int i = 0; i < kLegs; ++i) {
+    spec.legs[static_cast<std::size_t>(i)].drive_lead = seed_model().leg(i).lead;
+    spec.legs[static_cast<std::size_t>(i)].home_command = real.length_home()[i] + 1e-3 * (i - 2.5);
+  }
+  const Model driven(spec);
+  for (int n = 0; n < 200; ++n) {
+    const Pose p = random_valid_pose(seed_model(), rng, 0.3, deg2rad(20));
+    CommandReport travel, drive;
+    ASSERT_EQ(compute_commands(real, p, travel), Status::Ok) << str(p);
+    ASSERT_EQ(compute_commands(driven, p, drive), Status::Ok) << str(p);
+    EXPECT_LT((driven.travel_from_motor(drive.compensated) - travel.compensated).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_LT((driven.travel_from_motor(drive.conventional) - travel.conventional).cwiseAbs().maxCoeff(), 1e-15);
+    // The scale acts about the reference: m - h = (u - h) / 1.025.
+    const Vector6d h = driven.home_command();
+    for (int i = 0; i < kLegs; ++i)
+      EXPECT_NEAR(drive.compensated[i] - h[i], (travel.compensated[i] - h[i]) / 1.025, 1e-15) << "leg " << i + 1;
+    for (const Strategy strategy : {Strategy::Conventional, Strategy::Compensated}) {
+      Vector6d command;
+      LimitReport lim;
+      ASSERT_EQ(motor_commands(driven, p, strategy, command, lim), Status::Ok) << str(p);
+      EXPECT_EQ(command, strategy == Strategy::Conventional ? drive.conventional : drive.compensated);
+    }
+    FkResult r;
+    ASSERT_EQ(forward_kinematics(driven, drive.compensated, LengthKind::Motor, Placement{}, r), Status::Ok);
     const PoseError e = pose_error(r.placement, placement_from_pose(p));
     EXPECT_LT(std::max(e.position, e.rotation), 1e-11) << str(p);
   }

@@ -243,6 +243,40 @@ TEST(Config, BadLengthOffsetsAreLocated) {
   expect_error(kSymmetric + "length_offsets: [0, 0, 0, 1.5, 0, 0]\n", line, {"field 'length_offsets[3]'", "stroke"});
 }
 
+TEST(Config, DriveLeadAndHomeCommandsGiveTheDrivesScaleAndReference) {
+  // screw.drive_lead for every leg, a leg's own lead with its own drive_lead, home_commands for all.
+  std::string yaml = seed_legs_yaml();
+  yaml = replace_line(yaml, 4, line_of(yaml, 4) + "\n  drive_lead: 0.0098");
+  // Leg 3 (one line further down now): its own lead 0.0102 and drive lead 0.0100; leg 5: its own
+  // lead only, so no scale.
+  const int shift = 1;
+  yaml = replace_line(yaml, leg_line(4, kPlatformAxis) + shift,
+                      line_of(yaml, leg_line(4, kPlatformAxis) + shift) + "\n    lead: 0.011");
+  yaml = replace_line(yaml, leg_line(2, kPlatformAxis) + shift,
+                      line_of(yaml, leg_line(2, kPlatformAxis) + shift) + "\n    lead: 0.0102\n    drive_lead: 0.0100");
+  yaml += "home_commands: [1.91, 1.911, 1.912, 1.909, 1.9105, 1.9095]\n";
+  const Model m = load_model(yaml, "drive.yaml");
+  const std::array<double, kLegs> scale{0.010 / 0.0098, 0.010 / 0.0098, 0.0102 / 0.0100, 0.010 / 0.0098, 1.0,
+                                        0.010 / 0.0098};
+  for (int i = 0; i < kLegs; ++i) EXPECT_DOUBLE_EQ(m.leg(i).drive_scale, scale[static_cast<std::size_t>(i)]) << i;
+  EXPECT_EQ(m.home_command(), (Vector6d() << 1.91, 1.911, 1.912, 1.909, 1.9105, 1.9095).finished());
+  // Without them: no scale, and the reference is the command at home.
+  const Model plain = load_model(seed_legs_yaml(), "plain.yaml");
+  EXPECT_FALSE(plain.has_drive_scale());
+  EXPECT_EQ(plain.home_command(), plain.length_home());
+}
+
+TEST(Config, BadDriveLeadsAndHomeCommandsAreLocated) {
+  const int line = 17;  // appended after kSymmetric's 16 lines
+  expect_error(kSymmetric + "home_commands: [1.9, 1.9]\n", line, {"field 'home_commands'", "6 numbers", "got 2"});
+  expect_error(kSymmetric + "home_commands: [1.9, 1.9, 1.9, 1.9, 1.9, 9]\n", line,
+               {"field 'home_commands[5]'", "outside the stroke"});
+  std::string yaml = replace_line(kSymmetric, 9, line_of(kSymmetric, 9) + "\n  drive_lead: 0");
+  expect_error(yaml, 10, {"field 'screw.drive_lead'", "> 0"});
+  yaml = replace_line(kSymmetric, 9, line_of(kSymmetric, 9) + "\n  drive_lead: 0.1");
+  expect_error(yaml, 10, {"field 'screw.drive_lead'", "within 50 %"});
+}
+
 TEST(Config, ZeroLeadLegsFormNeedsNoAxesAndNoThread) {
   // A plain Stewart platform: joints only.
   std::string yaml =

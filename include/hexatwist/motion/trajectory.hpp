@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -127,6 +128,12 @@ struct TimedPoses {
 /// a wrong number of cells, a non-numeric or non-finite cell, a time not strictly increasing,
 /// fewer than 2 data rows, empty text.
 TimedPoses parse_trajectory_csv(std::string_view text, std::string_view source);
+
+/// The trajectory as CSV text that parse_trajectory_csv reads back to the same doubles: the header
+/// `t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad` (SI), then one row every `every` samples (>= 1) and
+/// the last sample, numbers in their shortest exact form. Rests stay exact (the interpolation is
+/// flat between equal samples), so a run written at a tracker's rate keeps its points at rest.
+std::string format_trajectory_csv(const Trajectory& trajectory, std::size_t every = 1);
 
 /// Resamples every `dt` [s] from t.front() to t.back() (t0 = t.front(); the last sample at, or
 /// within dt after, t.back(), holding the last pose: a last time between two ticks is not lost) with the monotone

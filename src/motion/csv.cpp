@@ -1,4 +1,4 @@
-#include "io/csv.hpp"
+#include "motion/csv.hpp"
 
 #include <fmt/format.h>
 

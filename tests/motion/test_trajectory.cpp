@@ -495,6 +495,26 @@ TEST(Trajectory, CsvInSiUnitsReadsBackExactly) {
   }
 }
 
+TEST(Trajectory, FormattedCsvReadsBackToTheSameDoublesWithTheLastSampleKept) {
+  // format_trajectory_csv is parse_trajectory_csv's inverse, every `every` samples and the last one.
+  std::mt19937_64 rng(kSeed + 207);
+  Trajectory tr;
+  tr.t0 = 0.25;
+  tr.dt = 0.001;
+  for (int k = 0; k < 23; ++k) tr.poses.push_back(random_pose(rng, 0.5, 1.0));
+  for (const std::size_t every : {std::size_t{1}, std::size_t{5}, std::size_t{22}, std::size_t{100}}) {
+    const TimedPoses back = parse_trajectory_csv(format_trajectory_csv(tr, every), "run.csv");
+    std::vector<std::size_t> rows;
+    for (std::size_t k = 0; k < tr.poses.size(); k += every) rows.push_back(k);
+    if (rows.back() != tr.poses.size() - 1) rows.push_back(tr.poses.size() - 1);
+    ASSERT_EQ(back.poses.size(), rows.size()) << "every " << every;
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      EXPECT_EQ(back.t[r], tr.time(rows[r])) << "every " << every << ", row " << r;
+      EXPECT_EQ(back.poses[r].to_vector(), tr.poses[rows[r]].to_vector()) << "every " << every << ", row " << r;
+    }
+  }
+}
+
 // parse_trajectory_csv must throw one line starting "bad.csv:<line>:<column>: column '<name>':"
 // and containing every one of `parts`.
 void expect_csv_error(const std::string& text, int line, int column, std::string_view name,

@@ -1,4 +1,4 @@
-#include "hexatwist/simulation/rig.hpp"
+#include "hexatwist/dynamics/rig.hpp"
 
 #include <fmt/format.h>
 

@@ -80,8 +80,25 @@ static void test_models(void) {
   CHECK(lo == 1.4 && hi == 2.45, "stroke %g..%g", lo, hi);
   for (int i = 0; i < 6; ++i)
     CHECK(geometric[i] > lo && geometric[i] < hi && motor[i] == geometric[i], "leg %d", i + 1);
+  double reference[6];
+  hexatwist_model_home_commands(m, reference);
+  for (int i = 0; i < 6; ++i) CHECK(reference[i] == motor[i], "leg %d: reference %g", i + 1, reference[i]);
   hexatwist_model_free(m);
   hexatwist_model_free(NULL);
+
+  /* The drives' reference and scale (an identification's contract): the reference is what the
+     configuration says, and the commands move about it by the inverse of the drive scale. */
+  m = hexatwist_model_from_yaml(
+      "symmetric: {Ra: 1.2, Rb: 1.5, da: 0.2, db: 0.3, H: 1.511}\n"
+      "screw: {lead: 0.0102, drive_lead: 0.010, thread: right, driven_side: base}\n"
+      "limits: {length_min: 1.4, length_max: 2.45}\n"
+      "home_commands: [1.911, 1.912, 1.913, 1.914, 1.915, 1.916]\n",
+      "drive.yaml", error, sizeof error);
+  CHECK(m != NULL, "drive model: %s", error);
+  hexatwist_model_home_commands(m, reference);
+  for (int i = 0; i < 6; ++i)
+    CHECK(fabs(reference[i] - (1.911 + 0.001 * i)) < 1e-15, "leg %d: %g", i + 1, reference[i]);
+  hexatwist_model_free(m);
 
   /* Errors: one line naming the file, line and field, or the path. */
   m = hexatwist_model_from_yaml("symmetric:\n  Ra: abc\n", "bad.yaml", error, sizeof error);

@@ -1,0 +1,214 @@
+// hexatwist synth: a tracker-like point log made from the simulation of a platform with known parameter
+// errors, with the truth beside it (docs/theory.md §12).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <memory>
+
+#include "cli_common.hpp"
+#include "json.hpp"
+#include "run_options.hpp"
+#include "study_report.hpp"
+
+namespace hexatwist::cli {
+namespace {
+
+struct SynthOptions {
+  RunOptions run;
+  double noise_um = 10.0;
+  double rate = 100.0;
+  std::uint64_t seed = 1;
+  double lead_error_pct = 0.0;
+  bool flip_sign = false;
+  std::string offsets_mm = "0";
+  std::string point_offset_mm = "0,0,0";
+  std::string out;
+  std::string run_out;
+};
+
+std::string truth_json(const Config& config, const SynthOptions& o, const Run& run, const SynthesisOptions& so,
+                       const SyntheticLog& log) {
+  const Model& model = config.rig.model();
+  JsonWriter j;
+  j.begin_object()
+      .field("command", "synth")
+      .field("model", model.spec().name)
+      .field("config", model_source(o.run.model))
+      .field("run", run.test.description)
+      .field("strategy", o.run.strategy)
+      .field("points", static_cast<int>(log.log.points_T.size()))
+      .field("rate", so.rate)
+      .field("seed", so.seed);
+  j.key("calibration_end");
+  std::isfinite(run.calibration_end) ? j.value(run.calibration_end) : j.null();
+  j.key("X_BT").begin_object();
+  j.key("R").begin_array();
+  for (int i = 0; i < 3; ++i) j.vector(log.X_BT.R.row(i));
+  j.end_array();
+  j.key("t").vector(log.X_BT.t);
+  j.end_object();
+  j.field("noise", so.noise);
+  j.key("errors").begin_object();
+  j.field("lead_error", so.errors.lead_error)
+      .field("lead_nominal", model.leg(0).lead)
+      .field("lead_real", model.leg(0).lead * (1.0 + so.errors.lead_error))
+      .field("flip_twist_sign", so.errors.flip_twist_sign)
+      .field("twist_sign_nominal", model.leg(0).twist_sign)
+      .field("twist_sign_real", so.errors.flip_twist_sign ? -model.leg(0).twist_sign : model.leg(0).twist_sign);
+  j.key("zero_offset").vector(so.errors.zero_offset);
+  j.key("observation_offset_P").vector(so.errors.observation_offset_P);
+  j.end_object().end_object();
+  return j.str();
+}
+
+// "0.1234, -0.5000, ..." in mm from metres.
+template <class Vec>
+std::string mm_list(const Vec& v) {
+  std::string s;
+  for (Eigen::Index i = 0; i < v.size(); ++i) s += fmt::format("{}{:.4f}", i == 0 ? "" : ", ", 1e3 * v[i]);
+  return s;
+}
+
+int run_synth(const SynthOptions& o) {
+  const Config config = load_config_from(o.run.model);
+  const Rig& rig = config.rig;
+  const Run run = build_run(config, o.run);
+  const std::string out = o.out.empty() ? fmt::format("tracker_{}.csv", run.test.name) : o.out;
+  const std::filesystem::path csv(out);
+  const std::string truth = (csv.parent_path() / (csv.stem().string() + ".truth.json")).string();
+  check_distinct_outputs({{"--out", out}, {"the truth beside --out", truth}, {"--run-out", o.run_out}});
+  // Finite but absurd values are refused too: a noise, an offset or a point error as large as the
+  // whole stroke leaves nothing in the log to measure or identify.
+  const double stroke_um = 1e6 * (rig.model().spec().limits.length_max - rig.model().spec().limits.length_min);
+  check_option(o.noise_um >= 0.0, "--noise-um", o.noise_um, "a standard deviation >= 0 [um]");
+  check_option(o.noise_um < stroke_um, "--noise-um", o.noise_um,
+               fmt::format("a standard deviation below the stroke ({:g} um, limits.length_max - limits.length_min): "
+                           "this one would drown every motion",
+                           stroke_um));
+  check_option(o.rate > 0.0, "--rate", o.rate, "a sample rate > 0 [Hz]");
+  check_option(o.lead_error_pct > -100.0 && o.lead_error_pct < 1e4, "--lead-error-pct", o.lead_error_pct,
+               "a lead error above -100 % (-100 % is a zero lead) and below 1e4 %");
+  SynthesisOptions so;
+  so.strategy = strategy_of(o.run);
+  so.noise = o.noise_um / 1e6;
+  so.rate = o.rate;
+  so.seed = o.seed;
+  so.errors.lead_error = o.lead_error_pct / 100.0;
+  so.errors.flip_twist_sign = o.flip_sign;
+  if (o.offsets_mm.find(',') == std::string::npos) {
+    const double bound = parse_numbers(o.offsets_mm, 1, "--offsets-mm", "a bound [mm], or six offsets [mm]")[0];
+    check_option(bound >= 0.0, "--offsets-mm", bound, "a bound >= 0 [mm], or six offsets [mm]");
+    check_option(bound < 1e-3 * stroke_um, "--offsets-mm", bound,
+                 fmt::format("a bound below the stroke ({:g} mm) [mm]", 1e-3 * stroke_um));
+    so.errors.zero_offset = random_zero_offsets(bound / 1e3, o.seed);
+  } else
+    for (int i = 0;
+         const double v : parse_numbers(o.offsets_mm, 6, "--offsets-mm", "a bound [mm], or six offsets [mm]")) {
+      check_option(std::abs(v) < 1e-3 * stroke_um, "--offsets-mm", v,
+                   fmt::format("offsets below the stroke ({:g} mm) in magnitude [mm]", 1e-3 * stroke_um));
+      so.errors.zero_offset[i++] = v / 1e3;
+    }
+  const std::vector<double> point = parse_numbers(o.point_offset_mm, 3, "--point-offset-mm", "x,y,z [mm]");
+  for (const double v : point)
+    check_option(std::abs(v) < 1e-3 * stroke_um, "--point-offset-mm", v,
+                 fmt::format("offsets below the stroke ({:g} mm) in magnitude [mm]", 1e-3 * stroke_um));
+  so.errors.observation_offset_P = Vector3d(point[0], point[1], point[2]) / 1e3;
+
+  SimulationIssue issue;
+  if (const Status s = check_trajectory(rig, run.test.trajectory, issue); s != Status::Ok)
+    throw ExitError(kExitOutOfLimit,
+                    fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
+                                is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+  SyntheticLog log;
+  Status synthesized = Status::Ok;
+  try {
+    synthesized = synthesize(rig, run.test.trajectory, so, log, issue);
+  } catch (const Error& e) {
+    // The options were checked above but the rate's divisibility: name the option, not the routine.
+    std::string what = e.what();
+    if (what.starts_with("rate: ")) what = fmt::format("--rate {}: {}", o.rate, what.substr(6));
+    throw ExitError(kExitBadInput, what);
+  }
+  if (const Status s = synthesized; s != Status::Ok)
+    throw ExitError(kExitOutOfLimit,
+                    fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
+                                is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+
+  // Like a tracker's export: millimetres with a unit suffix, 1 nm resolution (noise-free logs stay exact enough).
+  fmt::memory_buffer b;
+  fmt::format_to(std::back_inserter(b), "t_s,x_mm,y_mm,z_mm\n");
+  for (std::size_t k = 0; k < log.log.points_T.size(); ++k) {
+    const Vector3d p = 1e3 * log.log.points_T[k];
+    fmt::format_to(std::back_inserter(b), "{:.6f},{:.6f},{:.6f},{:.6f}\n", log.log.stamps[k], p.x(), p.y(), p.z());
+  }
+  OutputSet files;
+  files.add(out, fmt::to_string(b));
+  files.add(truth, truth_json(config, o, run, so, log));
+  if (!o.run_out.empty())
+    files.add(o.run_out,
+              format_trajectory_csv(run.test.trajectory,
+                                    static_cast<std::size_t>(std::llround(rig.simulation().control_rate / so.rate))));
+  files.commit();
+
+  const Vector3d& origin = log.X_BT.t;
+  std::string text = fmt::format("hexatwist synth on {}: {}\n", model_source(o.run.model), rig.model().spec().name);
+  text += fmt::format("run: {}, {} commands, {:.2f} s: {} points at {:g} Hz\n", run.test.description, o.run.strategy,
+                      run.test.trajectory.duration(), log.log.points_T.size(), so.rate);
+  text +=
+      fmt::format("real platform: lead {:+g}% ({:g} mm), twist sign {}, zero offsets [{}] mm, point offset [{}] mm\n",
+                  o.lead_error_pct, 1e3 * rig.model().leg(0).lead * (1.0 + so.errors.lead_error),
+                  so.errors.flip_twist_sign ? "flipped" : "as modelled", mm_list(so.errors.zero_offset),
+                  mm_list(so.errors.observation_offset_P));
+  text += fmt::format("tracker: origin ({:.3f}, {:.3f}, {:.3f}) m in the base frame, noise {:g} um per axis, seed {}\n",
+                      origin.x(), origin.y(), origin.z(), o.noise_um, o.seed);
+  text += o.run_out.empty() ? fmt::format("wrote {} and {}", out, truth)
+                            : fmt::format("wrote {}, {} and the run {}", out, truth, o.run_out);
+  if (std::isfinite(run.calibration_end))
+    text += fmt::format("; measure registers on the calibration moves, t <= {:.3f} s", run.calibration_end);
+  write_stdout_or_withdraw(text + "\n", files.paths());
+  return kExitOk;
+}
+
+}  // namespace
+
+Command make_synth_command(CLI::App& root) {
+  auto o = std::make_shared<SynthOptions>();
+  CLI::App* app = root.add_subcommand(
+      "synth",
+      "A tracker-like point log made from the closed-loop simulation: the real platform differs from the model by "
+      "known errors (lead, twist sign, zero offsets, observation point), the points are in a random tracker frame "
+      "with Gaussian noise. Writes FILE.csv (t_s,x_mm,y_mm,z_mm) and FILE.truth.json (SI: the tracker frame X_BT, the "
+      "errors, the noise) beside it, all files or none; outputs naming the same file are refused (exit 2). Input for "
+      "measure.");
+  add_run_options(*app, o->run);
+  app->add_option("--noise-um", o->noise_um, "Tracker noise, standard deviation per axis [um], >= 0")
+      ->capture_default_str();
+  app->add_option("--rate", o->rate, "Tracker samples per second [Hz], > 0; must divide the control rate")
+      ->capture_default_str();
+  app->add_option("--seed", o->seed, "Seed of the tracker's placement, the noise and random offsets")
+      ->capture_default_str();
+  app->add_option("--lead-error-pct", o->lead_error_pct,
+                  "Real lead minus nominal, in % of the nominal; above -100 (a zero lead)")
+      ->capture_default_str();
+  app->add_flag("--flip-sign", o->flip_sign, "The real twist term has the opposite sign (other thread hand)");
+  app->add_option("--offsets-mm", o->offsets_mm,
+                  "Zero-length offset of each leg's motor-side length [mm]: one number B draws each uniformly in "
+                  "[-B, B] (seeded); six comma-separated numbers give them")
+      ->capture_default_str();
+  app->add_option("--point-offset-mm", o->point_offset_mm,
+                  "Real minus modelled observation point, x,y,z [mm, platform]")
+      ->capture_default_str();
+  app->add_option("--out", o->out, "The CSV to write (default tracker_<test>.csv); the truth goes beside it");
+  app->add_option("--run-out", o->run_out,
+                  "Also write the commanded run as a trajectory CSV (t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad, at "
+                  "the tracker rate): to drive a real platform through it (e.g. a --stations run), or as --trajectory");
+  return {app, [o] { return run_synth(*o); }};
+}
+
+}  // namespace hexatwist::cli

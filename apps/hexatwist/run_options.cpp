@@ -1,0 +1,141 @@
+#include "run_options.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+namespace hexatwist::cli {
+
+Strategy strategy_of(const RunOptions& o) {
+  return o.strategy == "conventional" ? Strategy::Conventional : Strategy::Compensated;
+}
+
+Run build_run(const Config& config, const RunOptions& o) {
+  if (int{!o.test.empty()} + int{!o.trajectory.empty()} + int{o.stations > 0} != 1)
+    throw ExitError(kExitBadInput, "give one of --test NAME (Lz, Lx, Rz or Ry), --trajectory FILE.csv or --stations N");
+  Run run;
+  const double dt = config.rig.control_period();
+  if (!o.trajectory.empty()) {
+    run.test = reported_trajectory_file(o.trajectory, dt, &run.commanded);
+    return run;
+  }
+  if (o.stations > 0) {
+    StationsSpec spec;
+    spec.count = o.stations;
+    spec.seed = o.station_seed;
+    try {
+      run.test.trajectory = stations_trajectory(config.rig.model(), strategy_of(o), spec, dt);
+    } catch (const Error& e) {
+      throw ExitError(kExitOutOfLimit, fmt::format("--stations: {}", e.what()));
+    }
+    run.test.name = fmt::format("stations{}", o.stations);
+    run.test.label = fmt::format("{} stations", o.stations);
+    run.test.description =
+        fmt::format("{} random stations (seed {}), {:g} s at each", o.stations, o.station_seed, spec.dwell);
+    run.commanded = timed_poses(run.test.trajectory);
+    return run;
+  }
+  for (const StudyTest& t : seed_tests(config.study)) {
+    if (t.name != o.test) continue;
+    run.test = reported_test(t);
+    run.test.description += ", after the calibration moves";
+    run.test.trajectory = measured_test_trajectory(config.study, t, CalibrationSpec{}, dt, run.calibration_end);
+    run.commanded = timed_poses(run.test.trajectory);
+    return run;
+  }
+  throw ExitError(kExitBadInput,
+                  fmt::format("--test: unknown test '{}'; expected Lz, Lx, Rz or Ry", printable(o.test)));
+}
+
+void add_run_options(CLI::App& app, RunOptions& o) {
+  add_model_options(app, o.model);
+  auto* test = app.add_option("--test", o.test,
+                              "One of the paper's tests, Lz, Lx, Rz or Ry (the study's motion), after calibration "
+                              "moves: home, +0.2 m along x, y and z, home, 1 s at each station");
+  auto* trajectory =
+      app.add_option("--trajectory", o.trajectory, "Or a trajectory CSV file, as for simulate: t,x,y,z,roll,pitch,yaw");
+  auto* stations = app.add_option(
+      "--stations", o.stations,
+      "Or a calibration run for identify: home, N random stations (+-0.25 m, +-15 deg in every coordinate at once, "
+      "each reachable inside the limits), home; 1 s at each, straight jerk-limited moves");
+  app.add_option("--station-seed", o.station_seed, "Seed of the stations (the same seed gives the same run)")
+      ->capture_default_str();
+  test->excludes(trajectory);
+  test->excludes(stations);
+  trajectory->excludes(stations);
+  stations->check(CLI::Range(1, 10000));
+  app.add_option("--strategy", o.strategy, "The commands the platform runs: conventional or compensated")
+      ->check(CLI::IsMember({"conventional", "compensated"}))
+      ->capture_default_str();
+}
+
+void add_log_options(CLI::App& app, LogOptions& o) {
+  app.add_option("--points", o.points, "The point log (CSV with a header row)")->required();
+  app.add_option("--columns", o.columns,
+                 "Header names of the time (or index), x, y and z columns; case ignored, a unit suffix allowed "
+                 "(_s, _ms; _m, _mm)")
+      ->capture_default_str();
+  app.add_option("--units", o.units, "Length unit of x, y, z when their names carry no suffix: mm or m")
+      ->check(CLI::IsMember({"mm", "m"}));
+  app.add_flag("--index", o.index, "The time column is a sample index; give --rate");
+  app.add_option("--rate", o.rate, "Samples per second of an indexed log [Hz]");
+  app.add_option("--time-offset", o.time_offset, "The log's time (or index/rate) when the trajectory's time is 0 [s]")
+      ->capture_default_str();
+}
+
+PointLogFormat log_format(const LogOptions& o) {
+  check_option(true, "--time-offset", o.time_offset, "a time [s]");
+  PointLogFormat f;
+  std::vector<std::string> names;
+  std::size_t begin = 0;
+  for (;;) {
+    const std::size_t comma = o.columns.find(',', begin);
+    names.push_back(o.columns.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin));
+    if (comma == std::string::npos) break;
+    begin = comma + 1;
+  }
+  if (names.size() != 4 || std::find(names.begin(), names.end(), std::string()) != names.end())
+    throw ExitError(
+        kExitBadInput,
+        fmt::format("--columns: expected four column names (time or index, x, y, z), got '{}'", printable(o.columns)));
+  // Two names for one column would read it twice (x as y): every column once. Case and unit
+  // suffix are ignored when matching, so compare the bare names.
+  const auto bare = [](std::string n) {
+    std::transform(n.begin(), n.end(), n.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    for (const char* suffix : {"_ms", "_mm", "_s", "_m"})
+      if (n.size() > std::string_view(suffix).size() && n.ends_with(suffix)) {
+        n.resize(n.size() - std::string_view(suffix).size());
+        break;
+      }
+    return n;
+  };
+  for (std::size_t a = 0; a < names.size(); ++a)
+    for (std::size_t b = a + 1; b < names.size(); ++b)
+      if (bare(names[a]) == bare(names[b]))
+        throw ExitError(kExitBadInput, fmt::format("--columns: '{}' and '{}' name the same column; expected four "
+                                                   "different columns (time or index, x, y, z)",
+                                                   printable(names[a]), printable(names[b])));
+  f.time_column = names[0];
+  f.x_column = names[1];
+  f.y_column = names[2];
+  f.z_column = names[3];
+  if (!o.units.empty()) f.length_unit = o.units == "mm" ? 1e-3 : 1.0;
+  f.indexed = o.index;
+  if (o.index && !(o.rate > 0.0 && std::isfinite(o.rate)))
+    throw ExitError(kExitBadInput, "--index: give the tracker's sample rate with --rate HZ");
+  if (!o.index && o.rate != 0.0) throw ExitError(kExitBadInput, "--rate: only with --index (a log of sample indices)");
+  return f;
+}
+
+PointLog read_point_log(const LogOptions& o, const PointLogFormat& format) {
+  const std::string text = read_text_file(o.points, "--points", "point log");
+  try {
+    return parse_point_log(text, o.points, format);
+  } catch (const Error& e) {
+    throw ExitError(kExitBadInput, e.what());
+  }
+}
+
+}  // namespace hexatwist::cli

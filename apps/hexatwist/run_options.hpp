@@ -1,0 +1,61 @@
+// What synth, measure and identify share: the run the platform made (a study test after the
+// calibration moves, a trajectory file or a stations run) and how to read a tracker's point log.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+
+#include "cli_common.hpp"
+#include "study_report.hpp"
+
+namespace hexatwist::cli {
+
+/// The run: one of --test, --trajectory, --stations; the strategy its commands were made with.
+struct RunOptions {
+  ModelOptions model;
+  std::string test;
+  std::string trajectory;
+  int stations = 0;
+  std::uint64_t station_seed = 1;
+  std::string strategy = "compensated";
+};
+
+/// The strategy named by --strategy.
+Strategy strategy_of(const RunOptions& o);
+
+/// The run to report, the commanded poses as given, and where the calibration moves end (NaN for a
+/// trajectory file: its calibration is the user's).
+struct Run {
+  ReportedTest test;
+  TimedPoses commanded;
+  double calibration_end = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// Builds the run the options name; ExitError(2) for a missing or unknown run, (3) for stations
+/// that cannot be placed inside the limits.
+Run build_run(const Config& config, const RunOptions& o);
+
+/// Adds --config, --test, --trajectory, --stations, --station-seed and --strategy.
+void add_run_options(CLI::App& app, RunOptions& o);
+
+/// How to read a point log and place it in the run's time (measure and identify).
+struct LogOptions {
+  std::string points;
+  std::string columns = "t,x,y,z";
+  std::string units;
+  bool index = false;
+  double rate = 0.0;
+  double time_offset = 0.0;
+};
+
+/// Adds --points, --columns, --units, --index, --rate and --time-offset.
+void add_log_options(CLI::App& app, LogOptions& o);
+
+/// The log's format from the options; ExitError(2) naming the option at fault.
+PointLogFormat log_format(const LogOptions& o);
+
+/// Reads and parses the log; ExitError(2) with the parser's one line.
+PointLog read_point_log(const LogOptions& o, const PointLogFormat& format);
+
+}  // namespace hexatwist::cli
