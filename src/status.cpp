@@ -42,6 +42,10 @@ std::string_view to_string(Status s) noexcept {
       return "platform_singularity";
     case Status::AssemblyModeChanged:
       return "assembly_mode_changed";
+    case Status::SignUndecided:
+      return "sign_undecided";
+    case Status::ModelMismatch:
+      return "model_mismatch";
   }
   return "unknown";
 }
@@ -87,6 +91,10 @@ std::string_view describe(Status s) noexcept {
     case Status::AssemblyModeChanged:
       return "forward kinematics found a solution on another assembly mode than its start (the Jacobian determinant "
              "changed sign)";
+    case Status::SignUndecided:
+      return "both thread senses explain the measurements about as well: the twist's sign is not decided";
+    case Status::ModelMismatch:
+      return "the identified model leaves an error that the tracker's noise does not explain";
   }
   return "unknown status";
 }

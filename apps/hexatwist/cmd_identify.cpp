@@ -1,20 +1,17 @@
-// hexatwist identify: lead, twist sign, leg offsets and observation point identified from a point log,
-// written as a corrected configuration (docs/theory.md §13).
+// hexatwist identify: the platform identified from a tracker's point log (the library decides,
+// identification.hpp), printed, and written as a corrected configuration with the map of its
+// predicted accuracy (docs/theory/calibration.md §13).
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cctype>
-#include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <limits>
 #include <memory>
 
 #include "cli_common.hpp"
+#include "figures.hpp"
 #include "json.hpp"
 #include "run_options.hpp"
-#include "study_report.hpp"
 
 namespace hexatwist::cli {
 namespace {
@@ -23,130 +20,348 @@ struct IdentifyOptions {
   RunOptions run;
   LogOptions log;
   double settle = 0.25;
+  std::string model = "geometry";
   std::string lead_effect = "travel";
+  std::string axes = "auto";
+  double tracker_noise_um = std::numeric_limits<double>::quiet_NaN();
+  int folds = 5;
   std::string out = "identified.yaml";
+  bool no_figures = false;
   bool json = false;
 };
 
-// One row of the table: a parameter in display units.
-struct ParameterRow {
-  std::string name;
-  std::string unit;
-  double scale = 1.0;  // display units per SI unit
-  double nominal = 0.0;
-  double estimate = 0.0;
-  double sd = 0.0;
-  int decimals = 4;
+IdentificationOptions library_options(const IdentifyOptions& o) {
+  IdentificationOptions io;
+  io.model = o.model == "basic" ? CalibrationModel::Basic : CalibrationModel::Geometry;
+  io.lead_effect = o.lead_effect == "twist" ? LeadEffect::TwistOnly : LeadEffect::TwistAndTravel;
+  io.axes = o.axes == "none" ? AxisFit::None : o.axes == "all" ? AxisFit::All : AxisFit::Auto;
+  io.tracker_noise = o.tracker_noise_um * 1e-6;
+  io.folds = o.folds;
+  return io;
+}
+
+// Everything identify reports, gathered once for the text and the JSON.
+struct Report {
+  const IdentifyOptions& o;
+  const Model& nominal;
+  const ObservationSet& set;
+  const PointLog& log;
+  const Identification& id;
+  std::string run_description;
+
+  int line_of(std::size_t observation) const { return log.lines[set.points[observation]]; }
+  const ParameterSet& ps() const { return id.parameters; }
 };
 
-std::vector<ParameterRow> parameter_rows(const Model& nominal, const Identification& id) {
-  std::vector<ParameterRow> rows;
-  const PlatformParameters& e = id.estimate;
-  rows.push_back({"lead", "mm", 1e3, nominal.leg(0).lead, e.lead, id.sd[kLeadIndex], 6});
-  for (int i = 0; i < kLegs; ++i)
-    rows.push_back({fmt::format("offset {}", i + 1), "mm", 1e3, nominal.geometry().length_offset[i], e.length_offset[i],
-                    id.sd[kOffsetIndex + i]});
-  for (int a = 0; a < 3; ++a)
-    rows.push_back({fmt::format("point {}", "xyz"[a]), "mm", 1e3, nominal.spec().observation_P[a], e.observation_P[a],
-                    id.sd[kObservationIndex + a]});
+const char* model_name(CalibrationModel m) { return m == CalibrationModel::Basic ? "basic" : "geometry"; }
+
+std::string status_word(Status s) {
+  switch (s) {
+    case Status::NotIdentifiable:
+      return "not identifiable";
+    case Status::SolverNoConvergence:
+      return "no convergence";
+    case Status::SignUndecided:
+      return "thread sense not decided";
+    case Status::ModelMismatch:
+      return "the model does not explain the data";
+    default:
+      return "failed";
+  }
+}
+
+// The parameter table: every platform parameter in display units, joints per coordinate.
+struct Row {
+  std::string name, unit;
+  double nominal, estimate, sd;
+  int decimals;
+};
+
+std::vector<Row> parameter_rows(const Report& r) {
+  const Identification& id = r.id;
+  const ParameterSet& ps = r.ps();
+  std::vector<Row> rows;
+  for (int j = 0; j < ps.lead_count(); ++j)
+    rows.push_back({ps.name(j), "mm", 1e3 * id.nominal[j], 1e3 * id.estimate[j], 1e3 * id.sd[j], 6});
+  for (int i = 0; i < kLegs; ++i) {
+    const int k = ps.offset_index() + i;
+    rows.push_back({ps.name(k), "mm", 1e3 * id.nominal[k], 1e3 * id.estimate[k], 1e3 * id.sd[k], 4});
+  }
+  if (ps.model() == CalibrationModel::Geometry) {
+    const ModelSpec& n = ps.nominal();
+    for (int i = 0; i < kLegs; ++i)
+      for (int a = 0; a < 3; ++a)
+        rows.push_back(
+            {fmt::format("base {} {}", i + 1, "xyz"[a]), "mm", 1e3 * n.legs[static_cast<std::size_t>(i)].base_B[a],
+             1e3 * id.corrected.legs[static_cast<std::size_t>(i)].base_B[a], 1e3 * id.base_shift_sd(i, a), 4});
+    for (int i = 0; i < kLegs; ++i)
+      for (int a = 0; a < 3; ++a)
+        rows.push_back({fmt::format("platform {} {}", i + 1, "xyz"[a]), "mm",
+                        1e3 * n.legs[static_cast<std::size_t>(i)].platform_P[a],
+                        1e3 * id.corrected.legs[static_cast<std::size_t>(i)].platform_P[a],
+                        1e3 * id.platform_shift_sd(i, a), 4});
+    for (int k = ps.axis_index(); k < ps.axis_index() + ps.axis_count(); ++k)
+      rows.push_back({ps.name(k), "deg", 0.0, rad2deg(id.estimate[k]), rad2deg(id.sd[k]), 4});
+  }
+  for (int k = ps.target_index(); k < ps.rotation_index(); ++k)
+    rows.push_back({k - ps.target_index() < 3 ? fmt::format("point {}", "xyz"[k - ps.target_index()]) : ps.name(k),
+                    "mm", 1e3 * id.nominal[k], 1e3 * id.estimate[k], 1e3 * id.sd[k], 4});
   return rows;
 }
 
-// The tracker's own noise per coordinate: the scatter of the points at rest about the mean of
-// their pose (runs of one commanded pose), pooled over the poses; NaN without repeats [m]. It
-// needs no model, so it is what the fit's sigma is compared with.
-double scatter_at_rest(const ObservationSet& set) {
-  const std::vector<Observation>& obs = set.observations;
-  double sum = 0.0;
-  std::size_t dof = 0;
-  for (std::size_t a = 0; a < obs.size();) {
-    std::size_t b = a + 1;
-    while (b < obs.size() && (obs[b].motor - obs[a].motor).cwiseAbs().maxCoeff() <= 1e-9) ++b;
-    Vector3d mean = Vector3d::Zero();
-    for (std::size_t k = a; k < b; ++k) mean += obs[k].p_T;
-    mean /= static_cast<double>(b - a);
-    for (std::size_t k = a; k < b; ++k) sum += (obs[k].p_T - mean).squaredNorm();
-    dof += 3 * (b - a - 1);
-    a = b;
-  }
-  return dof >= 3 ? std::sqrt(sum / static_cast<double>(dof)) : std::numeric_limits<double>::quiet_NaN();
+// Which axes were fitted, and how well the data determine them, in one phrase.
+std::string axes_phrase(const Identification& id) {
+  if (id.parameters.model() != CalibrationModel::Geometry) return "joints as configured";
+  const int fitted = id.parameters.axis_count() / 2;
+  double lo = INFINITY, hi = 0.0;
+  for (const double sd : id.axis_sd)
+    if (std::isfinite(sd)) lo = std::min(lo, sd), hi = std::max(hi, sd);
+  const std::string sds =
+      std::isfinite(lo) ? fmt::format("the data determine them to {:.2g}-{:.2g} deg", rad2deg(lo), rad2deg(hi)) : "";
+  if (fitted == 0)
+    return sds.empty() ? "U-joint axes as configured" : fmt::format("U-joint axes as configured ({}: not fitted)", sds);
+  return fmt::format("{} U-joint ax{} fitted{}", fitted, fitted == 1 ? "is" : "es",
+                     sds.empty() ? "" : " (" + sds + ")");
 }
 
-// The fit's noise may exceed the tracker's scatter at rest by this factor before the model is
-// said not to explain the data (identify exits 5); the scatter counts as at least
-// kTrackerNoiseFloor (a log's rounding and the servo's settling are below it).
-constexpr double kNoiseRatioMax = 100.0;
-constexpr double kTrackerNoiseFloor = 1e-6;  // [m]
+std::string text_report(const Report& r) {
+  const Identification& id = r.id;
+  const IdentifyOptions& o = r.o;
+  std::string t = fmt::format("hexatwist identify on {}: {}\n", model_source(o.run.model), r.nominal.spec().name);
+  t += fmt::format(
+      "points: {}: {} points, {} at rest (commanded pose still for {:g} s) at {} stations, {} target{}; {}; {} "
+      "commands\n",
+      printable(o.log.points), r.log.points_T.size(), id.observations, r.set.settle, id.stations, r.set.targets.size(),
+      r.set.targets.size() == 1 ? "" : "s", r.run_description, o.run.strategy);
+  t += fmt::format("model: {} ({}), lead effect {}\n", model_name(r.ps().model()), axes_phrase(id),
+                   r.ps().lead_effect() == LeadEffect::TwistAndTravel
+                       ? "travel (the drives turn the screws by the nominal lead's angles)"
+                       : "twist only (the drives' travel is right)");
+  const SignFit& plus = id.fits[0];
+  const SignFit& minus = id.fits[1];
+  t += fmt::format("thread sense: as configured cost {:.4g} m^2{}, flipped cost {:.4g} m^2{}: {}, cost ratio {:.3g}\n",
+                   plus.cost, plus.lead_at_bound ? " (lead at 0)" : "", minus.cost,
+                   minus.lead_at_bound ? " (lead at 0)" : "",
+                   id.twist_sign > 0 ? "as configured" : "flipped (every leg the other hand)", id.cost_ratio);
+  t += fmt::format(
+      "fit: rms {:.4f} mm before (nominal model, tracker frame by Kabsch), {:.4f} mm after, largest {:.4f} mm (line "
+      "{}); noise {:.4f} mm per axis, the tracker's {:.4f} mm: test {:.2f} sigma (at most 5); condition {:.3g}\n",
+      1e3 * id.rms_before, 1e3 * id.rms_after, 1e3 * id.max_after,
+      r.line_of(static_cast<std::size_t>(id.max_after_index)), 1e3 * id.sigma, 1e3 * id.tracker_noise, id.fit_z,
+      id.condition);
+  const CrossValidation& cv = id.cross_validation;
+  if (cv.folds > 0)
+    t += fmt::format(
+        "cross-validated ({} folds over the stations): the {} left-out stations' mean points are predicted to {:.1f} "
+        "um rms, {:.1f} um at most ({:.1f} um expected from the noise and the covariance)\n",
+        cv.folds, cv.predicted, 1e6 * cv.rms, 1e6 * cv.max, 1e6 * cv.expected);
+  const AccuracyPrediction& acc = id.accuracy;
+  t += fmt::format(
+      "predicted accuracy of point A over the calibrated range ({} poses within {:.3f}..{:.3f} m, {:.1f}..{:.1f} deg): "
+      "median {:.4f} mm, largest {:.4f} mm in the gauge frames; {:.4f} mm and {:.4f} mm after a rigid re-alignment\n",
+      acc.poses, acc.range_low.head<3>().minCoeff(), acc.range_high.head<3>().maxCoeff(),
+      rad2deg(acc.range_low.tail<3>().minCoeff()), rad2deg(acc.range_high.tail<3>().maxCoeff()), 1e3 * acc.median,
+      1e3 * acc.max, 1e3 * acc.aligned_median, 1e3 * acc.aligned_max);
+  t += fmt::format("{:<18} {:>12} {:>12} {:>10} {:>12}\n", "parameter", "nominal", "estimate", "sd", "change");
+  for (const Row& row : parameter_rows(r)) {
+    const std::string change = row.name.starts_with("lead")
+                                   ? fmt::format("{:+.4f} %", 100.0 * (row.estimate / row.nominal - 1.0))
+                                   : fmt::format("{:+.{}f}", row.estimate - row.nominal, row.decimals);
+    t += fmt::format("{:<18} {:>12.{}f} {:>12.{}f} {:>10.{}f} {:>12}  [{}]\n", row.name, row.nominal, row.decimals,
+                     row.estimate, row.decimals, row.sd, row.decimals, change, row.unit);
+  }
+  const Eigen::AngleAxisd turn(id.X_BT.R);
+  t += fmt::format(
+      "tracker frame in the base frame: origin ({:.4f}, {:.4f}, {:.4f}) m, turned {:.4f} deg about ({:.4f}, {:.4f}, "
+      "{:.4f})\n",
+      id.X_BT.t.x(), id.X_BT.t.y(), id.X_BT.t.z(), rad2deg(turn.angle()), turn.axis().x(), turn.axis().y(),
+      turn.axis().z());
+  if (r.ps().model() == CalibrationModel::Geometry)
+    t += "gauge: B is the least-squares frame of the six base joint centres, P that of the six platform joint centres "
+         "(the joint displacements have no rigid part)\n";
+  return t;
+}
 
-// The JSON of identify. `failure` empty: the run succeeded and wrote `o.out`. Otherwise its
-// one-line reason; the estimate and what follows from it are null unless the identification
-// itself succeeded (`status` Ok, e.g. only the output failed). `fitted`: the solver converged, so
-// the fit's numbers (residuals, sigma, the cost ratio) are known even where the estimate is
-// refused (thread hands tied, a fit far noisier than the tracker): they say why.
-std::string identify_json(const Model& nominal, const IdentifyOptions& o, const ObservationSet& set,
-                          const PointLog& log, const Identification& id, Status status, bool fitted,
-                          const std::string& failure) {
-  const bool solved = status == Status::Ok;
+std::string json_report(const Report& r, const std::string& failure, bool written) {
+  const Identification& id = r.id;
+  const ParameterSet& ps = r.ps();
+  const bool solved = id.status == Status::Ok;
   const auto number = [](JsonWriter& w, std::string_view key, double v, bool known) {
     w.key(key);
     known&& std::isfinite(v) ? w.value(v) : w.null();
   };
   JsonWriter j;
   j.begin_object().field("command", "identify").field("status", failure.empty() ? "ok" : "failed");
+  j.field("identification", to_string(id.status));
   if (!failure.empty()) j.field("reason", failure);
-  j.field("model", nominal.spec().name).field("config", model_source(o.run.model)).field("points", o.log.points);
-  j.field("log_points", static_cast<int>(log.points_T.size())).field("observations", id.count);
-  j.field("poses", static_cast<int>(set.poses))
-      .field("settle", set.settle)
-      .field("strategy", o.run.strategy)
-      .field("lead_effect", o.lead_effect);
+  if (!id.hint.empty()) j.field("hint", id.hint);
+  j.field("model", r.nominal.spec().name).field("config", model_source(r.o.run.model)).field("points", r.o.log.points);
+  j.field("calibration_model", model_name(ps.model())).field("lead_effect", r.o.lead_effect);
+  j.field("log_points", static_cast<int>(r.log.points_T.size())).field("observations", id.observations);
+  j.field("stations", id.stations).field("groups", id.groups).field("settle", r.set.settle);
+  j.field("strategy", r.o.run.strategy);
+  j.key("targets").begin_array();
+  for (const std::string& name : r.set.targets) j.value(name);
+  j.end_array();
   number(j, "rms_before", id.rms_before, true);
-  number(j, "rms_after", id.rms_after, fitted);
-  number(j, "max_after", id.max_after, fitted);
+  number(j, "rms_after", id.rms_after, id.fitted);
+  number(j, "max_after", id.max_after, id.fitted);
   j.key("max_after_line");
-  fitted&& id.max_after_index >= 0 ? j.value(log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]])
-                                   : j.null();
-  number(j, "sigma", id.sigma, fitted);
-  const double scatter = scatter_at_rest(set);
-  number(j, "tracker_noise", scatter, true);
-  number(j, "noise_ratio", id.sigma / std::max(scatter, kTrackerNoiseFloor), fitted);
+  id.fitted&& id.max_after_index >= 0 ? j.value(r.line_of(static_cast<std::size_t>(id.max_after_index))) : j.null();
+  number(j, "sigma", id.sigma, id.fitted);
+  number(j, "tracker_noise", id.tracker_noise, true);
+  number(j, "scatter", id.scatter, true);
+  number(j, "noise_ratio", id.sigma / id.tracker_noise, id.fitted);
+  j.key("fit_test").begin_object();
+  number(j, "statistic", id.fit_statistic, id.fitted);
+  j.field("dof", id.fit_dof);
+  number(j, "z", id.fit_z, id.fitted);
+  j.field("limit", 5.0).end_object();
+  j.key("worst_stations").begin_array(true);
+  for (const StationResidual& w : id.worst) {
+    j.begin_object().field("station", w.station + 1).field("target", r.set.targets[static_cast<std::size_t>(w.target)]);
+    j.field("line", r.line_of(w.first)).field("points", w.count).field("mean_error", w.mean_error);
+    j.field("statistic", w.statistic).end_object();
+  }
+  j.end_array();
   number(j, "condition", id.condition, true);
-  number(j, "cost_ratio", id.cost_ratio, fitted);
+  if (!id.undetermined.empty()) j.field("undetermined", id.undetermined);
+  number(j, "cost_ratio", id.cost_ratio, id.fitted);
+  number(j, "sign_separation", id.sign_separation, id.fitted);
   j.key("fits").begin_array(true);
   for (const SignFit& f : id.fits) {
     j.begin_object().field("twist_sign", f.twist_sign).field("status", describe(f.status));
-    number(j, "cost", f.cost, f.status == Status::Ok);
-    j.field("iterations", f.iterations).field("lead_at_bound", f.lead_at_bound);
-    number(j, "lead", f.estimate.lead, f.status == Status::Ok);
-    j.end_object();
+    number(j, "cost", f.cost, std::isfinite(f.cost));
+    j.field("iterations", f.iterations).field("lead_at_bound", f.lead_at_bound).end_object();
   }
   j.end_array();
-  const PlatformParameters& e = id.estimate;
+  j.key("axis_sd").begin_array();
+  for (const double sd : id.axis_sd) std::isfinite(sd) ? j.value(sd) : j.null();
+  j.end_array();
+  j.key("axes_fitted").begin_array();
+  for (const bool a : ps.axes()) j.value(a);
+  j.end_array();
+  const CrossValidation& cv = id.cross_validation;
+  j.key("cross_validation").begin_object().field("folds", cv.folds).field("predicted", cv.predicted);
+  number(j, "rms", cv.rms, cv.folds > 0);
+  number(j, "max", cv.max, cv.folds > 0);
+  number(j, "expected", cv.expected, cv.folds > 0);
+  j.end_object();
+  const AccuracyPrediction& acc = id.accuracy;
+  j.key("accuracy").begin_object().field("poses", acc.poses);
+  number(j, "median", acc.median, acc.poses > 0);
+  number(j, "max", acc.max, acc.poses > 0);
+  number(j, "aligned_median", acc.aligned_median, acc.poses > 0);
+  number(j, "aligned_max", acc.aligned_max, acc.poses > 0);
+  j.key("range_low").vector(acc.range_low);
+  j.key("range_high").vector(acc.range_high);
+  j.end_object();
   j.key("estimate");
   if (!solved) {
     j.null();
   } else {
     j.begin_object();
-    j.field("lead", e.lead).field("lead_sd", id.sd[kLeadIndex]).field("lead_nominal", nominal.leg(0).lead);
-    j.field("twist_sign", e.twist_sign).field("twist_sign_nominal", nominal.leg(0).twist_sign);
-    j.field("thread", e.twist_sign > 0.0 ? "right" : "left");
-    j.key("length_offsets").vector(e.length_offset);
-    j.key("length_offsets_sd").vector(id.sd.segment<kLegs>(kOffsetIndex));
-    j.key("observation_point").vector(e.observation_P);
-    j.key("observation_point_sd").vector(id.sd.segment<3>(kObservationIndex));
+    j.key("parameters").begin_array(true);
+    for (int k = 0; k < ps.size(); ++k)
+      j.begin_object()
+          .field("name", ps.name(k))
+          .field("nominal", id.nominal[k])
+          .field("estimate", id.estimate[k])
+          .field("sd", id.sd[k])
+          .end_object();
+    j.end_array();
+    j.field("twist_sign", id.twist_sign);
+    const ModelSpec& c = id.corrected;
+    j.key("leads").begin_array();
+    for (const LegSpec& leg : c.legs) j.value(leg.lead);
+    j.end_array();
+    j.key("threads").begin_array();
+    for (const LegSpec& leg : c.legs) j.value(leg.thread == ThreadSense::Right ? "right" : "left");
+    j.end_array();
+    j.key("length_offsets").begin_array();
+    for (const LegSpec& leg : c.legs) j.value(leg.length_offset);
+    j.end_array();
+    j.key("base_joints").begin_array();
+    for (const LegSpec& leg : c.legs) j.vector(leg.base_B);
+    j.end_array();
+    j.key("base_joints_sd").begin_array();
+    for (int i = 0; i < kLegs; ++i) j.vector(Vector3d(id.base_shift_sd.row(i).transpose()));
+    j.end_array();
+    j.key("platform_joints").begin_array();
+    for (const LegSpec& leg : c.legs) j.vector(leg.platform_P);
+    j.end_array();
+    j.key("platform_joints_sd").begin_array();
+    for (int i = 0; i < kLegs; ++i) j.vector(Vector3d(id.platform_shift_sd.row(i).transpose()));
+    j.end_array();
+    j.key("targets").begin_array();
+    for (int t = 0; t < ps.targets(); ++t) j.vector(ps.target(id.estimate, t));
+    j.end_array();
+    j.key("observation_point").vector(c.observation_P);
     j.key("X_BT").begin_object();
     j.key("R").begin_array();
-    for (int i = 0; i < 3; ++i) j.vector(e.X_BT.R.row(i));
+    for (int i = 0; i < 3; ++i) j.vector(id.X_BT.R.row(i));
     j.end_array();
-    j.key("t").vector(e.X_BT.t);
-    j.key("rotation_sd").vector(id.sd.segment<3>(kRotationIndex));
-    j.key("t_sd").vector(id.sd.segment<3>(kTranslationIndex));
+    j.key("t").vector(id.X_BT.t);
+    j.key("rotation_sd").vector(id.sd.segment<3>(ps.rotation_index()));
+    j.key("t_sd").vector(id.sd.segment<3>(ps.translation_index()));
     j.end_object().end_object();
   }
   j.key("corrected_config");
-  failure.empty() ? j.value(o.out) : j.null();
+  written ? j.value(r.o.out) : j.null();
   j.end_object();
   return j.str();
+}
+
+// The map of the predicted accuracy: positions in the x-y plane at the range's middle height, each
+// drawn in the colour of its error band.
+Figure accuracy_figure(const Identification& id, const std::string& stem) {
+  Figure fig;
+  fig.stem = stem;
+  fig.title = "predicted error of point A after calibration (gauge frames, no rotation; blank: outside a limit)";
+  const Eigen::MatrixXd C = id.covariance.topLeftCorner(id.parameters.platform_size(), id.parameters.platform_size());
+  const std::array<std::pair<int, int>, 2> planes{{{0, 1}, {0, 2}}};
+  std::vector<AccuracyMap> maps;
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto& [a, b] : planes) {
+    AccuracyMap map;
+    if (accuracy_map(id.parameters, id.estimate, id.twist_sign, C, id.accuracy, a, b, 41, map) != Status::Ok) continue;
+    for (const double e : map.error)
+      if (std::isfinite(e)) lo = std::min(lo, 1e6 * e), hi = std::max(hi, 1e6 * e);
+    maps.push_back(std::move(map));
+  }
+  if (!std::isfinite(lo)) return fig;
+  // Five bands of equal width from the smallest to the largest error of both maps, each its own
+  // colour, with enough decimals to tell their edges apart.
+  std::array<double, 6> edges{};
+  for (std::size_t k = 0; k < edges.size(); ++k) edges[k] = lo + (hi - lo) * static_cast<double>(k) / 5.0;
+  const double step = (hi - lo) / 5.0;
+  const int decimals = step >= 5.0 ? 0 : step >= 0.5 ? 1 : 2;
+  for (const AccuracyMap& map : maps) {
+    const int a = map.axis_u, b = map.axis_v;
+    Panel panel;
+    panel.title = fmt::format("{}-{} plane, {} = {:.3f} m", "xyz"[a], "xyz"[b], "xyz"[3 - a - b],
+                              0.5 * (id.accuracy.range_low[3 - a - b] + id.accuracy.range_high[3 - a - b]));
+    panel.xlabel = fmt::format("{} [m]", "xyz"[a]);
+    panel.ylabel = fmt::format("{} [m]", "xyz"[b]);
+    for (std::size_t band = 0; band + 1 < edges.size(); ++band) {
+      Series s;
+      s.style = Series::Style::Points;
+      s.label = fmt::format("{:.{}f}-{:.{}f} um", edges[band], decimals, edges[band + 1], decimals);
+      const bool last = band + 2 == edges.size();
+      for (std::size_t jv = 0; jv < map.v.size(); ++jv)
+        for (std::size_t iu = 0; iu < map.u.size(); ++iu) {
+          const double e = 1e6 * map.error[jv * map.u.size() + iu];
+          if (!(e >= edges[band] && (e < edges[band + 1] || (last && e <= edges[band + 1])))) continue;
+          s.x.push_back(map.u[iu]);
+          s.y.push_back(map.v[jv]);
+        }
+      // An empty band keeps its place in the legend, so that a colour means one band in both panels.
+      if (s.x.empty()) s.x = {std::nan("")}, s.y = {std::nan("")};
+      panel.series.push_back(std::move(s));
+    }
+    fig.panels.push_back(std::move(panel));
+  }
+  return fig;
 }
 
 int run_identify(const IdentifyOptions& o) {
@@ -154,6 +369,10 @@ int run_identify(const IdentifyOptions& o) {
   const Model& model = config.rig.model();
   const PointLogFormat format = log_format(o.log);
   check_option(o.settle >= 0.0, "--settle", o.settle, "a time >= 0 [s]");
+  if (!std::isnan(o.tracker_noise_um))
+    check_option(o.tracker_noise_um > 0.0 && o.tracker_noise_um < 1e4, "--tracker-noise-um", o.tracker_noise_um,
+                 "a standard deviation > 0 and below 1e4 [um]");
+  check_option(o.folds == 0 || (o.folds >= 2 && o.folds <= 100), "--folds", o.folds, "0 (none) or 2 to 100");
   const Run run = build_run(config, o.run);
   check_option(o.settle < run.test.trajectory.duration(), "--settle", o.settle,
                fmt::format("a time shorter than the run ({:g} s): no point can be still for longer [s]",
@@ -166,118 +385,66 @@ int run_identify(const IdentifyOptions& o) {
   } catch (const Error& e) {
     throw ExitError(kExitBadInput, e.what());
   }
-  IdentificationOptions io;
-  io.lead_effect = o.lead_effect == "twist" ? LeadEffect::TwistOnly : LeadEffect::TwistAndTravel;
   Identification id;
-  const Status status = identify(model, set.observations, id, io);
+  const Status status = identify(model, set.observations, id, library_options(o));
+  const Report report{o, model, set, log, id, run.test.description};
   // A failure still prints the JSON (with the reason, and null where there is no value) when asked.
-  const auto fail = [&](const ExitError& e, Status solved) {
-    if (o.json) write_stdout(identify_json(model, o, set, log, id, solved, status == Status::Ok, e.what()) + "\n");
+  const auto fail = [&](const ExitError& e) {
+    if (o.json) write_stdout(json_report(report, e.what(), false));
     throw e;
   };
-  if (status != Status::Ok) {
-    const char* what = status == Status::NotIdentifiable       ? "not identifiable"
-                       : status == Status::SolverNoConvergence ? "no convergence"
-                                                               : "failed";
-    fail(ExitError(kExitNotIdentified, fmt::format("{}: {} points at rest at {} pose{}: {}: {}; nothing was written",
-                                                   printable(o.log.points), set.observations.size(), set.poses,
-                                                   set.poses == 1 ? "" : "s", what, id.reason)),
-         status);
-  }
+  if (status != Status::Ok)
+    fail(ExitError(kExitNotIdentified,
+                   fmt::format("{}: {} points at rest at {} station{}: {}: {}{}; nothing was written",
+                               printable(o.log.points), set.observations.size(), set.poses, set.poses == 1 ? "" : "s",
+                               status_word(status), id.reason, id.hint.empty() ? "" : "; hint: " + id.hint)));
 
-  // The fit must explain the data about as well as the tracker measures: a residual noise far
-  // above the scatter of the points at rest means a model that does not describe the machine
-  // (another configuration, log or run), whose lead and thread would mean nothing.
-  if (const double scatter = scatter_at_rest(set), floor = std::max(scatter, kTrackerNoiseFloor);
-      !(id.sigma <= kNoiseRatioMax * floor))
-    fail(
-        ExitError(kExitNotIdentified,
-                  fmt::format("{}: the fit leaves a noise of {:.4g} mm per axis, {:.3g} times the tracker's scatter at "
-                              "rest ({:.4g} mm, at least {:g} mm counted; {:g} times allowed): the model does not "
-                              "explain the data (another configuration, log or run?); nothing was written",
-                              printable(o.log.points), 1e3 * id.sigma, id.sigma / floor, 1e3 * scatter,
-                              1e3 * kTrackerNoiseFloor, kNoiseRatioMax)),
-        Status::NotIdentifiable);
-
-  // The thread hand is decided only if the other sign fits worse by more than the noise explains:
-  // twice the cost difference over sigma^2 is a chi-square of one degree of freedom; ask 25 (5 sd).
-  {
-    const bool plus = id.estimate.twist_sign > 0.0;
-    const SignFit& rejected = id.fits[plus ? 1 : 0];
-    const SignFit& chosen = id.fits[plus ? 0 : 1];
-    const double separation = 2.0 * (rejected.cost - chosen.cost) / (id.sigma * id.sigma);
-    if (rejected.status == Status::Ok && !rejected.lead_at_bound && !(separation >= 25.0))
-      fail(ExitError(kExitNotIdentified,
-                     fmt::format("{}: the two thread hands fit the data equally well (cost ratio {:.4g}, difference "
-                                 "{:.3g} noise variances, 25 needed): the twist sign and lead are not decided; record "
-                                 "a run with rotations (--stations); nothing was written",
-                                 printable(o.log.points), id.cost_ratio, separation)),
-           Status::NotIdentifiable);
-  }
+  // The corrected configuration: the user's file (or the seed) with the identified platform in the
+  // legs form, and the drives' reference recorded (the contract of theory §4).
   const std::string source_text = o.run.model.config.empty()
                                       ? std::string(seed_config_yaml())
                                       : read_text_file(o.run.model.config, "--config", "config file");
-  ModelSpec corrected = corrected_spec(model.spec(), id.estimate);
+  ModelSpec corrected = id.corrected;
   corrected.name = fmt::format("{} (identified from {})", model.spec().name, o.log.points);
   const std::string header = fmt::format(
-      "corrected by hexatwist identify from {} ({} observations at rest, rms {:.4f} -> {:.4f} mm):\n"
-      "name, screw lead and thread, length_offsets and observation_point; everything else as in {}.",
-      o.log.points, id.count, 1e3 * id.rms_before, 1e3 * id.rms_after, model_source(o.run.model));
+      "corrected by hexatwist identify ({} model) from {} ({} points at rest at {} stations, rms {:.4f} -> {:.4f} "
+      "mm):\njoint centres, leads, thread hands, length_offsets and observation_point identified; home_commands and\n"
+      "drive_lead record the drives' reference and scale the log was recorded with (keep the controller's HOME and "
+      "scale);\nB and P are the least-squares frames of the base and platform joint centres; everything else as in "
+      "{}.",
+      model_name(id.parameters.model()), o.log.points, id.observations, id.stations, 1e3 * id.rms_before,
+      1e3 * id.rms_after, model_source(o.run.model));
   std::string yaml;
   try {
-    yaml = corrected_config_yaml(source_text, model_source(o.run.model), corrected, header);
-    (void)load_config(yaml, o.out);  // what is written must load
+    yaml = platform_config_yaml(source_text, model_source(o.run.model), corrected, header, true);
   } catch (const Error& e) {
-    fail(ExitError(kExitNotIdentified, fmt::format("{}: the corrected configuration does not load: {}; nothing was "
-                                                   "written",
-                                                   printable(o.out), e.what())),
-         Status::NotIdentifiable);
+    fail(ExitError(kExitNotIdentified,
+                   fmt::format("{}: the corrected configuration does not load: {}; nothing was written",
+                               printable(o.out), e.what())));
+  }
+  OutputSet files;
+  files.add(o.out, yaml);
+  if (!o.no_figures) {
+    const std::filesystem::path out(o.out);
+    const std::string stem = (out.parent_path() / (out.stem().string() + "_accuracy")).string();
+    try {
+      write_figures({accuracy_figure(id, stem)});
+    } catch (const ExitError& e) {
+      fail(e);
+    }
+    files.adopt(stem + ".png");
+    files.adopt(stem + ".svg");
   }
   try {
-    write_output_file(o.out, yaml);
+    files.commit();
   } catch (const ExitError& e) {
-    fail(e, status);
+    fail(e);
   }
-  if (o.json) {
-    write_stdout_or_withdraw(identify_json(model, o, set, log, id, status, true, std::string()) + "\n", {o.out});
-    return kExitOk;
-  }
-
-  std::string text = fmt::format("hexatwist identify on {}: {}\n", model_source(o.run.model), model.spec().name);
-  text += fmt::format(
-      "points: {}: {} points, {} at rest (commanded pose still for {:g} s) at {} poses used; {}; {} commands\n",
-      printable(o.log.points), log.points_T.size(), id.count, set.settle, set.poses, run.test.description,
-      o.run.strategy);
-  text += fmt::format("lead model: {}\n", io.lead_effect == LeadEffect::TwistAndTravel
-                                              ? "travel (the drives turn the screws by the nominal lead's angles)"
-                                              : "twist only (the drives' travel is right; --lead-effect twist)");
-  const SignFit& plus = id.fits[0];
-  const SignFit& minus = id.fits[1];
-  text += fmt::format(
-      "twist sign: +1 cost {:.4g} m^2{}, -1 cost {:.4g} m^2{}: {} ({}-hand thread), cost ratio {:.3g}\n", plus.cost,
-      plus.lead_at_bound ? " (lead at 0)" : "", minus.cost, minus.lead_at_bound ? " (lead at 0)" : "",
-      id.estimate.twist_sign > 0.0 ? "+1" : "-1", id.estimate.twist_sign > 0.0 ? "right" : "left", id.cost_ratio);
-  text += fmt::format(
-      "residual: rms {:.4f} mm before (nominal model, tracker frame by Kabsch), {:.4f} mm after, largest {:.4f} mm "
-      "(line {}); noise {:.4f} mm per axis (the tracker's scatter at rest {:.4f} mm); condition {:.3g}\n",
-      1e3 * id.rms_before, 1e3 * id.rms_after, 1e3 * id.max_after,
-      log.lines[set.points[static_cast<std::size_t>(id.max_after_index)]], 1e3 * id.sigma, 1e3 * scatter_at_rest(set),
-      id.condition);
-  text += fmt::format("{:<12} {:>12} {:>12} {:>10} {:>12}\n", "parameter", "nominal", "estimate", "sd", "change");
-  for (const ParameterRow& r : parameter_rows(model, id)) {
-    const std::string change = r.name == "lead" ? fmt::format("{:+.4f} %", 100.0 * (r.estimate / r.nominal - 1.0))
-                                                : fmt::format("{:+.4f}", r.scale * (r.estimate - r.nominal));
-    text += fmt::format("{:<12} {:>12.{}f} {:>12.{}f} {:>10.{}f} {:>12}  [{}]\n", r.name, r.scale * r.nominal,
-                        r.decimals, r.scale * r.estimate, r.decimals, r.scale * r.sd, r.decimals, change, r.unit);
-  }
-  const Eigen::AngleAxisd turn(id.estimate.X_BT.R);
-  text += fmt::format(
-      "tracker frame in the base frame: origin ({:.4f}, {:.4f}, {:.4f}) m, turned {:.4f} deg about "
-      "({:.4f}, {:.4f}, {:.4f})\n",
-      id.estimate.X_BT.t.x(), id.estimate.X_BT.t.y(), id.estimate.X_BT.t.z(), rad2deg(turn.angle()), turn.axis().x(),
-      turn.axis().y(), turn.axis().z());
-  text += fmt::format("wrote {}: the corrected configuration", o.out);
-  write_stdout_or_withdraw(text + "\n", {o.out});
+  std::string text = o.json ? json_report(report, std::string(), true) : text_report(report);
+  if (!o.json)
+    text += fmt::format("wrote {}: the corrected configuration (legs form){}\n", o.out,
+                        o.no_figures ? "" : ", and the map of its predicted accuracy beside it");
+  write_stdout_or_withdraw(text, files.paths());
   return kExitOk;
 }
 
@@ -287,26 +454,45 @@ Command make_identify_command(CLI::App& root) {
   auto o = std::make_shared<IdentifyOptions>();
   CLI::App* app = root.add_subcommand(
       "identify",
-      "Estimates, by nonlinear least squares (Ceres), the screw lead, the sign of the twist term (thread hand), each "
-      "leg's zero-length offset, the observation point and the tracker frame from a laser tracker's point log of the "
-      "observation point, using the points where the platform stood still; reports each with its standard deviation "
-      "and the residual before and after, and writes the corrected configuration (YAML). Record a run that stops at "
-      "many poses (--stations): the paper's tests alone leave some offsets undetermined. Exit 5 when the data do not "
-      "determine the parameters, the thread hand is not decided (both signs fit alike) or the solver does not "
-      "converge; exit 4 if the configuration cannot be written. --json is printed on failure too, its status "
-      "agreeing with the exit code and null where there is no value.");
+      "Calibrates the platform from a laser tracker's point log of one or more targets on it, taken at stations "
+      "where it stood still: by nonlinear least squares (Ceres), twist-aware, the twelve U-joint centres, the "
+      "screw lead(s), the thread sense, each leg's zero offset, the targets and the tracker frame (--model geometry; "
+      "--model basic keeps the joints as configured). The library decides: every parameter determined, the fit as "
+      "good as the tracker's noise (an F test at 5 sigma), the thread sense decided; it reports standard deviations, "
+      "a cross-validation over the stations and the accuracy it predicts, and writes the corrected configuration "
+      "(legs form) with a map of that accuracy. Exit 5 when the data do not determine the parameters, the model does "
+      "not explain them, the thread sense is not decided or the solver does not converge; exit 4 if a file cannot "
+      "be written. --json is printed on failure too, its status agreeing with the exit code.");
   add_log_options(*app, o->log);
   add_run_options(*app, o->run);
   app->add_option("--settle", o->settle,
                   "Use the points whose commanded pose has been still for this long [s]; 0 = every point (the servo "
                   "lags in motion)")
       ->capture_default_str();
+  app->add_option("--model", o->model,
+                  "geometry: the joint centres too (the default); basic: lead, thread sense, offsets, targets and "
+                  "tracker frame on the configured joints")
+      ->check(CLI::IsMember({"geometry", "basic"}))
+      ->capture_default_str();
   app->add_option("--lead-effect", o->lead_effect,
                   "travel: the drives turn the screws by the nominal lead's angles, so a wrong lead also scales the "
                   "travel; twist: only the twist term sees it (the drives' travel is right)")
       ->check(CLI::IsMember({"travel", "twist"}))
       ->capture_default_str();
-  app->add_option("--out", o->out, "The corrected configuration to write (YAML)")->capture_default_str();
+  app->add_option("--axes", o->axes,
+                  "U-joint fixed axes (geometry model): auto fits those the data determine to 0.1 deg, none keeps "
+                  "them as configured, all fits every one")
+      ->check(CLI::IsMember({"auto", "none", "all"}))
+      ->capture_default_str();
+  app->add_option("--tracker-noise-um", o->tracker_noise_um,
+                  "The tracker's noise per axis [um], for logs without repeated points at rest (default: their "
+                  "scatter at rest)");
+  app->add_option("--folds", o->folds, "Cross-validation folds over the stations; 0 = none")->capture_default_str();
+  app->add_option("--out", o->out,
+                  "The corrected configuration to write (YAML); its accuracy map goes beside it as "
+                  "<stem>_accuracy.png/.svg")
+      ->capture_default_str();
+  app->add_flag("--no-figures", o->no_figures, "Skip the accuracy map (gnuplot)");
   app->add_flag("--json", o->json, "Machine-readable output (SI units: m, rad)");
   return {app, [o] { return run_identify(*o); }};
 }

@@ -24,10 +24,13 @@ struct SynthOptions {
   double noise_um = 10.0;
   double rate = 100.0;
   std::uint64_t seed = 1;
-  double lead_error_pct = 0.0;
+  std::string lead_error_pct = "0";
   bool flip_sign = false;
   std::string offsets_mm = "0";
   std::string point_offset_mm = "0,0,0";
+  double joint_errors_mm = 0.0;
+  double axis_errors_deg = 0.0;
+  std::string targets_mm;
   std::string out;
   std::string run_out;
 };
@@ -35,6 +38,7 @@ struct SynthOptions {
 std::string truth_json(const Config& config, const SynthOptions& o, const Run& run, const SynthesisOptions& so,
                        const SyntheticLog& log) {
   const Model& model = config.rig.model();
+  const Model real = real_model(model, so.errors);
   JsonWriter j;
   j.begin_object()
       .field("command", "synth")
@@ -55,14 +59,49 @@ std::string truth_json(const Config& config, const SynthOptions& o, const Run& r
   j.end_object();
   j.field("noise", so.noise);
   j.key("errors").begin_object();
-  j.field("lead_error", so.errors.lead_error)
-      .field("lead_nominal", model.leg(0).lead)
-      .field("lead_real", model.leg(0).lead * (1.0 + so.errors.lead_error))
-      .field("flip_twist_sign", so.errors.flip_twist_sign)
-      .field("twist_sign_nominal", model.leg(0).twist_sign)
-      .field("twist_sign_real", so.errors.flip_twist_sign ? -model.leg(0).twist_sign : model.leg(0).twist_sign);
+  j.key("lead_error").vector(so.errors.lead_error);
+  j.field("flip_twist_sign", so.errors.flip_twist_sign);
   j.key("zero_offset").vector(so.errors.zero_offset);
   j.key("observation_offset_P").vector(so.errors.observation_offset_P);
+  j.key("base_offset_B").begin_array();
+  for (int i = 0; i < kLegs; ++i) j.vector(Vector3d(so.errors.base_offset_B.row(i).transpose()));
+  j.end_array();
+  j.key("platform_offset_P").begin_array();
+  for (int i = 0; i < kLegs; ++i) j.vector(Vector3d(so.errors.platform_offset_P.row(i).transpose()));
+  j.end_array();
+  j.key("base_axis_rotation").begin_array();
+  for (int i = 0; i < kLegs; ++i) j.vector(Vector3d(so.errors.base_axis_rotation.row(i).transpose()));
+  j.end_array();
+  j.key("platform_axis_rotation").begin_array();
+  for (int i = 0; i < kLegs; ++i) j.vector(Vector3d(so.errors.platform_axis_rotation.row(i).transpose()));
+  j.end_array();
+  j.end_object();
+  // The real platform itself, in the gauge frames (the joints' errors have no rigid part).
+  j.key("real").begin_object();
+  const auto legs = [&](const char* key, const auto& get) {
+    j.key(key).begin_array();
+    for (const LegSpec& leg : real.spec().legs) j.vector(get(leg));
+    j.end_array();
+  };
+  legs("base_joints", [](const LegSpec& l) { return l.base_B; });
+  legs("platform_joints", [](const LegSpec& l) { return l.platform_P; });
+  legs("base_axes", [](const LegSpec& l) { return l.axis_base_B; });
+  legs("platform_axes", [](const LegSpec& l) { return l.axis_platform_P; });
+  j.key("leads").begin_array();
+  for (int i = 0; i < kLegs; ++i) j.value(real.leg(i).lead);
+  j.end_array();
+  j.key("drive_leads").begin_array();
+  for (int i = 0; i < kLegs; ++i) j.value(real.leg(i).lead / real.leg(i).drive_scale);
+  j.end_array();
+  j.key("threads").begin_array();
+  for (int i = 0; i < kLegs; ++i) j.value(real.leg(i).thread == ThreadSense::Right ? "right" : "left");
+  j.end_array();
+  j.key("length_offsets").vector(real.geometry().length_offset);
+  j.key("home_commands").vector(real.home_command());
+  j.key("targets").begin_array();
+  j.vector(real.spec().observation_P);
+  for (const Vector3d& t : so.extra_targets_P) j.vector(t);
+  j.end_array();
   j.end_object().end_object();
   return j.str();
 }
@@ -92,14 +131,23 @@ int run_synth(const SynthOptions& o) {
                            "this one would drown every motion",
                            stroke_um));
   check_option(o.rate > 0.0, "--rate", o.rate, "a sample rate > 0 [Hz]");
-  check_option(o.lead_error_pct > -100.0 && o.lead_error_pct < 1e4, "--lead-error-pct", o.lead_error_pct,
-               "a lead error above -100 % (-100 % is a zero lead) and below 1e4 %");
+
   SynthesisOptions so;
   so.strategy = strategy_of(o.run);
   so.noise = o.noise_um / 1e6;
   so.rate = o.rate;
   so.seed = o.seed;
-  so.errors.lead_error = o.lead_error_pct / 100.0;
+  {
+    constexpr const char* kLeadWhat =
+        "a lead error [%], or six (one per leg), each above -100 (a zero lead) and below 100";
+    const bool six = o.lead_error_pct.find(',') != std::string::npos;
+    const std::vector<double> pct = parse_numbers(o.lead_error_pct, six ? 6 : 1, "--lead-error-pct", kLeadWhat);
+    for (int i = 0; i < kLegs; ++i) {
+      const double v = pct[six ? static_cast<std::size_t>(i) : 0];
+      check_option(v > -100.0 && v < 100.0, "--lead-error-pct", v, kLeadWhat);
+      so.errors.lead_error[i] = v / 100.0;
+    }
+  }
   so.errors.flip_twist_sign = o.flip_sign;
   if (o.offsets_mm.find(',') == std::string::npos) {
     const double bound = parse_numbers(o.offsets_mm, 1, "--offsets-mm", "a bound [mm], or six offsets [mm]")[0];
@@ -119,6 +167,30 @@ int run_synth(const SynthOptions& o) {
     check_option(std::abs(v) < 1e-3 * stroke_um, "--point-offset-mm", v,
                  fmt::format("offsets below the stroke ({:g} mm) in magnitude [mm]", 1e-3 * stroke_um));
   so.errors.observation_offset_P = Vector3d(point[0], point[1], point[2]) / 1e3;
+  // Joint-centre and axis errors (theory §13): a bound each, drawn per coordinate, no rigid part.
+  check_option(o.joint_errors_mm >= 0.0 && o.joint_errors_mm <= 50.0, "--joint-errors-mm", o.joint_errors_mm,
+               "a bound >= 0 and at most 50 [mm]");
+  check_option(o.axis_errors_deg >= 0.0 && o.axis_errors_deg <= 10.0, "--axis-errors-deg", o.axis_errors_deg,
+               "a bound >= 0 and at most 10 [deg]");
+  random_geometry_errors(rig.model(), o.joint_errors_mm / 1e3, deg2rad(o.axis_errors_deg), o.seed, so.errors);
+  if (!o.targets_mm.empty()) {
+    // "x,y,z;x,y,z" [mm, P]: more targets besides the observation point.
+    std::size_t begin = 0;
+    for (;;) {
+      const std::size_t semi = o.targets_mm.find(';', begin);
+      const std::vector<double> t =
+          parse_numbers(o.targets_mm.substr(begin, semi == std::string::npos ? std::string::npos : semi - begin), 3,
+                        "--targets-mm", "x,y,z [mm, platform] of each target, ';' between targets");
+      for (const double v : t)
+        check_option(std::abs(v) < 1e4, "--targets-mm", v, "coordinates below 10 m in magnitude [mm]");
+      so.extra_targets_P.emplace_back(t[0] / 1e3, t[1] / 1e3, t[2] / 1e3);
+      if (semi == std::string::npos) break;
+      begin = semi + 1;
+    }
+    if (so.extra_targets_P.size() + 1 > kMaxTargets)
+      throw ExitError(kExitBadInput, fmt::format("--targets-mm: {} targets with the observation point, at most {}",
+                                                 so.extra_targets_P.size() + 1, kMaxTargets));
+  }
 
   SimulationIssue issue;
   if (const Status s = check_trajectory(rig, run.test.trajectory, issue); s != Status::Ok)
@@ -142,10 +214,14 @@ int run_synth(const SynthOptions& o) {
 
   // Like a tracker's export: millimetres with a unit suffix, 1 nm resolution (noise-free logs stay exact enough).
   fmt::memory_buffer b;
-  fmt::format_to(std::back_inserter(b), "t_s,x_mm,y_mm,z_mm\n");
+  const bool targets = !so.extra_targets_P.empty();
+  fmt::format_to(std::back_inserter(b), "{}", targets ? "t_s,target,x_mm,y_mm,z_mm\n" : "t_s,x_mm,y_mm,z_mm\n");
   for (std::size_t k = 0; k < log.log.points_T.size(); ++k) {
     const Vector3d p = 1e3 * log.log.points_T[k];
-    fmt::format_to(std::back_inserter(b), "{:.6f},{:.6f},{:.6f},{:.6f}\n", log.log.stamps[k], p.x(), p.y(), p.z());
+    fmt::format_to(std::back_inserter(b), "{:.6f},", log.log.stamps[k]);
+    if (targets)
+      fmt::format_to(std::back_inserter(b), "{},", log.log.target_names[static_cast<std::size_t>(log.log.targets[k])]);
+    fmt::format_to(std::back_inserter(b), "{:.6f},{:.6f},{:.6f}\n", p.x(), p.y(), p.z());
   }
   OutputSet files;
   files.add(out, fmt::to_string(b));
@@ -160,11 +236,27 @@ int run_synth(const SynthOptions& o) {
   std::string text = fmt::format("hexatwist synth on {}: {}\n", model_source(o.run.model), rig.model().spec().name);
   text += fmt::format("run: {}, {} commands, {:.2f} s: {} points at {:g} Hz\n", run.test.description, o.run.strategy,
                       run.test.trajectory.duration(), log.log.points_T.size(), so.rate);
-  text +=
-      fmt::format("real platform: lead {:+g}% ({:g} mm), twist sign {}, zero offsets [{}] mm, point offset [{}] mm\n",
-                  o.lead_error_pct, 1e3 * rig.model().leg(0).lead * (1.0 + so.errors.lead_error),
-                  so.errors.flip_twist_sign ? "flipped" : "as modelled", mm_list(so.errors.zero_offset),
-                  mm_list(so.errors.observation_offset_P));
+  const bool one_lead = (so.errors.lead_error.array() == so.errors.lead_error[0]).all();
+  text += fmt::format(
+      "real platform: lead {} ({} mm), twist sign {}, zero offsets [{}] mm, point offset [{}] mm\n",
+      one_lead ? fmt::format("{:+g}%", 100.0 * so.errors.lead_error[0]) : "errors [" + o.lead_error_pct + "] %",
+      one_lead
+          ? fmt::format("{:g}", 1e3 * rig.model().leg(0).lead * (1.0 + so.errors.lead_error[0]))
+          : mm_list(
+                Vector6d(so.errors.lead_error.array() + 1.0).cwiseProduct(Vector6d::Constant(rig.model().leg(0).lead))),
+      so.errors.flip_twist_sign ? "flipped" : "as modelled", mm_list(so.errors.zero_offset),
+      mm_list(so.errors.observation_offset_P));
+  if (o.joint_errors_mm > 0.0 || o.axis_errors_deg > 0.0)
+    text += fmt::format(
+        "joints: centres off by up to {:.4f} mm (within ±{:g} mm per coordinate, no rigid part), axes turned by up to "
+        "{:.3f} deg\n",
+        1e3 * std::max(so.errors.base_offset_B.rowwise().norm().maxCoeff(),
+                       so.errors.platform_offset_P.rowwise().norm().maxCoeff()),
+        o.joint_errors_mm,
+        rad2deg(std::max(so.errors.base_axis_rotation.rowwise().norm().maxCoeff(),
+                         so.errors.platform_axis_rotation.rowwise().norm().maxCoeff())),
+        o.axis_errors_deg);
+  if (targets) text += fmt::format("targets: A and {} more, measured at every sample\n", so.extra_targets_P.size());
   text += fmt::format("tracker: origin ({:.3f}, {:.3f}, {:.3f}) m in the base frame, noise {:g} um per axis, seed {}\n",
                       origin.x(), origin.y(), origin.z(), o.noise_um, o.seed);
   text += o.run_out.empty() ? fmt::format("wrote {} and {}", out, truth)
@@ -182,10 +274,11 @@ Command make_synth_command(CLI::App& root) {
   CLI::App* app = root.add_subcommand(
       "synth",
       "A tracker-like point log made from the closed-loop simulation: the real platform differs from the model by "
-      "known errors (lead, twist sign, zero offsets, observation point), the points are in a random tracker frame "
-      "with Gaussian noise. Writes FILE.csv (t_s,x_mm,y_mm,z_mm) and FILE.truth.json (SI: the tracker frame X_BT, the "
-      "errors, the noise) beside it, all files or none; outputs naming the same file are refused (exit 2). Input for "
-      "measure.");
+      "known errors (joint centres and axes, leads, twist sign, zero offsets, observation point), the points of one "
+      "or more targets are in a random tracker frame with Gaussian noise. Writes FILE.csv (t_s,x_mm,y_mm,z_mm; a "
+      "target column with --targets-mm) and FILE.truth.json (SI: the tracker frame X_BT, the errors, the real "
+      "platform, the noise) beside it, all files or none; outputs naming the same file are refused (exit 2). Input "
+      "for measure and identify.");
   add_run_options(*app, o->run);
   app->add_option("--noise-um", o->noise_um, "Tracker noise, standard deviation per axis [um], >= 0")
       ->capture_default_str();
@@ -194,8 +287,19 @@ Command make_synth_command(CLI::App& root) {
   app->add_option("--seed", o->seed, "Seed of the tracker's placement, the noise and random offsets")
       ->capture_default_str();
   app->add_option("--lead-error-pct", o->lead_error_pct,
-                  "Real lead minus nominal, in % of the nominal; above -100 (a zero lead)")
+                  "Real lead minus nominal, in % of the nominal (the drives keep the nominal lead); one for every "
+                  "leg, or six comma-separated; each in (-100, 100)")
       ->capture_default_str();
+  app->add_option("--joint-errors-mm", o->joint_errors_mm,
+                  "U-joint centres off by up to this in every coordinate [mm], drawn uniformly (seeded), the rigid "
+                  "part per set removed (the truth is in the gauge frames)")
+      ->capture_default_str();
+  app->add_option("--axis-errors-deg", o->axis_errors_deg,
+                  "U-joint fixed axes turned by up to this about each of the two directions across them [deg]")
+      ->capture_default_str();
+  app->add_option("--targets-mm", o->targets_mm,
+                  "More targets on the platform, measured at every sample after A: \"x,y,z;x,y,z\" [mm, platform]; the "
+                  "log gets a target column (A, T2, T3, ...)");
   app->add_flag("--flip-sign", o->flip_sign, "The real twist term has the opposite sign (other thread hand)");
   app->add_option("--offsets-mm", o->offsets_mm,
                   "Zero-length offset of each leg's motor-side length [mm]: one number B draws each uniformly in "

@@ -140,14 +140,13 @@ void expose_errors(py::module_& m) {
 
   // Status codes as stored in the batch results' int8 `status` arrays.
   py::list names;
-  for (int s = 0; s <= static_cast<int>(Status::AssemblyModeChanged); ++s)
+  for (int s = 0; s <= static_cast<int>(kLastStatus); ++s)
     names.append(py::str(std::string(to_string(static_cast<Status>(s)))));
   m.attr("STATUS_NAMES") = py::tuple(names);
   m.def(
       "describe_status",
       [](int s) {
-        if (s < 0 || s > static_cast<int>(Status::AssemblyModeChanged))
-          raise_input("status: no status " + std::to_string(s));
+        if (s < 0 || s > static_cast<int>(kLastStatus)) raise_input("status: no status " + std::to_string(s));
         return std::string(describe(static_cast<Status>(s)));
       },
       py::arg("status"), "One-sentence description of a status code.");

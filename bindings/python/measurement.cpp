@@ -1,5 +1,5 @@
-// Measurement and identification: a tracker point log, the commanded run of a measured test, the
-// observations at rest, and the identification of lead, offsets, observation point and X_BT.
+// Measurement: a tracker point log (one or more targets), the commanded runs (a measured test, a
+// stations run), and the observations at rest an identification uses (identification.cpp).
 #include <pybind11/stl.h>
 
 #include "common.hpp"
@@ -8,6 +8,8 @@ namespace hexatwist::python {
 
 std::pair<std::string, std::string> read_yaml_source(const py::object& path_or_text);
 Config python_config(const py::object& src);
+
+std::vector<int> targets_of(const py::object& targets, std::size_t n);
 
 namespace {
 
@@ -28,18 +30,61 @@ const double* rows_of(const py::array& a, std::size_t cols, const char* name, st
   return static_cast<const double*>(a.data());
 }
 
-py::dict point_log(const py::object& src, const std::string& time_column, double length_unit, bool indexed) {
+py::dict point_log(const py::object& src, const std::string& time_column, double length_unit, bool indexed,
+                   const std::string& target_column) {
   auto [text, source] = read_yaml_source(src);
   PointLogFormat f;
   f.time_column = time_column;
   f.length_unit = length_unit;
   f.indexed = indexed;
+  f.target_column = target_column;
   const PointLog log = parse_point_log(text, source, f);
   py::dict d;
   d["stamps"] = vec(log.stamps.data(), log.stamps.size());
   d["points"] = points3(log.points_T);
+  d["targets"] = py::array_t<int>(static_cast<py::ssize_t>(log.targets.size()), log.targets.data());
+  d["target_names"] = py::cast(log.target_names);
   d["lines"] = py::array_t<int>(static_cast<py::ssize_t>(log.lines.size()), log.lines.data());
   d["source"] = log.source;
+  return d;
+}
+
+py::dict run_dict(const Trajectory& tr) {
+  py::array_t<double> t(static_cast<py::ssize_t>(tr.poses.size()));
+  py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
+  for (std::size_t k = 0; k < tr.poses.size(); ++k) {
+    t.mutable_data()[k] = tr.time(k);
+    const Vector6d v = tr.poses[k].to_vector();
+    std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
+  }
+  py::dict d;
+  d["t"] = t;
+  d["poses"] = q;
+  return d;
+}
+
+py::dict stations_run(const py::object& config_src, int count, std::uint64_t seed, const std::string& strategy,
+                      double translation, double rotation, const py::object& stations) {
+  const Config config = python_config(config_src);
+  StationsSpec spec;
+  spec.count = count;
+  spec.seed = seed;
+  spec.translation = translation;
+  spec.rotation = rotation;
+  std::vector<Vector6d> poses;
+  if (stations.is_none()) {
+    poses = random_stations(config.rig.model(), strategy_from(strategy), spec);
+  } else {
+    const Rows6 q = rows6(stations, "stations", false);
+    for (std::size_t i = 0; i < q.rows; ++i) poses.push_back(pose_row(q.data, i).to_vector());
+  }
+  const Trajectory tr =
+      station_run(config.rig.model(), strategy_from(strategy), poses, spec, config.rig.control_period());
+  py::dict d = run_dict(tr);
+  py::array_t<double> st({static_cast<py::ssize_t>(poses.size()), py::ssize_t{6}});
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    std::copy(poses[i].data(), poses[i].data() + 6, st.mutable_data() + 6 * i);
+  d["stations"] = st;
   return d;
 }
 
@@ -82,7 +127,8 @@ py::dict measured_test(const py::object& config_src, const std::string& test) {
 }
 
 py::dict observations(const Model& model, const py::array& t, const py::array& poses, const py::array& stamps,
-                      const py::array& points, double time_offset, const std::string& strategy, double settle) {
+                      const py::array& points, const py::object& targets, double time_offset,
+                      const std::string& strategy, double settle) {
   const TimedPoses tp = timed(t, poses);
   PointLog log;
   std::size_t ns = 0, np = 0;
@@ -93,8 +139,10 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
   if (ns != np) raise_input("stamps and points: expected as many stamps as points");
   py::array sc = py::module_::import("numpy").attr("ascontiguousarray")(stamps);
   log.stamps.assign(static_cast<const double*>(sc.data()), static_cast<const double*>(sc.data()) + ns);
+  const std::vector<int> target = targets_of(targets, np);
   for (std::size_t k = 0; k < np; ++k) {
     log.points_T.emplace_back(p[3 * k], p[3 * k + 1], p[3 * k + 2]);
+    log.targets.push_back(target[k]);
     log.lines.push_back(static_cast<int>(k) + 2);
     log.stamp_columns.push_back(1);
   }
@@ -116,81 +164,18 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
   return d;
 }
 
-py::dict params(const PlatformParameters& p) {
-  py::dict d;
-  d["lead"] = p.lead;
-  d["twist_sign"] = p.twist_sign;
-  d["length_offsets"] = vec(p.length_offset.data(), 6);
-  d["observation_point"] = vec(p.observation_P.data(), 3);
-  Eigen::Matrix<double, 3, 3, Eigen::RowMajor> R = p.X_BT.R;
-  py::array_t<double> r({3, 3});
-  std::copy(R.data(), R.data() + 9, r.mutable_data());
-  d["R_BT"] = r;
-  d["t_BT"] = vec(p.X_BT.t.data(), 3);
-  return d;
-}
-
-py::dict identify_py(const Model& model, const py::array& motor, const py::array& points,
-                     const std::string& lead_effect) {
-  std::size_t nm = 0, np = 0;
-  const double* m = rows_of(motor, 6, "motor", nm);
-  const double* p = rows_of(points, 3, "points", np);
-  if (nm != np) raise_input("motor and points: expected as many rows");
-  IdentificationOptions o;
-  if (lead_effect == "twist")
-    o.lead_effect = LeadEffect::TwistOnly;
-  else if (lead_effect == "travel")
-    o.lead_effect = LeadEffect::TwistAndTravel;
-  else
-    raise_input("lead_effect: expected 'twist' or 'travel', got '" + lead_effect + "'");
-  std::vector<Observation> obs(nm);
-  for (std::size_t k = 0; k < nm; ++k) {
-    obs[k].motor = Eigen::Map<const Vector6d>(m + 6 * k);
-    obs[k].p_T = Eigen::Map<const Vector3d>(p + 3 * k);
-  }
-  Identification id;
-  Status s;
-  {
-    py::gil_scoped_release release;
-    s = identify(model, obs, id, o);
-  }
-  py::dict d;
-  d["status"] = std::string(to_string(s));
-  d["reason"] = id.reason;
-  d["estimate"] = params(id.estimate);
-  d["sd"] = vec(id.sd.data(), kIdentifiedParameters);
-  py::list names;
-  for (int i = 0; i < kIdentifiedParameters; ++i) names.append(std::string(parameter_name(i)));
-  d["parameter_names"] = names;
-  Eigen::Matrix<double, kIdentifiedParameters, kIdentifiedParameters, Eigen::RowMajor> C = id.covariance;
-  py::array_t<double> cov({kIdentifiedParameters, kIdentifiedParameters});
-  std::copy(C.data(), C.data() + C.size(), cov.mutable_data());
-  d["covariance"] = cov;
-  d["sigma"] = id.sigma;
-  d["count"] = id.count;
-  d["rms_before"] = id.rms_before;
-  d["rms_after"] = id.rms_after;
-  d["max_after"] = id.max_after;
-  d["cost_ratio"] = id.cost_ratio;
-  d["condition"] = id.condition;
-  d["residuals"] = points3(id.residual_B);
-  if (s == Status::Ok) {
-    const ModelSpec spec = corrected_spec(model.spec(), id.estimate);
-    d["corrected_model"] = std::make_shared<Model>(spec);
-  }
-  return d;
-}
-
 }  // namespace
 
 void expose_measurement(py::module_& m) {
   m.def("_read_point_log", &point_log, py::arg("path_or_text"), py::arg("time_column") = "t",
-        py::arg("length_unit") = 0.0, py::arg("indexed") = false);
+        py::arg("length_unit") = 0.0, py::arg("indexed") = false, py::arg("target_column") = "");
+  m.def("_stations_run", &stations_run, py::arg("config") = py::none(), py::arg("count") = 40, py::arg("seed") = 1,
+        py::arg("strategy") = "compensated", py::arg("translation") = 0.25, py::arg("rotation") = deg2rad(15.0),
+        py::arg("stations") = py::none());
   m.def("_measured_test", &measured_test, py::arg("config") = py::none(), py::arg("test") = "Rz");
   m.def("_observations_at_rest", &observations, py::arg("model"), py::arg("t"), py::arg("poses"), py::arg("stamps"),
-        py::arg("points"), py::arg("time_offset") = 0.0, py::arg("strategy") = "compensated", py::arg("settle") = 0.25);
-  m.def("_identify", &identify_py, py::arg("model"), py::arg("motor"), py::arg("points"),
-        py::arg("lead_effect") = "twist");
+        py::arg("points"), py::arg("targets") = py::none(), py::arg("time_offset") = 0.0,
+        py::arg("strategy") = "compensated", py::arg("settle") = 0.25);
 }
 
 }  // namespace hexatwist::python

@@ -28,9 +28,14 @@
 
 #include "hexatwist/calibration/identification.hpp"
 #include "hexatwist/calibration/measurement.hpp"
+#include "hexatwist/calibration/observations.hpp"
 #include "hexatwist/calibration/parameter_errors.hpp"
+#include "hexatwist/calibration/parameter_set.hpp"
+#include "hexatwist/calibration/point_log.hpp"
 #include "hexatwist/calibration/registration.hpp"
+#include "hexatwist/calibration/stations.hpp"
 #include "hexatwist/calibration/synthesis.hpp"
 
 #include "hexatwist/io/config.hpp"
 #include "hexatwist/io/mjcf.hpp"
+#include "hexatwist/io/platform_yaml.hpp"

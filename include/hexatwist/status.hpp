@@ -27,8 +27,13 @@ enum class Status : int {
   PlatformSingularity,     ///< the pose is too close to a platform (Jacobian) singularity: the motor-side Jacobian's
                            ///< condition number exceeds limits.jacobian_condition_max
   AssemblyModeChanged,  ///< forward kinematics found a solution on another assembly mode than its start (the Jacobian
-                        ///< determinant changed sign)
+  SignUndecided,        ///< an identification: both thread senses explain the measurements about as well
+  ModelMismatch,  ///< an identification: the identified model leaves an error the tracker's noise does not explain
+                  ///< determinant changed sign)
 };
+
+/// The last status: every status is in Ok .. kLastStatus.
+inline constexpr Status kLastStatus = Status::ModelMismatch;
 
 /// True for the statuses that mean "this pose is outside a limit".
 constexpr bool is_limit(Status s) noexcept {

@@ -47,6 +47,10 @@ Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisO
   if (!(ratio <= 1e9))
     throw Error(fmt::format("rate: {} Hz is below the control rate {} Hz / 1e9", options.rate, control_rate));
   const Model real = real_model(rig.model(), options.errors);
+  if (options.extra_targets_P.size() + 1 > kMaxTargets)
+    throw Error(fmt::format("targets: {} targets, at most {}", options.extra_targets_P.size() + 1, kMaxTargets));
+  for (const Vector3d& t : options.extra_targets_P)
+    if (!t.allFinite()) throw Error("targets: expected finite points [m, P], got NaN or inf");
   const auto every = static_cast<std::size_t>(std::round(ratio));
 
   SimulationOptions sim;
@@ -57,13 +61,18 @@ Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisO
   const RigidTransform X_TB = inverse(out.X_BT);
   Random noise(options.seed ^ 0x9E3779B97F4A7C15ull);  // another stream than the placement's
   out.log.source = "synthetic log";
+  // Target 0 is the observation point; the others follow it at every sample, in their order.
+  std::vector<Vector3d> targets{real.spec().observation_P};
+  targets.insert(targets.end(), options.extra_targets_P.begin(), options.extra_targets_P.end());
+  out.log.target_names.push_back("A");
+  for (std::size_t t = 1; t < targets.size(); ++t) out.log.target_names.push_back(fmt::format("T{}", t + 1));
   FkResult fk;
   Placement guess = placement_from_pose(trajectory.poses.front());
-  Vector6d motor;
   for (std::size_t k = 0; k < out.simulation.size(); k += every) {
     const SimulationSample& sample = out.simulation[k];
-    real_motor_lengths(rig.model(), options.errors, sample.motor, motor);
-    if (const Status s = forward_kinematics(real, motor, LengthKind::Motor, guess, fk); s != Status::Ok) {
+    // The drives' motor-side lengths on the real platform: its leads, joints, offsets and the
+    // drives' reference and scale (real_model) give the pose the platform takes.
+    if (const Status s = forward_kinematics(real, sample.motor, LengthKind::Motor, guess, fk); s != Status::Ok) {
       issue.status = s;
       issue.index = k;
       issue.time = sample.time;
@@ -72,15 +81,18 @@ Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisO
       return s;
     }
     guess = fk.placement;
-    const Vector3d p_B = platform_point_B(real, fk.placement, real.spec().observation_P);
-    Vector3d p_T = apply(X_TB, p_B);
-    for (int a = 0; a < 3; ++a) p_T[a] += options.noise * noise.normal();
-    out.true_B.push_back(p_B);
-    out.ticks.push_back(k);
-    out.log.stamps.push_back(sample.time);
-    out.log.points_T.push_back(p_T);
-    out.log.lines.push_back(static_cast<int>(out.log.lines.size()) + 2);
-    out.log.stamp_columns.push_back(1);
+    for (std::size_t t = 0; t < targets.size(); ++t) {
+      const Vector3d p_B = platform_point_B(real, fk.placement, targets[t]);
+      Vector3d p_T = apply(X_TB, p_B);
+      for (int a = 0; a < 3; ++a) p_T[a] += options.noise * noise.normal();
+      out.true_B.push_back(p_B);
+      out.ticks.push_back(k);
+      out.log.stamps.push_back(sample.time);
+      out.log.points_T.push_back(p_T);
+      out.log.targets.push_back(static_cast<int>(t));
+      out.log.lines.push_back(static_cast<int>(out.log.lines.size()) + 2);
+      out.log.stamp_columns.push_back(1);
+    }
   }
   return Status::Ok;
 }

@@ -1,483 +1,490 @@
-// Identification (include/hexatwist/calibration/identification.hpp, theory §13) on synthetic tracker data made
-// here: the seed model is the nominal one, the "true" platform has its lead 5 % off, the other
-// thread hand, zero errors of up to 1 mm per leg and the observation point a few mm away, and a
-// tracker stands at a random place. The commands are the nominal model's compensated commands at
-// random poses across the workspace, a tenth of them at home (the paper's four test motions
-// determine the offsets too loosely, as one test here shows); the points are the true platform's
-// observation point in the tracker frame plus Gaussian noise. Checks: the issue's accuracies, the
-// reported standard deviations against the actual errors over seeds, exact recovery without
-// noise, the Jacobian against central differences, degenerate data, the travel model of the lead,
-// and the corrected model. Seed counts scale with HEXATWIST_STRESS (support.hpp).
+// Identification (include/hexatwist/calibration/identification.hpp, theory §13) on synthetic tracker
+// data made here (calibration_support.hpp): a real platform whose joint centres, leads, thread
+// sense, zero offsets and observation point differ from the seed by known amounts, seen by a
+// tracker at a random place at stations where the nominal model's commands hold it still. Checks:
+// the truth recovered within its reported standard deviations, and those honest over many seeds;
+// exact recovery without noise; the Jacobian against central differences (joints, axes, both
+// lead models, both senses, several targets); the decisions (undetermined data, a model that
+// leaves an error, a thread sense the data do not decide); cross-validation against its
+// expectation; per-leg threads and leads; several targets; the corrected platform on target at
+// poses not used, against the accuracy the covariance predicts. Seed counts scale with
+// HEXATWIST_STRESS (support.hpp).
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <cstdio>
 #include <vector>
 
-#include "support.hpp"
+#include "calibration/calibration_support.hpp"
 
 namespace hexatwist::test {
 namespace {
 
 constexpr double kTrackerNoise = 10e-6;  // the paper's tracker class [m]
 
-double gaussian(std::mt19937_64& rng) { return std::normal_distribution<double>(0.0, 1.0)(rng); }
-
-Matrix3d random_rotation(std::mt19937_64& rng) {
-  Eigen::Quaterniond q(gaussian(rng), gaussian(rng), gaussian(rng), gaussian(rng));
-  return q.normalized().toRotationMatrix();
-}
-
-// Poses of the paper's four tests (Lz, Lx, Rz, Ry, theory §9) every `dt` seconds: the motions a
-// user runs anyway, with their dwells at home and at the extremes.
-std::vector<Pose> paper_poses(double dt, int only_test = -1) {
-  const StudySpec spec;
-  std::vector<Pose> poses;
-  const std::vector<StudyTest> tests = seed_tests(spec);
-  for (std::size_t i = 0; i < tests.size(); ++i) {
-    if (only_test >= 0 && static_cast<int>(i) != only_test) continue;
-    const Trajectory t = test_trajectory(spec, tests[i], dt);
-    poses.insert(poses.end(), t.poses.begin(), t.poses.end());
-  }
-  return poses;
-}
-
-// A platform that differs from the nominal one as issue 5 says, and what it is.
-struct Truth {
-  ModelSpec spec;        // the real platform (offsets in the spec, the other thread hand)
-  PlatformParameters p;  // its identified quantities and the tracker placement
-};
-
-Truth random_truth(const Model& nominal, std::mt19937_64& rng) {
-  Truth truth;
-  truth.spec = nominal.spec();
-  const double lead = 1.05 * nominal.leg(0).lead;
-  const ThreadSense thread = nominal.leg(0).thread == ThreadSense::Right ? ThreadSense::Left : ThreadSense::Right;
-  for (int i = 0; i < kLegs; ++i) {
-    LegSpec& leg = truth.spec.legs[static_cast<std::size_t>(i)];
-    leg.lead = lead;
-    leg.thread = thread;
-    leg.length_offset = uniform(rng, -1e-3, 1e-3);
-    truth.p.length_offset[i] = leg.length_offset;
-  }
-  for (int k = 0; k < 3; ++k) truth.spec.observation_P[k] += uniform(rng, -3e-3, 3e-3);
-  truth.p.lead = lead;
-  truth.p.twist_sign = thread == ThreadSense::Right ? 1.0 : -1.0;
-  truth.p.observation_P = truth.spec.observation_P;
-  truth.p.X_BT = {random_rotation(rng), Vector3d(uniform(rng, -5, 5), uniform(rng, -5, 5), uniform(rng, -2, 2))};
-  return truth;
-}
-
-// The nominal model's compensated commands at `poses` and where the true platform puts A, seen by
-// the tracker with Gaussian noise `sigma` per coordinate. With the travel effect the drives
-// turned the screws by the nominal lead's angles, so the real motor-side lengths move by
-// lead/nominal lead times the commanded travel from home.
-std::vector<Observation> observe(const Model& nominal, const Truth& truth, const std::vector<Pose>& poses, double sigma,
-                                 std::mt19937_64& rng, LeadEffect effect = LeadEffect::TwistOnly) {
-  const Model real(truth.spec);
-  const RigidTransform X_TB = inverse(truth.p.X_BT);
-  std::vector<Observation> out;
-  for (const Pose& pose : poses) {
-    Observation o;
-    LimitReport limit;
-    EXPECT_EQ(motor_commands(nominal, pose, Strategy::Compensated, o.motor, limit), Status::Ok) << str(pose);
-    Vector6d motor = o.motor;
-    if (effect == LeadEffect::TwistAndTravel) {
-      const Vector6d home = nominal.length_home() - nominal.geometry().length_offset;
-      motor = home + (o.motor - home) * (truth.p.lead / nominal.leg(0).lead);
+// The truth in the order of `set` (tracker rotation: zero; compare X_BT apart).
+Eigen::VectorXd truth_vector(const ParameterSet& set, const Truth& truth) {
+  Eigen::VectorXd theta = Eigen::VectorXd::Zero(set.size());
+  const ModelSpec& nominal = set.nominal();
+  for (int j = 0; j < set.lead_count(); ++j) theta[j] = truth.spec.legs[static_cast<std::size_t>(j)].lead;
+  for (int i = 0; i < kLegs; ++i)
+    theta[set.offset_index() + i] = truth.spec.legs[static_cast<std::size_t>(i)].length_offset;
+  if (set.model() == CalibrationModel::Geometry) {
+    Eigen::VectorXd db(3 * kLegs), dp(3 * kLegs);
+    for (int i = 0; i < kLegs; ++i) {
+      db.segment<3>(3 * i) =
+          truth.spec.legs[static_cast<std::size_t>(i)].base_B - nominal.legs[static_cast<std::size_t>(i)].base_B;
+      dp.segment<3>(3 * i) = truth.spec.legs[static_cast<std::size_t>(i)].platform_P -
+                             nominal.legs[static_cast<std::size_t>(i)].platform_P;
     }
-    FkResult fk;
-    EXPECT_EQ(forward_kinematics(real, motor, LengthKind::Motor, placement_from_pose(pose), fk), Status::Ok)
-        << str(pose);
-    const Vector3d noise(gaussian(rng), gaussian(rng), gaussian(rng));
-    o.p_T = apply(X_TB, platform_point_B(real, fk.placement, truth.p.observation_P)) + sigma * noise;
-    out.push_back(o);
+    theta.segment(set.base_index(), 3 * kLegs - 6) = set.base_basis().transpose() * db;
+    theta.segment(set.platform_index(), 3 * kLegs - 6) = set.platform_basis().transpose() * dp;
+    for (int a = 0, k = set.axis_index(); a < 2 * kLegs; ++a) {
+      if (!set.axes()[static_cast<std::size_t>(a)]) continue;
+      const LegSpec& n = nominal.legs[static_cast<std::size_t>(a % kLegs)];
+      const LegSpec& r = truth.spec.legs[static_cast<std::size_t>(a % kLegs)];
+      const Vector3d axis0 = (a < kLegs ? n.axis_base_B : n.axis_platform_P).normalized();
+      Vector3d axis = a < kLegs ? r.axis_base_B : r.axis_platform_P;
+      axis /= axis.dot(axis0);  // axis0 + u1 e1 + u2 e2
+      theta[k] = axis.dot(set.axis_directions(a)[0]);
+      theta[k + 1] = axis.dot(set.axis_directions(a)[1]);
+      k += 2;
+    }
   }
-  return out;
+  for (std::size_t t = 0; t < truth.targets.size(); ++t)
+    theta.segment<3>(set.target_index() + 3 * static_cast<int>(t)) = truth.targets[t];
+  theta.segment<3>(set.translation_index()) = truth.X_BT.t;
+  return theta;
 }
 
-// Estimate minus truth in the parameter order (rotation: dw with R_est = exp(dw) R_true).
-ParameterVector parameter_error(const PlatformParameters& est, const PlatformParameters& truth) {
-  ParameterVector d;
-  d[kLeadIndex] = est.lead - truth.lead;
-  d.segment<6>(kOffsetIndex) = est.length_offset - truth.length_offset;
-  d.segment<3>(kObservationIndex) = est.observation_P - truth.observation_P;
-  const Eigen::AngleAxisd r(Matrix3d(est.X_BT.R * truth.X_BT.R.transpose()));
-  d.segment<3>(kRotationIndex) = r.angle() * r.axis();
-  d.segment<3>(kTranslationIndex) = est.X_BT.t - truth.X_BT.t;
+// Estimate minus truth, the tracker rotation as dw with R_est = exp(dw) R_true.
+Eigen::VectorXd parameter_error(const Identification& id, const Truth& truth) {
+  Eigen::VectorXd d = id.estimate - truth_vector(id.parameters, truth);
+  const Eigen::AngleAxisd r(Matrix3d(id.X_BT.R * truth.X_BT.R.transpose()));
+  d.segment<3>(id.parameters.rotation_index()) = r.angle() * r.axis();
   return d;
 }
 
-// The errors issue 5 bounds, and the others.
-struct Errors {
-  double lead_relative;  // |lead - true| / true
-  double offset;         // largest |offset - true| [m]
-  double observation;    // |A - true| [m]
-  double rotation;       // angle of R_est R_true^T [rad]
-  double transfer;       // |X_est c - X_true c| at the points' centroid c [m]
-};
-
-Errors errors_of(const PlatformParameters& est, const PlatformParameters& truth, const std::vector<Observation>& obs) {
-  Vector3d c = Vector3d::Zero();
-  for (const Observation& o : obs) c += o.p_T / static_cast<double>(obs.size());
-  const ParameterVector d = parameter_error(est, truth);
-  return {std::abs(d[kLeadIndex]) / truth.lead, d.segment<6>(kOffsetIndex).cwiseAbs().maxCoeff(),
-          d.segment<3>(kObservationIndex).norm(), d.segment<3>(kRotationIndex).norm(),
-          (apply(est.X_BT, c) - apply(truth.X_BT, c)).norm()};
+// The seed's tracker data: `stations` random stations within +-0.25 m and +-15 deg (home first),
+// `points` points of each target at each.
+std::vector<Observation> station_data(const Truth& truth, int stations, int points, double sigma, std::mt19937_64& rng,
+                                      Strategy strategy = Strategy::Compensated) {
+  const Model real(truth.spec);
+  const std::vector<Pose> poses = random_station_poses(seed_model(), real, stations, 0.25, deg2rad(15), rng);
+  return observe(seed_model(), truth, poses, points, sigma, rng, strategy);
 }
 
-// A calibration run: `count` random poses inside every limit of the nominal model (+-0.5 m,
-// +-30 deg), a tenth of them at home (the dwells before, between and after the moves).
-std::vector<Pose> calibration_poses(int count, std::mt19937_64& rng) {
-  std::vector<Pose> poses;
-  for (int k = 0; k < count; ++k)
-    poses.push_back(k % 10 == 0 ? Pose{} : random_valid_pose(seed_model(), rng, 0.5, deg2rad(30)));
-  return poses;
+IdentificationOptions quick(IdentificationOptions o = {}) {
+  o.folds = 0;
+  o.accuracy_poses = 50;
+  return o;
 }
 
-// Runs identify on `obs` and expects Ok.
-Identification identified(const std::vector<Observation>& obs, const IdentificationOptions& options = {}) {
-  Identification id;
-  EXPECT_EQ(identify(seed_model(), obs, id, options), Status::Ok) << id.reason;
-  return id;
-}
-
-TEST(Identification, RecoversLeadSignOffsetsAndObservationPointFromACalibrationRun) {
-  // Issue 5: lead within 0.5 %, the sign, offsets within 20 um at 10 um tracker noise. The data
-  // are 2000 random poses (a tenth at home): the paper's four tests alone determine the offsets
-  // only to 30-110 um (IdentifiabilityOfThePaperTests). The bounds are the issue's; that they
-  // hold by design, and not by luck, shows in the reported standard deviations: 4 sd must fit
-  // inside each bound (measured sd: lead 0.049 %, offsets 3.1-4.7 um).
-  const Model& nominal = seed_model();
+TEST(Identification, GeometryRecoversEveryJointCentreLeadOffsetAndPointWithinItsStandardDeviations) {
+  // The issue's case: joints off by up to 1 mm, the lead 2.5 % long, offsets +-0.5 mm, A off by
+  // 2 mm, 40 stations at 10 um. Every parameter within 4 sd of the truth; the joints determined
+  // to 5-80 um (issue 21).
   for (std::uint32_t seed = 1; seed <= 3; ++seed) {
     SCOPED_TRACE(seed);
     std::mt19937_64 rng(kSeed + seed);
-    const Truth truth = random_truth(nominal, rng);
-    const std::vector<Observation> obs = observe(nominal, truth, calibration_poses(2000, rng), kTrackerNoise, rng);
-    const Identification id = identified(obs);
-    const Errors e = errors_of(id.estimate, truth.p, obs);
-    std::printf("  seed %u: %d observations; rms before %.4g mm, after %.4g um; sigma %.4g um; condition %.3g\n", seed,
-                id.count, 1e3 * id.rms_before, 1e6 * id.rms_after, 1e6 * id.sigma, id.condition);
-    std::printf("    sign %+.0f, cost ratio %.3g, iterations %d (sign +1) and %d (sign -1)\n", id.estimate.twist_sign,
-                id.cost_ratio, id.fits[0].iterations, id.fits[1].iterations);
-    std::printf("    lead error %.3g %% (sd %.3g %%); largest offset error %.3g um (sd %.3g-%.3g um)\n",
-                100 * e.lead_relative, 100 * id.sd[kLeadIndex] / truth.p.lead, 1e6 * e.offset,
-                1e6 * id.sd.segment<6>(kOffsetIndex).minCoeff(), 1e6 * id.sd.segment<6>(kOffsetIndex).maxCoeff());
-    std::printf("    A error %.3g um (sd %.2g-%.2g um); rotation error %.3g urad; transfer error %.3g um\n",
-                1e6 * e.observation, 1e6 * id.sd.segment<3>(kObservationIndex).minCoeff(),
-                1e6 * id.sd.segment<3>(kObservationIndex).maxCoeff(), 1e6 * e.rotation, 1e6 * e.transfer);
-    EXPECT_EQ(id.estimate.twist_sign, truth.p.twist_sign);
-    EXPECT_LT(e.lead_relative, 0.005);
-    EXPECT_LT(e.offset, 20e-6);
-    EXPECT_LT(4 * id.sd[kLeadIndex], 0.005 * truth.p.lead);
-    EXPECT_LT(4 * id.sd.segment<6>(kOffsetIndex).maxCoeff(), 20e-6);
-    // The rejected sign leaves millimetre residuals: its cost is hundreds of times the chosen
-    // one's (measured 674-694), and its lead ends at 0.
-    EXPECT_GT(id.cost_ratio, 100.0);
-    EXPECT_TRUE(id.fits[id.estimate.twist_sign > 0 ? 1 : 0].lead_at_bound);
-    // Before: the nominal model misses by the parameter errors (1.08-1.32 mm rms); after: the noise
-    // alone. sigma has 3K - 16 degrees of freedom: relative sd 1 %, bound 5 %.
-    EXPECT_GT(id.rms_before, 30 * kTrackerNoise);
+    const Truth truth = random_truth(seed_model(), TruthErrors{}, rng);
+    const std::vector<Observation> obs = station_data(truth, 42, 20, kTrackerNoise, rng);
+    Identification id;
+    ASSERT_EQ(identify(seed_model(), obs, id, quick()), Status::Ok) << id.reason;
+    const Eigen::VectorXd d = parameter_error(id, truth);
+    double worst = 0.0;
+    for (int k = 0; k < id.parameters.size(); ++k) {
+      EXPECT_LT(std::abs(d[k]), 4.0 * id.sd[k]) << id.parameters.name(k);
+      worst = std::max(worst, std::abs(d[k]) / id.sd[k]);
+    }
+    const double joint_sd = std::max(id.base_shift_sd.maxCoeff(), id.platform_shift_sd.maxCoeff());
+    std::printf("  seed %u: worst error %.2f sd; joints sd %.1f-%.1f um; lead %.2g (sd %.2g); sigma %.2f um\n", seed,
+                worst, 1e6 * std::min(id.base_shift_sd.minCoeff(), id.platform_shift_sd.minCoeff()), 1e6 * joint_sd,
+                d[0] / truth.spec.legs[0].lead, id.sd[0] / truth.spec.legs[0].lead, 1e6 * id.sigma);
+    EXPECT_LT(joint_sd, 200e-6);  // issue 21: "5-80 um" on its run; random stations here
+    EXPECT_EQ(id.twist_sign, 1.0);
     EXPECT_NEAR(id.sigma, kTrackerNoise, 0.05 * kTrackerNoise);
-    EXPECT_NEAR(id.rms_after, std::sqrt(3.0 * (3 * id.count - kIdentifiedParameters) / (3 * id.count)) * id.sigma,
-                1e-12);
+    EXPECT_LT(id.fit_z, 5.0);
   }
 }
 
-TEST(Identification, ReportedStandardDeviationsMatchTheActualErrorsOverSeeds) {
-  // Over many seeds the errors, normalised by the reported covariance, must look like standard
-  // normal draws. The whole covariance is tested through the squared Mahalanobis distance
-  // d^2 = err^T C^-1 err, a chi^2 with 16 degrees of freedom: mean(d^2)/16 = 1 within 4 of its
-  // standard deviations sqrt(2 / (16 S)). Per parameter, z = err/sd: the mean within 4/sqrt(S),
-  // and S times the mean square is a chi^2 with S degrees of freedom, whose tails are heavier than
-  // a normal law's: it must lie between its 1e-4 and 1 - 1e-4 quantiles (Wilson-Hilferty; for
-  // S = 40, 0.37 to 2.06 for the mean square). A rounding difference between compilers changes
-  // which random poses pass the limits and so the draws; a bound at 4 normal sd (1.89) was
-  // crossed by one parameter in the clang build (1.94, from one seed at 4.4 sd) while the gcc
-  // build passed. An sd off by 1.45 or more fails here; the whole covariance is held to 4 % by
-  // d^2. The sign must be right every time.
-  const Model& nominal = seed_model();
-  const int S = stress(40);
-  double d2_sum = 0.0, smallest_ratio = std::numeric_limits<double>::infinity();
-  ParameterVector z_sum = ParameterVector::Zero(), z2_sum = ParameterVector::Zero();
-  for (int seed = 0; seed < S; ++seed) {
-    SCOPED_TRACE(seed);
+TEST(Identification, ReportedStandardDeviationsAreHonestOverFiftySeeds) {
+  // Over many seeds the errors, normalised by the reported standard deviations, must look like
+  // standard normal draws: the fraction inside 1 sd near 68.3 % (issue 21), and the whole
+  // covariance through the squared Mahalanobis distance d^2 = err^T C^-1 err, a chi^2 with p
+  // degrees of freedom: its mean over the seeds / p within 4 of its standard deviations sqrt(2/(p S)).
+  const int S = stress(50);
+  int inside = 0, total = 0;
+  double d2_sum = 0.0;
+  int p = 0;
+  for (int seed = 1; seed <= S; ++seed) {
     std::mt19937_64 rng(kSeed + 1000 + static_cast<std::uint32_t>(seed));
-    const Truth truth = random_truth(nominal, rng);
-    const std::vector<Observation> obs = observe(nominal, truth, calibration_poses(200, rng), kTrackerNoise, rng);
-    const Identification id = identified(obs);
-    ASSERT_EQ(id.estimate.twist_sign, truth.p.twist_sign);
-    smallest_ratio = std::min(smallest_ratio, id.cost_ratio);
-    const ParameterVector err = parameter_error(id.estimate, truth.p);
-    d2_sum += err.dot(id.covariance.ldlt().solve(err));
-    const ParameterVector z = err.cwiseQuotient(id.sd);
-    for (int j = 0; j < kIdentifiedParameters; ++j)
-      if (std::abs(z[j]) > 4.0)
-        std::printf("  seed %d: %s off by %.2f sd (cost ratio %.3g, iterations %d and %d, %s)\n", seed,
-                    std::string(parameter_name(j)).c_str(), z[j], id.cost_ratio, id.fits[0].iterations,
-                    id.fits[1].iterations, id.fits[id.estimate.twist_sign > 0 ? 0 : 1].message.c_str());
-    z_sum += z;
-    z2_sum += z.cwiseAbs2();
+    TruthErrors e;
+    e.flip = seed % 2 == 0;
+    const Truth truth = random_truth(seed_model(), e, rng);
+    const std::vector<Observation> obs = station_data(truth, 32, 8, kTrackerNoise, rng);
+    Identification id;
+    ASSERT_EQ(identify(seed_model(), obs, id, quick()), Status::Ok) << "seed " << seed << ": " << id.reason;
+    const Eigen::VectorXd d = parameter_error(id, truth);
+    for (int k = 0; k < d.size(); ++k) inside += std::abs(d[k]) < id.sd[k] ? 1 : 0;
+    total += static_cast<int>(d.size());
+    p = static_cast<int>(d.size());
+    d2_sum += d.dot(id.covariance.ldlt().solve(d));
   }
-  const double d2_mean = d2_sum / (S * kIdentifiedParameters);
-  const ParameterVector z_mean = z_sum / S, z2_mean = z2_sum / S;
-  std::printf("  %d seeds: mean d^2 / 16 = %.3f (tolerance %.3f); smallest sign cost ratio %.3g\n", S, d2_mean,
-              4 * std::sqrt(2.0 / (16.0 * S)), smallest_ratio);
-  for (int j = 0; j < kIdentifiedParameters; ++j)
-    std::printf("  %-14s mean z %+.3f, mean z^2 %.3f\n", std::string(parameter_name(j)).c_str(), z_mean[j], z2_mean[j]);
-  EXPECT_NEAR(d2_mean, 1.0, 4 * std::sqrt(2.0 / (16.0 * S)));
-  // Quantile of chi^2 with k degrees of freedom at the standard normal quantile u, over k.
-  const auto chi2_mean_quantile = [](double k, double u) {
-    const double c = 1.0 - 2.0 / (9.0 * k) + u * std::sqrt(2.0 / (9.0 * k));
-    return c * c * c;
-  };
-  const double u = 3.719;  // 1 - 1e-4 of the standard normal law
-  const double low = chi2_mean_quantile(S, -u), high = chi2_mean_quantile(S, u);
-  for (int j = 0; j < kIdentifiedParameters; ++j) {
-    EXPECT_NEAR(z_mean[j], 0.0, 4 / std::sqrt(S)) << parameter_name(j);
-    EXPECT_GT(z2_mean[j], low) << parameter_name(j);
-    EXPECT_LT(z2_mean[j], high) << parameter_name(j);
-  }
+  const double fraction = static_cast<double>(inside) / total, mean_d2 = d2_sum / (S * p);
+  std::printf("  %d seeds x %d parameters: %.1f %% inside 1 sd; mean d^2 / p = %.3f (+- %.3f)\n", S, p, 100 * fraction,
+              mean_d2, std::sqrt(2.0 / (p * S)));
+  EXPECT_NEAR(fraction, 0.683, 0.05);
+  EXPECT_NEAR(mean_d2, 1.0, 4.0 * std::sqrt(2.0 / (p * S)) + 0.02);
 }
 
 TEST(Identification, NoiseFreeDataAreRecoveredToRounding) {
-  // Without noise the estimate is the truth up to rounding and the forward kinematics tolerance.
-  // Measured: lead 2.3e-11 relative, offsets 1.2e-12 m, A 3e-13 m, rotation 3.8e-13 rad, the
-  // tracker transform 1.0e-12 m at the points' centroid, residual rms 2.1e-13 m; bounds ~10x.
-  const Model& nominal = seed_model();
-  double lead = 0.0, offset = 0.0, observation = 0.0, rotation = 0.0, transfer = 0.0, rms = 0.0;
-  for (std::uint32_t seed = 1; seed <= 3; ++seed) {
-    std::mt19937_64 rng(kSeed + 2000 + seed);
-    const Truth truth = random_truth(nominal, rng);
-    const std::vector<Observation> obs = observe(nominal, truth, calibration_poses(200, rng), 0.0, rng);
-    const Identification id = identified(obs);
-    EXPECT_EQ(id.estimate.twist_sign, truth.p.twist_sign);
-    const Errors e = errors_of(id.estimate, truth.p, obs);
-    lead = std::max(lead, e.lead_relative);
-    offset = std::max(offset, e.offset);
-    observation = std::max(observation, e.observation);
-    rotation = std::max(rotation, e.rotation);
-    transfer = std::max(transfer, e.transfer);
-    rms = std::max(rms, id.rms_after);
-  }
-  report("residual rms [m]", rms);
-  report("relative lead error", lead);
-  report("offset error [m]", offset);
-  report("A error [m]", observation);
-  report("rotation error [rad]", rotation);
-  report("transfer error [m]", transfer);
-  EXPECT_LT(lead, 3e-10);
-  EXPECT_LT(offset, 1.5e-11);
-  EXPECT_LT(observation, 3e-12);
-  EXPECT_LT(rotation, 4e-12);
-  EXPECT_LT(transfer, 1e-11);
-  EXPECT_LT(rms, 3e-12);
+  // Joints, axes (all fitted), leads, offsets, two targets: without noise the truth comes back to
+  // rounding (the tracker's noise given, since there is no scatter to measure).
+  std::mt19937_64 rng(kSeed + 7);
+  TruthErrors e;
+  e.axes = deg2rad(0.5);
+  e.extra_targets = {Vector3d(-0.4, 0.6, 0.05)};
+  const Truth truth = random_truth(seed_model(), e, rng);
+  const std::vector<Observation> obs = station_data(truth, 60, 1, 0.0, rng);
+  IdentificationOptions o = quick();
+  o.axes = AxisFit::All;
+  o.tracker_noise = kTrackerNoise;
+  Identification id;
+  ASSERT_EQ(identify(seed_model(), obs, id, o), Status::Ok) << id.reason;
+  const Eigen::VectorXd d = parameter_error(id, truth);
+  const ParameterSet& set = id.parameters;
+  std::printf("  %d iterations, cost %.3g, condition %.3g: %s\n", id.fits[0].iterations, id.fits[0].cost, id.condition,
+              id.fits[0].message.c_str());
+  EXPECT_LT(std::abs(d[0]) / truth.spec.legs[0].lead, 1e-9);
+  EXPECT_LT(d.segment(set.offset_index(), kLegs).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT(d.segment(set.base_index(), 2 * (3 * kLegs - 6)).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT(d.segment(set.axis_index(), set.axis_count()).cwiseAbs().maxCoeff(), 1e-7);
+  EXPECT_LT(d.segment(set.target_index(), 6).cwiseAbs().maxCoeff(), 1e-9);
+  report("largest joint error without noise [m]",
+         d.segment(set.base_index(), 2 * (3 * kLegs - 6)).cwiseAbs().maxCoeff());
+  report("largest axis error without noise [rad]", d.segment(set.axis_index(), set.axis_count()).cwiseAbs().maxCoeff());
 }
 
 TEST(Identification, JacobianMatchesCentralDifferences) {
-  // The implicit-function Jacobian against central differences of the residuals, at a candidate
-  // away from the truth, for both signs and both lead models. Step 1e-7 (m or rad); the forward kinematics converges to
-  // 1e-14 m here so that its stopping point does not show in the differences. Measured worst difference 4.4e-8 of the
-  // column's largest entry.
-  const Model& nominal = seed_model();
-  std::mt19937_64 rng(kSeed + 3000);
-  const Truth truth = random_truth(nominal, rng);
-  std::vector<Observation> obs = observe(nominal, truth, calibration_poses(30, rng), kTrackerNoise, rng);
-  IdentificationOptions options;
-  options.fk.tolerance = 1e-14;
-  double worst = 0.0;
-  for (const LeadEffect effect : {LeadEffect::TwistOnly, LeadEffect::TwistAndTravel}) {
-    options.lead_effect = effect;
+  // The residuals' Jacobian (implicit function theorem through twist-aware FK, joints and axes by
+  // dual numbers) against central differences of the residuals, every column, both lead models,
+  // both senses, two targets, a drive scale in the nominal model.
+  std::mt19937_64 rng(kSeed + 11);
+  TruthErrors e;
+  e.axes = deg2rad(1.0);
+  e.extra_targets = {Vector3d(0.3, -0.8, 0.1)};
+  const Truth truth = random_truth(seed_model(), e, rng);
+  const std::vector<Observation> obs = station_data(truth, 12, 1, 0.0, rng);
+  AxisSelection all;
+  all.fill(true);
+  for (const LeadEffect effect : {LeadEffect::TwistOnly, LeadEffect::TwistAndTravel})
     for (const double sign : {1.0, -1.0}) {
-      PlatformParameters p = truth.p;
-      p.twist_sign = sign;
-      p.lead = 0.8 * truth.p.lead;
-      for (int i = 0; i < kLegs; ++i) p.length_offset[i] += uniform(rng, -1e-3, 1e-3);
-      p.observation_P += Vector3d(2e-3, -3e-3, 1e-3);
-      p.X_BT.R = exp_so3(Vector3d(0.01, -0.02, 0.03)) * p.X_BT.R;
-      Eigen::VectorXd e, ep, em;
-      Eigen::MatrixXd J, unused;
-      ASSERT_EQ(identification_residuals(nominal, obs, p, options, e, &J), Status::Ok);
-      for (int j = 0; j < kIdentifiedParameters; ++j) {
-        constexpr double h = 1e-7;
-        const auto moved = [&](double step) {
-          PlatformParameters q = p;
-          if (j == kLeadIndex)
-            q.lead += step;
-          else if (j < kObservationIndex)
-            q.length_offset[j - kOffsetIndex] += step;
-          else if (j < kRotationIndex)
-            q.observation_P[j - kObservationIndex] += step;
-          else if (j < kTranslationIndex)
-            q.X_BT.R = exp_so3(step * Vector3d::Unit(j - kRotationIndex)) * q.X_BT.R;
-          else
-            q.X_BT.t[j - kTranslationIndex] += step;
-          return q;
-        };
-        ASSERT_EQ(identification_residuals(nominal, obs, moved(h), options, ep, nullptr), Status::Ok);
-        ASSERT_EQ(identification_residuals(nominal, obs, moved(-h), options, em, nullptr), Status::Ok);
+      SCOPED_TRACE(effect == LeadEffect::TwistOnly ? "twist only" : "travel");
+      SCOPED_TRACE(sign);
+      const ParameterSet set(seed_model(), CalibrationModel::Geometry, effect, all, 2);
+      Eigen::VectorXd theta = truth_vector(set, truth);
+      theta.segment<3>(set.rotation_index()).setZero();
+      Eigen::VectorXd e0;
+      Eigen::MatrixXd J;
+      FkOptions tight;
+      tight.tolerance = 1e-14;
+      ASSERT_EQ(identification_residuals(set, obs, theta, sign, truth.X_BT, tight, e0, &J), Status::Ok);
+      double worst = 0.0;
+      for (int c = 0; c < set.size(); ++c) {
+        const bool rotation = c >= set.rotation_index() && c < set.rotation_index() + 3;
+        // Steps that move the residuals well above the forward kinematics' tolerance (an axis
+        // moves A by microns per degree) and keep the truncation error far below it.
+        const bool axis = c >= set.axis_index() && c < set.axis_index() + set.axis_count();
+        const double h = c < set.lead_count() ? 1e-5 * theta[c] : axis ? 1e-4 : 1e-6;
+        Eigen::VectorXd ep, em;
+        Eigen::VectorXd tp = theta, tm = theta;
+        RigidTransform Xp = truth.X_BT, Xm = truth.X_BT;
+        if (rotation) {
+          Xp.R = exp_so3(Vector3d::Unit(c - set.rotation_index()) * h) * truth.X_BT.R;
+          Xm.R = exp_so3(-Vector3d::Unit(c - set.rotation_index()) * h) * truth.X_BT.R;
+        } else if (c >= set.translation_index()) {
+          Xp.t[c - set.translation_index()] += h;
+          Xm.t[c - set.translation_index()] -= h;
+        } else {
+          tp[c] += h;
+          tm[c] -= h;
+        }
+        ASSERT_EQ(identification_residuals(set, obs, tp, sign, Xp, tight, ep, nullptr), Status::Ok);
+        ASSERT_EQ(identification_residuals(set, obs, tm, sign, Xm, tight, em, nullptr), Status::Ok);
         const Eigen::VectorXd fd = (ep - em) / (2 * h);
-        const double scale = J.col(j).cwiseAbs().maxCoeff();
-        ASSERT_GT(scale, 0.0) << parameter_name(j);
-        const double diff = (fd - J.col(j)).cwiseAbs().maxCoeff() / scale;
+        const double scale = std::max(J.col(c).cwiseAbs().maxCoeff(), 1e-12);
+        const double diff = (fd - J.col(c)).cwiseAbs().maxCoeff() / scale;
         worst = std::max(worst, diff);
-        EXPECT_LT(diff, 5e-7) << parameter_name(j) << " sign " << sign << " travel "
-                              << (effect == LeadEffect::TwistAndTravel);
+        EXPECT_LT(diff, 1e-6) << set.name(c);
       }
+      report("largest column difference / column max", worst);
     }
-  }
-  report("relative Jacobian difference", worst);
 }
 
-TEST(Identification, DegenerateDataAreReportedNotSolved) {
-  const Model& nominal = seed_model();
-  std::mt19937_64 rng(kSeed + 4000);
-  const Truth truth = random_truth(nominal, rng);
+TEST(Identification, UndeterminedDataAreReportedNotSolved) {
+  std::mt19937_64 rng(kSeed + 13);
+  const Truth truth = random_truth(seed_model(), TruthErrors{}, rng);
   Identification id;
-
-  // Every point at one pose: the tracker frame cannot even be registered.
-  const std::vector<Observation> home = observe(nominal, truth, std::vector<Pose>(50, Pose{}), kTrackerNoise, rng);
-  EXPECT_EQ(identify(nominal, home, id), Status::NotIdentifiable);
+  // Too few stations for the geometry model's 40 parameters: named, nothing solved.
+  const std::vector<Observation> few = station_data(truth, 8, 5, kTrackerNoise, rng);
+  EXPECT_EQ(identify(seed_model(), few, id, quick()), Status::NotIdentifiable);
+  EXPECT_NE(id.reason.find("stations are needed"), std::string::npos) << id.reason;
+  EXPECT_FALSE(id.fitted);
+  // One station only for the basic model.
+  std::vector<Observation> one(few.begin(), few.begin() + 5);
+  IdentificationOptions basic = quick();
+  basic.model = CalibrationModel::Basic;
+  EXPECT_EQ(identify(seed_model(), one, id, basic), Status::NotIdentifiable);
+  // Translations along z only: the points lie on a line, no tracker frame (theory §11).
+  std::vector<Pose> lz, lxz;
+  for (int k = -4; k <= 4; ++k) {
+    Pose p;
+    p.position.z() = 0.05 * k;
+    lz.push_back(p);
+    lxz.push_back(p);
+    p.position = Vector3d(0.05 * k, 0.0, 0.0);
+    lxz.push_back(p);
+  }
+  EXPECT_EQ(identify(seed_model(), observe(seed_model(), truth, lz, 5, kTrackerNoise, rng), id, basic),
+            Status::NotIdentifiable);
   EXPECT_NE(id.reason.find("registration"), std::string::npos) << id.reason;
-
-  // Translations only (the paper's Lz and Lx tests): the platform never turns, so A and the
-  // tracker's translation enter only as their difference: three combinations, named.
-  std::vector<Pose> translations = paper_poses(0.1, 0);
-  const std::vector<Pose> lx = paper_poses(0.1, 1);
-  translations.insert(translations.end(), lx.begin(), lx.end());
-  EXPECT_EQ(identify(nominal, observe(nominal, truth, translations, kTrackerNoise, rng), id), Status::NotIdentifiable);
-  std::printf("  translations only: %s\n", id.reason.c_str());
-  EXPECT_NE(id.reason.find("3 combinations"), std::string::npos) << id.reason;
-  for (const char* name : {"A x", "A y", "A z", "translation x", "translation y", "translation z"})
-    EXPECT_NE(id.reason.find(name), std::string::npos) << name << ": " << id.reason;
-  EXPECT_GT(id.condition, 1e12);
-
-  // Too few points for 16 parameters; a NaN; a leg whose twist is undefined.
-  std::vector<Observation> few(home.begin(), home.begin() + 5);
-  EXPECT_EQ(identify(nominal, few, id), Status::NotIdentifiable);
-  EXPECT_NE(id.reason.find("at least 6"), std::string::npos) << id.reason;
-  std::vector<Observation> bad = home;
-  bad[7].p_T.y() = std::nan("");
-  EXPECT_EQ(identify(nominal, bad, id), Status::NonFiniteInput);
-  EXPECT_NE(id.reason.find("observation 8"), std::string::npos) << id.reason;
-  ModelSpec no_axes = nominal.spec();
-  for (LegSpec& leg : no_axes.legs) leg.lead = 0.0;
-  no_axes.legs[2].axis_base_B.setZero();
-  no_axes.legs[2].axis_platform_P.setZero();
-  EXPECT_EQ(identify(Model(no_axes), home, id), Status::NotIdentifiable);
-  EXPECT_NE(id.reason.find("leg 3"), std::string::npos) << id.reason;
+  // Along x and z: translations only, so A and the tracker's translation are confounded (theory
+  // §13), and named.
+  EXPECT_EQ(identify(seed_model(), observe(seed_model(), truth, lxz, 5, kTrackerNoise, rng), id, basic),
+            Status::NotIdentifiable);
+  EXPECT_NE(id.reason.find("do not determine"), std::string::npos) << id.reason;
+  EXPECT_NE(id.reason.find("A x"), std::string::npos) << id.reason;
+  EXPECT_NE(id.reason.find("translation"), std::string::npos) << id.reason;
+  // Points without repeats and no tracker noise given: the noise is unknown.
+  const std::vector<Observation> single = station_data(truth, 60, 1, kTrackerNoise, rng);
+  EXPECT_EQ(identify(seed_model(), single, id, quick()), Status::NotIdentifiable);
+  EXPECT_NE(id.reason.find("noise is unknown"), std::string::npos) << id.reason;
 }
 
-TEST(Identification, EachPaperTestAloneLeavesParametersFreeAndAllFourLeaveTheOffsetsWeak) {
-  // Identifiability of the paper's motions (theory §13): each test moves the platform along one
-  // coordinate. Lz and Lx move A along a line, which does not even register the tracker; Rz
-  // turns about z and Ry about y, which leave A's coordinate along that axis indistinguishable
-  // from the tracker's translation along it. The four together determine everything, but the
-  // offsets only loosely: measured sd 29-107 um at 516 points, against 6-10 um for as many
-  // random poses.
-  const Model& nominal = seed_model();
-  std::mt19937_64 rng(kSeed + 5000);
-  const Truth truth = random_truth(nominal, rng);
-  const std::array<std::vector<std::string>, 4> confounded{
-      {{"registration"}, {"registration"}, {"A z", "translation z"}, {"A y", "translation y"}}};
+TEST(Identification, TheBasicModelOnJointErrorDataIsRefusedWithTheHint) {
+  // Issue 21: the basic model absorbs joint errors into its offsets and leaves millimetres; the
+  // model-fit test refuses it, names the worst station and points at the geometry model.
+  std::mt19937_64 rng(kSeed + 17);
+  const Truth truth = random_truth(seed_model(), TruthErrors{}, rng);
+  const std::vector<Observation> obs = station_data(truth, 42, 20, kTrackerNoise, rng);
+  IdentificationOptions o = quick();
+  o.model = CalibrationModel::Basic;
   Identification id;
-  for (int test = 0; test < 4; ++test) {
-    const auto obs = observe(nominal, truth, paper_poses(0.1, test), kTrackerNoise, rng);
-    EXPECT_EQ(identify(nominal, obs, id), Status::NotIdentifiable) << test;
-    std::printf("  %s alone: %s\n", seed_tests(StudySpec{})[static_cast<std::size_t>(test)].name.c_str(),
-                id.reason.c_str());
-    for (const std::string& name : confounded[static_cast<std::size_t>(test)])
-      EXPECT_NE(id.reason.find(name), std::string::npos) << name << ": " << id.reason;
-  }
-  const auto paper = observe(nominal, truth, paper_poses(0.1), kTrackerNoise, rng);
-  const Identification all = identified(paper);
-  EXPECT_EQ(all.estimate.twist_sign, truth.p.twist_sign);
-  const auto random = observe(nominal, truth, calibration_poses(all.count, rng), kTrackerNoise, rng);
-  const Identification spread = identified(random);
-  std::printf("  all four tests (%d points): condition %.3g, lead sd %.3g %%, offset sd %.3g-%.3g um\n", all.count,
-              all.condition, 100 * all.sd[kLeadIndex] / truth.p.lead, 1e6 * all.sd.segment<6>(kOffsetIndex).minCoeff(),
-              1e6 * all.sd.segment<6>(kOffsetIndex).maxCoeff());
-  std::printf("  random poses (%d points): condition %.3g, lead sd %.3g %%, offset sd %.3g-%.3g um\n", spread.count,
-              spread.condition, 100 * spread.sd[kLeadIndex] / truth.p.lead,
-              1e6 * spread.sd.segment<6>(kOffsetIndex).minCoeff(), 1e6 * spread.sd.segment<6>(kOffsetIndex).maxCoeff());
-  std::printf("  paper tests' least-determined combination (column-scaled):");
-  for (int j = 0; j < kIdentifiedParameters; ++j)
-    if (std::abs(all.weakest[j]) >= 0.1)
-      std::printf(" %+.2f %s", all.weakest[j], std::string(parameter_name(j)).c_str());
-  std::printf("\n  sign cost ratio: paper tests %.3g, random poses %.3g\n", all.cost_ratio, spread.cost_ratio);
-  EXPECT_GT(all.sd.segment<6>(kOffsetIndex).maxCoeff(), 5 * spread.sd.segment<6>(kOffsetIndex).maxCoeff());
+  EXPECT_EQ(identify(seed_model(), obs, id, o), Status::ModelMismatch);
+  EXPECT_GT(id.fit_z, 50.0);
+  EXPECT_FALSE(id.worst.empty());
+  EXPECT_NE(id.hint.find("geometry"), std::string::npos) << id.hint;
+  // The same data without joint errors: the basic model explains them.
+  TruthErrors e;
+  e.joints = 0.0;
+  const Truth plain = random_truth(seed_model(), e, rng);
+  EXPECT_EQ(identify(seed_model(), station_data(plain, 42, 20, kTrackerNoise, rng), id, o), Status::Ok) << id.reason;
+  EXPECT_LT(id.fit_z, 5.0);
 }
 
-TEST(Identification, TravelModelOfTheLeadIsRecoveredAndTheTwistOnlyModelDoesNotFitIt) {
-  // Drives that convert lengths to angles with the nominal lead move the legs by lead/nominal
-  // times the commanded travel: 5 % of up to 0.5 m. The travel model recovers every parameter
-  // within 4 of its reported sd, the lead to about a part per million; the twist-only model
-  // cannot explain such data, and its sigma says so (measured 8.8 mm, 900 times the tracker's).
-  const Model& nominal = seed_model();
-  std::mt19937_64 rng(kSeed + 6000);
-  const Truth truth = random_truth(nominal, rng);
-  const auto obs = observe(nominal, truth, calibration_poses(500, rng), kTrackerNoise, rng, LeadEffect::TwistAndTravel);
-  IdentificationOptions travel;
-  travel.lead_effect = LeadEffect::TwistAndTravel;
-  const Identification id = identified(obs, travel);
-  const Errors e = errors_of(id.estimate, truth.p, obs);
-  std::printf("  travel model: lead error %.3g (sd %.3g) relative, offsets %.3g um, sigma %.3g um, cost ratio %.3g\n",
-              e.lead_relative, id.sd[kLeadIndex] / truth.p.lead, 1e6 * e.offset, 1e6 * id.sigma, id.cost_ratio);
-  EXPECT_EQ(id.estimate.twist_sign, truth.p.twist_sign);
-  const ParameterVector z = parameter_error(id.estimate, truth.p).cwiseQuotient(id.sd);
-  for (int j = 0; j < kIdentifiedParameters; ++j) EXPECT_LT(std::abs(z[j]), 4.0) << parameter_name(j);
-  EXPECT_LT(id.sd[kLeadIndex], 1e-5 * truth.p.lead);
-  EXPECT_NEAR(id.sigma, kTrackerNoise, 0.1 * kTrackerNoise);
-  EXPECT_GT(id.cost_ratio, 100.0);
-
-  Identification twist_only;
-  const Status s = identify(nominal, obs, twist_only);
-  std::printf("  twist-only model on the same data: %s, sigma %.3g mm\n", std::string(to_string(s)).c_str(),
-              1e3 * twist_only.sigma);
-  EXPECT_GT(twist_only.sigma, 100 * kTrackerNoise);
+TEST(Identification, AnErrorTheModelDoesNotHaveIsRefused) {
+  // Data of the conventional commands identified as compensated (the other --strategy, issue 22),
+  // and axes turned by 3 degrees with the axes kept: both leave more than the noise.
+  std::mt19937_64 rng(kSeed + 19);
+  const Truth truth = random_truth(seed_model(), TruthErrors{}, rng);
+  Identification id;
+  const std::vector<Observation> conventional = station_data(truth, 42, 20, kTrackerNoise, rng, Strategy::Conventional);
+  // The observations carry the compensated commands of the same poses.
+  std::vector<Observation> relabelled = conventional;
+  for (Observation& o : relabelled) {
+    FkResult fk;
+    ASSERT_EQ(forward_kinematics(seed_model(), o.motor, LengthKind::Geometric, Placement{}, fk), Status::Ok);
+    LimitReport limit;
+    ASSERT_EQ(motor_commands(seed_model(), fk.pose, Strategy::Compensated, o.motor, limit), Status::Ok);
+  }
+  EXPECT_EQ(identify(seed_model(), relabelled, id, quick()), Status::ModelMismatch) << id.reason;
+  TruthErrors turned;
+  turned.axes = deg2rad(3.0);
+  const Truth axes = random_truth(seed_model(), turned, rng);
+  IdentificationOptions none = quick();
+  none.axes = AxisFit::None;
+  EXPECT_EQ(identify(seed_model(), station_data(axes, 42, 20, kTrackerNoise, rng), id, none), Status::ModelMismatch)
+      << id.reason;
+  EXPECT_NE(id.hint.find("axes"), std::string::npos) << id.hint;
 }
 
-TEST(Identification, CorrectedModelPutsTheRealPlatformOnTarget) {
-  // The point of it all: the corrected model's compensated commands, sent to the real platform,
-  // put A where it was commanded. Measured on 200 random poses: 11 um at worst, against 3.9 mm
-  // with the nominal model. The corrected model carries the estimate in its own fields.
-  const Model& nominal = seed_model();
-  std::mt19937_64 rng(kSeed + 7000);
-  const Truth truth = random_truth(nominal, rng);
-  const auto obs = observe(nominal, truth, calibration_poses(2000, rng), kTrackerNoise, rng);
-  const Identification id = identified(obs);
-  const ModelSpec spec = corrected_spec(nominal.spec(), id.estimate);
-  const Model corrected(spec);
-  for (int i = 0; i < kLegs; ++i) {
-    EXPECT_EQ(corrected.leg(i).lead, id.estimate.lead);
-    EXPECT_EQ(corrected.leg(i).twist_sign, id.estimate.twist_sign);
-    EXPECT_EQ(corrected.leg(i).length_offset, id.estimate.length_offset[i]);
-    EXPECT_EQ(corrected.leg(i).driven, nominal.leg(i).driven);
+TEST(Identification, AxesAreFittedOnlyWhereTheDataDetermineThem) {
+  // With 42 stations at 10 um the axes are not determined to 0.1 deg (their effect on A is a few
+  // um per 0.5 deg, issue 21): Auto fits none and says how well each is known.
+  std::mt19937_64 rng(kSeed + 23);
+  const Truth truth = random_truth(seed_model(), TruthErrors{}, rng);
+  Identification id;
+  ASSERT_EQ(identify(seed_model(), station_data(truth, 42, 20, kTrackerNoise, rng), id, quick()), Status::Ok);
+  EXPECT_EQ(id.parameters.axis_count(), 0);
+  double lo = INFINITY;
+  for (const double sd : id.axis_sd) {
+    ASSERT_TRUE(std::isfinite(sd));
+    lo = std::min(lo, sd);
   }
-  EXPECT_EQ(spec.observation_P, id.estimate.observation_P);
+  std::printf("  axes' sd if fitted: %.3g deg at best\n", rad2deg(lo));
+  EXPECT_GT(lo, deg2rad(0.1));
+  // Noise a hundred times smaller determines many of them: every axis fitted comes back within
+  // its standard deviations, and Auto fits exactly those whose predicted sd is within 0.1 deg.
+  TruthErrors e;
+  e.axes = deg2rad(1.0);
+  const Truth turned = random_truth(seed_model(), e, rng);
+  const std::vector<Observation> obs = station_data(turned, 60, 20, 0.1e-6, rng);
+  IdentificationOptions all = quick();
+  all.axes = AxisFit::All;
+  ASSERT_EQ(identify(seed_model(), obs, id, all), Status::Ok) << id.reason;
+  EXPECT_EQ(id.parameters.axis_count(), 24);
+  const Eigen::VectorXd d = parameter_error(id, turned);
+  for (int k = id.parameters.axis_index(); k < id.parameters.axis_index() + id.parameters.axis_count(); ++k)
+    EXPECT_LT(std::abs(d[k]), 4.0 * id.sd[k]) << id.parameters.name(k);
+  Identification automatic;
+  (void)identify(seed_model(), obs, automatic, quick());
+  int fitted = 0;
+  for (std::size_t a = 0; a < automatic.axis_sd.size(); ++a) {
+    EXPECT_EQ(automatic.parameters.axes()[a], automatic.axis_sd[a] <= deg2rad(0.1)) << "axis " << a;
+    fitted += automatic.parameters.axes()[a] ? 1 : 0;
+  }
+  std::printf("  at 0.1 um: %d of 12 axes determined to 0.1 deg\n", fitted);
+  EXPECT_GT(fitted, 0);
+}
 
+TEST(Identification, CrossValidationPredictsLeftOutStationsAsTheCovarianceExpects) {
+  std::mt19937_64 rng(kSeed + 29);
+  const Truth truth = random_truth(seed_model(), TruthErrors{}, rng);
+  IdentificationOptions o = quick();
+  o.folds = 5;
+  Identification id;
+  ASSERT_EQ(identify(seed_model(), station_data(truth, 42, 20, kTrackerNoise, rng), id, o), Status::Ok);
+  const CrossValidation& cv = id.cross_validation;
+  std::printf("  cross-validation: %d groups, rms %.2f um, expected %.2f um, largest %.2f um\n", cv.predicted,
+              1e6 * cv.rms, 1e6 * cv.expected, 1e6 * cv.max);
+  EXPECT_EQ(cv.folds, 5);
+  EXPECT_EQ(cv.predicted, 42);
+  EXPECT_NEAR(cv.rms / cv.expected, 1.0, 0.35);
+  // The basic model's folds on the same data would miss by the joints' effect; the geometry's
+  // left-out stations are within a few noise levels of a mean.
+  EXPECT_LT(cv.max, 5.0 * cv.expected);
+}
+
+TEST(Identification, PerLegThreadsAndLeadsAreIdentifiedAndKept) {
+  // A legs configuration whose leg 3 is left-handed and legs 5-6 have a 12 mm lead (issue 21: a
+  // per-leg thread was ignored, a per-leg lead blamed on the data).
+  ModelSpec spec = seed_model().spec();
+  spec.legs[2].thread = ThreadSense::Left;
+  spec.legs[4].lead = spec.legs[5].lead = 0.012;
+  const Model nominal(spec);
+  std::mt19937_64 rng(kSeed + 31);
+  const Truth truth = random_truth(nominal, TruthErrors{}, rng);
+  EXPECT_EQ(truth.spec.legs[2].thread, ThreadSense::Left);
   const Model real(truth.spec);
-  double worst_corrected = 0.0, worst_nominal = 0.0;
-  for (int n = 0; n < 200; ++n) {
-    // A pose inside the limits of both models (the corrected commands differ by the offsets).
-    Pose pose = random_valid_pose(corrected, rng, 0.5, deg2rad(30));
-    for (CommandReport r; compute_commands(nominal, pose, r) != Status::Ok;)
-      pose = random_valid_pose(corrected, rng, 0.5, deg2rad(30));
-    const Vector3d target = platform_point_B(real, placement_from_pose(pose), truth.p.observation_P);
-    for (const Model* model : {&corrected, &nominal}) {
-      Vector6d command;
-      LimitReport limit;
-      ASSERT_EQ(motor_commands(*model, pose, Strategy::Compensated, command, limit), Status::Ok) << str(pose);
-      FkResult fk;
-      ASSERT_EQ(forward_kinematics(real, command, LengthKind::Motor, placement_from_pose(pose), fk), Status::Ok);
-      const double miss = (platform_point_B(real, fk.placement, truth.p.observation_P) - target).norm();
-      (model == &corrected ? worst_corrected : worst_nominal) =
-          std::max(model == &corrected ? worst_corrected : worst_nominal, miss);
-    }
+  const std::vector<Pose> poses = random_station_poses(nominal, real, 42, 0.25, deg2rad(15), rng);
+  const std::vector<Observation> obs = observe(nominal, truth, poses, 20, kTrackerNoise, rng);
+  Identification id;
+  ASSERT_EQ(identify(nominal, obs, id, quick()), Status::Ok) << id.reason;
+  EXPECT_EQ(id.parameters.lead_count(), kLegs);
+  EXPECT_EQ(id.twist_sign, 1.0);
+  for (int i = 0; i < kLegs; ++i) {
+    EXPECT_EQ(id.corrected.legs[static_cast<std::size_t>(i)].thread,
+              truth.spec.legs[static_cast<std::size_t>(i)].thread)
+        << "leg " << i + 1;
+    EXPECT_NEAR(id.corrected.legs[static_cast<std::size_t>(i)].lead, truth.spec.legs[static_cast<std::size_t>(i)].lead,
+                4.0 * id.sd[i])
+        << "leg " << i + 1;
   }
-  report("miss of A with the corrected model [m]", worst_corrected);
-  report("miss of A with the nominal model [m]", worst_nominal);
-  EXPECT_LT(worst_corrected, 100e-6);
-  EXPECT_GT(worst_nominal, 100 * worst_corrected);
+  // The same with every hand flipped: the global sense is found, leg 3 stays the odd one.
+  TruthErrors flipped;
+  flipped.flip = true;
+  const Truth other = random_truth(nominal, flipped, rng);
+  ASSERT_EQ(identify(nominal, observe(nominal, other, poses, 20, kTrackerNoise, rng), id, quick()), Status::Ok)
+      << id.reason;
+  EXPECT_EQ(id.twist_sign, -1.0);
+  EXPECT_EQ(id.corrected.legs[2].thread, ThreadSense::Right);
+  EXPECT_EQ(id.corrected.legs[0].thread, ThreadSense::Left);
+}
+
+TEST(Identification, SeveralTargetsEachGetTheirPointAndSharpenTheEstimate) {
+  std::mt19937_64 rng(kSeed + 37);
+  TruthErrors e;
+  e.extra_targets = {Vector3d(-0.6, 1.0, 0.02), Vector3d(-0.6, -1.0, -0.03)};
+  const Truth truth = random_truth(seed_model(), e, rng);
+  const Model real(truth.spec);
+  const std::vector<Pose> poses = random_station_poses(seed_model(), real, 42, 0.25, deg2rad(15), rng);
+  Identification three, one;
+  ASSERT_EQ(identify(seed_model(), observe(seed_model(), truth, poses, 20, kTrackerNoise, rng), three, quick()),
+            Status::Ok)
+      << three.reason;
+  ASSERT_EQ(three.parameters.targets(), 3);
+  const Eigen::VectorXd d = parameter_error(three, truth);
+  for (int k = three.parameters.target_index(); k < three.parameters.rotation_index(); ++k)
+    EXPECT_LT(std::abs(d[k]), 4.0 * three.sd[k]) << three.parameters.name(k);
+  Truth single = truth;
+  single.targets.resize(1);
+  ASSERT_EQ(identify(seed_model(), observe(seed_model(), single, poses, 20, kTrackerNoise, rng), one, quick()),
+            Status::Ok);
+  // Three targets see the orientation too: the joints come out better determined.
+  const double sd3 = three.base_shift_sd.maxCoeff(), sd1 = one.base_shift_sd.maxCoeff();
+  std::printf("  largest base joint sd: %.1f um with one target, %.1f um with three\n", 1e6 * sd1, 1e6 * sd3);
+  EXPECT_LT(sd3, 0.8 * sd1);
+}
+
+TEST(Identification, TheCorrectedPlatformHitsPosesNotUsedAsTheCovariancePredicts) {
+  // Under the contract (the drives keep their reference and scale, theory §4): commands of the
+  // corrected model at poses not used, run on the real platform, put its A where the corrected
+  // model says, within 2.5 times the predicted accuracy in the gauge frames and, after a rigid
+  // re-alignment, within the issue's 15 um median and 50 um worst; the nominal model misses by mm.
+  for (const double joints : {0.5e-3, 2e-3}) {
+    SCOPED_TRACE(joints);
+    std::mt19937_64 rng(kSeed + 41 + static_cast<std::uint32_t>(1e4 * joints));
+    TruthErrors e;
+    e.joints = joints;
+    e.flip = joints > 1e-3;
+    const Truth truth = random_truth(seed_model(), e, rng);
+    IdentificationOptions o = quick();
+    o.accuracy_poses = 400;
+    Identification id;
+    ASSERT_EQ(identify(seed_model(), station_data(truth, 42, 20, kTrackerNoise, rng), id, o), Status::Ok) << id.reason;
+    const Model corrected(id.corrected), real(truth.spec);
+    std::vector<Vector3d> target, actual;
+    double nominal_miss = 0.0;
+    while (target.size() < 200) {
+      const Pose p = random_pose(rng, 0.2, deg2rad(12));
+      Vector6d command, command_nominal;
+      LimitReport limit;
+      if (motor_commands(corrected, p, Strategy::Compensated, command, limit) != Status::Ok) continue;
+      if (motor_commands(seed_model(), p, Strategy::Compensated, command_nominal, limit) != Status::Ok) continue;
+      FkResult fk, fk_nominal;
+      ASSERT_EQ(forward_kinematics(real, command, LengthKind::Motor, placement_from_pose(p), fk), Status::Ok);
+      ASSERT_EQ(forward_kinematics(real, command_nominal, LengthKind::Motor, placement_from_pose(p), fk_nominal),
+                Status::Ok);
+      target.push_back(platform_point_B(corrected, placement_from_pose(p), id.corrected.observation_P));
+      actual.push_back(platform_point_B(real, fk.placement, truth.spec.observation_P));
+      nominal_miss = std::max(
+          nominal_miss, (platform_point_B(real, fk_nominal.placement, truth.spec.observation_P) -
+                         platform_point_B(seed_model(), placement_from_pose(p), seed_model().spec().observation_P))
+                            .norm());
+    }
+    std::vector<double> gauge, aligned;
+    std::vector<PointPair> pairs;
+    for (std::size_t k = 0; k < target.size(); ++k) {
+      gauge.push_back((actual[k] - target[k]).norm());
+      pairs.push_back({target[k], actual[k]});
+    }
+    Registration reg;
+    ASSERT_EQ(register_points(pairs, reg), Status::Ok);
+    for (std::size_t k = 0; k < target.size(); ++k) aligned.push_back((apply(reg.X_BT, target[k]) - actual[k]).norm());
+    std::sort(gauge.begin(), gauge.end());
+    std::sort(aligned.begin(), aligned.end());
+    const double gauge_median = gauge[gauge.size() / 2], aligned_median = aligned[aligned.size() / 2];
+    std::printf(
+        "  joints +-%.1f mm: gauge frames median %.1f um (predicted %.1f), worst %.1f um; aligned median %.2f um "
+        "(predicted %.2f), worst %.2f um; nominal model misses by up to %.2f mm\n",
+        1e3 * joints, 1e6 * gauge_median, 1e6 * id.accuracy.median, 1e6 * gauge.back(), 1e6 * aligned_median,
+        1e6 * id.accuracy.aligned_median, 1e6 * aligned.back(), 1e3 * nominal_miss);
+    EXPECT_LT(gauge_median, 2.5 * id.accuracy.median);
+    EXPECT_LT(aligned_median, 15e-6);
+    EXPECT_LT(aligned.back(), 50e-6);
+    EXPECT_LT(aligned_median, 2.5 * id.accuracy.aligned_median + 1e-6);
+    EXPECT_GT(nominal_miss, 0.5e-3);
+  }
 }
 
 }  // namespace

@@ -274,7 +274,7 @@ TEST(Measurement, LeadErrorRaisesTheErrorWithItsSignAndSize) {
   for (const int i : {0, 1}) {
     SynthesisOptions o;
     o.noise = 0.0;
-    o.errors.lead_error = i == 0 ? 0.005 : 0.01;
+    o.errors.lead_error.setConstant(i == 0 ? 0.005 : 0.01);
     const SyntheticLog log = synth(run, o);
     const Measurement m = measure(run, log.log, Strategy::Compensated);
     for (std::size_t k = m.window; k < m.points.size(); ++k) {
@@ -429,7 +429,7 @@ TEST(Measurement, PointsAtRestOfAStationsRunIdentifyTheRealPlatform) {
   spec.count = 40;
   const Trajectory traj = stations_trajectory(rig.model(), Strategy::Compensated, spec, rig.control_period());
   SynthesisOptions o;
-  o.errors.lead_error = 0.05;
+  o.errors.lead_error.setConstant(0.05);
   o.errors.flip_twist_sign = true;
   o.errors.zero_offset = random_zero_offsets(1e-3, 11);
   o.errors.observation_offset_P = Vector3d(2e-3, -1.5e-3, 3e-3);
@@ -452,26 +452,33 @@ TEST(Measurement, PointsAtRestOfAStationsRunIdentifyTheRealPlatform) {
     EXPECT_LT((set.observations[i].motor - command).cwiseAbs().maxCoeff(), 1e-12) << i;
     EXPECT_EQ(set.observations[i].p_T, log.log.points_T[set.points[i]]);
   }
+  // The basic model (the joints are right here); the synth's drives turn the screws by the nominal
+  // lead's angles (the travel effect, the default).
   IdentificationOptions io;
-  io.lead_effect = LeadEffect::TwistAndTravel;  // the synth's drives turn the screws by the nominal lead's angles
+  io.model = CalibrationModel::Basic;
   Identification id;
   ASSERT_EQ(identify(rig.model(), set.observations, id, io), Status::Ok) << id.reason;
-  const PlatformParameters& e = id.estimate;
   const double lead = rig.model().leg(0).lead * 1.05;
+  const ModelSpec& c = id.corrected;
   // Measured: lead 1.2e-6 relative (sd 0.9e-6), offsets within 4.3 um (sd 4.3-7.2 um), the point
   // within 1.4 um (sd 1.4 um). The bounds: 0.5 %, 20 um.
-  EXPECT_LT(std::abs(e.lead / lead - 1.0), 1e-5);
-  EXPECT_EQ(e.twist_sign, -rig.model().leg(0).twist_sign);
-  EXPECT_LT((e.length_offset - o.errors.zero_offset).cwiseAbs().maxCoeff(), 20e-6);
+  EXPECT_LT(std::abs(c.legs[0].lead / lead - 1.0), 1e-5);
+  EXPECT_EQ(id.twist_sign, -1.0);
+  EXPECT_NE(c.legs[0].thread, rig.model().leg(0).thread);
+  Vector6d offsets;
+  for (int i = 0; i < kLegs; ++i) offsets[i] = c.legs[static_cast<std::size_t>(i)].length_offset;
+  EXPECT_LT((offsets - o.errors.zero_offset).cwiseAbs().maxCoeff(), 20e-6);
   const Vector3d point = rig.model().spec().observation_P + o.errors.observation_offset_P;
-  EXPECT_LT((e.observation_P - point).cwiseAbs().maxCoeff(), 10e-6);
+  EXPECT_LT((c.observation_P - point).cwiseAbs().maxCoeff(), 10e-6);
   // Each error within 4 of its standard deviations, and the noise recovered.
-  const ParameterVector truth_error = (ParameterVector() << e.lead - lead, e.length_offset - o.errors.zero_offset,
-                                       e.observation_P - point, Vector6d::Zero())
-                                          .finished();
-  for (int p = 0; p < kRotationIndex; ++p) {
-    EXPECT_LT(std::abs(truth_error[p]), 4.0 * id.sd[p]) << parameter_name(p);
-    std::printf("  %-10s error %+.3g, sd %.3g\n", std::string(parameter_name(p)).c_str(), truth_error[p], id.sd[p]);
+  const ParameterSet& ps = id.parameters;
+  Eigen::VectorXd truth_error = Eigen::VectorXd::Zero(ps.rotation_index());
+  truth_error[0] = c.legs[0].lead - lead;
+  truth_error.segment(ps.offset_index(), kLegs) = offsets - o.errors.zero_offset;
+  truth_error.segment<3>(ps.target_index()) = c.observation_P - point;
+  for (int p = 0; p < ps.rotation_index(); ++p) {
+    EXPECT_LT(std::abs(truth_error[p]), 4.0 * id.sd[p]) << ps.name(p);
+    std::printf("  %-10s error %+.3g, sd %.3g\n", ps.name(p).c_str(), truth_error[p], id.sd[p]);
   }
   EXPECT_NEAR(id.sigma, o.noise, 0.05 * o.noise);
 }

@@ -5,7 +5,9 @@
 
 #include <Eigen/Geometry>
 
+#include <limits>
 #include "hexatwist/hexatwist.hpp"
+
 #include "support.hpp"
 
 namespace hexatwist {
@@ -54,22 +56,26 @@ TEST(Synthesis, ParameterErrorsMoveThePointsAsTheRealPlatformDoes) {
   const Trajectory traj = short_trajectory(config.rig);
   SynthesisOptions o;
   o.noise = 0.0;
-  o.errors.lead_error = 0.01;
+  o.errors.lead_error.setConstant(0.01);
   o.errors.flip_twist_sign = true;
   o.errors.zero_offset << 1e-3, -1e-3, 0.5e-3, 0, 2e-4, -7e-4;
   o.errors.observation_offset_P = Vector3d(0.002, 0, -0.001);
   SyntheticLog log;
   SimulationIssue issue;
   ASSERT_EQ(synthesize(config.rig, traj, o, log, issue), Status::Ok);
-  // Independently: the real motor lengths through the real model, FK from home each time.
+  // Independently: the nut's real travel, h + (1 + lead error)(m - h) with the drives' nominal
+  // reference h, through a real model whose drives have no scale, FK from home each time.
   const Model real = real_model(config.rig.model(), o.errors);
+  ModelSpec unscaled = real.spec();
+  for (LegSpec& leg : unscaled.legs) leg.drive_lead = std::numeric_limits<double>::quiet_NaN();
+  const Model travel(unscaled);
+  const Vector6d h = config.rig.model().home_command();
   double worst = 0.0, moved = 0.0;
   for (std::size_t k = 0; k < log.ticks.size(); k += 10) {
     const SimulationSample& s = log.simulation[log.ticks[k]];
-    Vector6d motor;
-    real_motor_lengths(config.rig.model(), o.errors, s.motor, motor);
+    const Vector6d motor = h + 1.01 * (s.motor - h);
     FkResult fk;
-    ASSERT_EQ(forward_kinematics(real, motor, LengthKind::Motor, Placement{}, fk), Status::Ok);
+    ASSERT_EQ(forward_kinematics(travel, motor, LengthKind::Motor, Placement{}, fk), Status::Ok);
     worst = std::max(worst, (platform_point_B(real, fk.placement, real.spec().observation_P) - log.true_B[k]).norm());
     const Model& model = config.rig.model();
     moved = std::max(

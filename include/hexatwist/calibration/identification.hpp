@@ -1,130 +1,220 @@
-// Identification of what the model needs from tracker measurements (issue 5): the screw lead, the
-// sign of the twist term, the legs' zero-length offsets, the observation point and the tracker
-// frame, by nonlinear least squares on the observation point's positions at commanded motor-side
-// lengths, with standard deviations and an identifiability check. Theory: docs/theory.md §13.
+// Twist-aware calibration from a laser tracker's points (issues 5, 21): the U-joint centres, the
+// screw leads, the sign of the twist term, each leg's zero offset, the targets on the platform and
+// the tracker frame, by nonlinear least squares with standard deviations; and the decisions on
+// the result, the same for every caller (CLI, C++, Python): is every parameter determined, is the
+// thread hand decided, does the model explain the data as well as the tracker measures, how well
+// does it predict stations left out, and how accurate will the corrected platform be. Theory:
+// docs/theory/calibration.md §13.
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <limits>
 #include <span>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "hexatwist/calibration/observations.hpp"
+#include "hexatwist/calibration/parameter_set.hpp"
 #include "hexatwist/calibration/registration.hpp"
 #include "hexatwist/kinematics/forward.hpp"
 
 namespace hexatwist {
 
-/// One tracker measurement: where the observation point was seen while the legs stood at the
-/// motor-side lengths they were commanded to.
-struct Observation {
-  Vector6d motor = Vector6d::Zero();  ///< commanded motor-side lengths m_k [m]
-  Vector3d p_T = Vector3d::Zero();    ///< measured observation point [m, T]
+/// Which U-joint axes an identification fits (Geometry model).
+enum class AxisFit {
+  None,  ///< none: the axes as configured
+  Auto,  ///< those the data determine to IdentificationOptions::axis_sd_max (theory §13)
+  All,   ///< every axis
 };
 
-/// How a lead that differs from the nominal one shows in the measurements (theory §13).
-enum class LeadEffect {
-  TwistOnly,       ///< through the twist term only: the commanded lengths are the real motor-side lengths
-  TwistAndTravel,  ///< also through the travel: the drives turned the screws by the nominal lead's angles
-};
-
-/// Number of continuous parameters identified: lead, six offsets, A, rotation and translation of X_BT.
-inline constexpr int kIdentifiedParameters = 16;
-/// Fewest observations an identification accepts: 3K equations must exceed the 16 parameters.
-inline constexpr int kMinObservations = kIdentifiedParameters / 3 + 1;
-/// Position of each group in ParameterVector, covariance and Jacobian columns.
-inline constexpr int kLeadIndex = 0;          ///< lead [m]
-inline constexpr int kOffsetIndex = 1;        ///< length offsets of legs 1..6 [m]
-inline constexpr int kObservationIndex = 7;   ///< observation point x, y, z [m, P]
-inline constexpr int kRotationIndex = 10;     ///< rotation of X_BT: R_BT -> exp(dw) R_BT, dw [rad, B]
-inline constexpr int kTranslationIndex = 13;  ///< translation of X_BT [m, B]
-
-using ParameterVector = Eigen::Matrix<double, kIdentifiedParameters, 1>;
-using ParameterMatrix = Eigen::Matrix<double, kIdentifiedParameters, kIdentifiedParameters>;
-
-/// Name of parameter `i` for reports: "lead", "offset 1".."offset 6", "A x".., "rotation x"..,
-/// "translation x".. ("?" outside 0..15).
-std::string_view parameter_name(int i) noexcept;
-
-/// One candidate for the platform and the tracker placement.
-struct PlatformParameters {
-  double lead = 0.0;                          ///< screw lead, one for all six legs [m]
-  double twist_sign = 1.0;                    ///< sign of the twist term: +1 right-hand thread, -1 left (theory §4)
-  Vector6d length_offset = Vector6d::Zero();  ///< real minus commanded motor-side length delta_i [m]
-  Vector3d observation_P = Vector3d::Zero();  ///< observation point A [m, P]
-  RigidTransform X_BT;                        ///< tracker frame in the base frame: p_B = R p_T + t
-};
-
-/// Settings of identify.
+/// Settings of identify. The defaults are the CLI's.
 struct IdentificationOptions {
-  LeadEffect lead_effect = LeadEffect::TwistOnly;  ///< measurement model of the lead
-  int max_iterations = 100;                        ///< solver iterations per sign
+  CalibrationModel model = CalibrationModel::Geometry;  ///< which parameters
+  LeadEffect lead_effect = LeadEffect::TwistAndTravel;  ///< measurement model of the lead
+  AxisFit axes = AxisFit::Auto;                         ///< which U-joint axes (Geometry)
+  /// Auto: an axis direction is fitted when the data determine both its angles to this [rad].
+  double axis_sd_max = deg2rad(0.1);
+  /// The tracker's noise per coordinate [m]; NaN = its scatter at rest (tracker_scatter), which
+  /// needs several points per station and target.
+  double tracker_noise = std::numeric_limits<double>::quiet_NaN();
+  /// The tracker's noise counts as at least this (a log's rounding and the servo's settling are below it) [m].
+  double tracker_noise_floor = 1e-6;
+  /// The model-fit test: the fit's residual against the tracker's noise, refused beyond this many
+  /// normal deviates of its F distribution (theory §13; 5 = a false alarm in 3.5 million fits).
+  double fit_sigmas = 5.0;
+  /// The thread hand: the rejected sign must fit worse by this many noise variances, 2 dC / sigma^2 (a
+  /// chi-square of one degree of freedom: 25 = 5 sigma).
+  double sign_separation_min = 25.0;
+  int folds = 5;                    ///< cross-validation folds over the stations (0 = none; needs >= 2)
+  int accuracy_poses = 1000;        ///< poses of the predicted accuracy over the calibrated range
+  std::uint64_t accuracy_seed = 1;  ///< their seed
+  int max_iterations = 100;         ///< solver iterations per sign
   /// Largest accepted condition number of the column-scaled Jacobian; above it some parameter
   /// combination is undetermined (exact confounding gives about 1e15).
   double max_condition = 1e8;
-  FkOptions fk;  ///< forward kinematics of every observation
+  FkOptions fk;  ///< forward kinematics of every station
 };
 
-/// The solve with the twist sign held at one value.
+/// The solve with the thread sense held at one value.
 struct SignFit {
-  double twist_sign = 0.0;                      ///< the sign held
-  Status status = Status::SolverNoConvergence;  ///< Ok, SolverNoConvergence or what forward kinematics returned
-  double cost = std::numeric_limits<double>::infinity();  ///< half the sum of squared residuals at the end [m^2]
+  double twist_sign = 0.0;                                ///< +1: every hand as configured, -1: all flipped
+  Status status = Status::SolverNoConvergence;            ///< Ok, SolverNoConvergence or a forward kinematics status
+  double cost = std::numeric_limits<double>::infinity();  ///< half the sum of squared residuals of all points [m^2]
   int iterations = 0;                                     ///< solver iterations
-  bool lead_at_bound = false;                             ///< the lead ended at 0: this sign cannot explain the data
+  bool lead_at_bound = false;                             ///< a lead ended at 0: this sense cannot explain the twist
   std::string message;                                    ///< the solver's account of why it stopped
-  PlatformParameters estimate;                            ///< where it stopped
+  Eigen::VectorXd theta;  ///< where it stopped (ParameterSet order; the tracker rotation in X_BT)
+  RigidTransform X_BT;    ///< the tracker frame there
 };
 
-/// Result of identify (caller-owned). `estimate`, `sd`, `covariance` and the residuals after are
-/// meaningful when the status is Ok (and, as the solver left them, for SolverNoConvergence).
+/// A station with a large residual, for the report.
+struct StationResidual {
+  int station = -1;         ///< 0-based station (ObservationGroups::station)
+  int target = 0;           ///< target
+  std::size_t first = 0;    ///< its first observation
+  int count = 0;            ///< its observations
+  double mean_error = 0.0;  ///< |mean residual| [m]
+  double statistic = 0.0;   ///< count |mean residual|^2 / sigma_tracker^2: its share of the fit test [-]
+};
+
+/// Stations left out and predicted (theory §13).
+struct CrossValidation {
+  int folds = 0;      ///< 0: not done
+  int predicted = 0;  ///< groups predicted (each station and target once)
+  /// rms of the predicted groups' mean residual, |mean point - prediction| [m], and what the
+  /// tracker's noise and the parameters' covariance make it expected to be [m].
+  double rms = std::numeric_limits<double>::quiet_NaN();
+  double expected = std::numeric_limits<double>::quiet_NaN();
+  double max = std::numeric_limits<double>::quiet_NaN();  ///< largest predicted group's mean residual [m]
+  Status status = Status::Ok;                             ///< a fold whose fit failed
+};
+
+/// The predicted accuracy of the corrected platform over the calibrated range (theory §13): at
+/// random poses within the stations' range, inside every limit, the error of the target point
+/// that the estimate's covariance predicts for compensated commands, sqrt(trace(G C G^T)) with
+/// G = d A_B / d theta at fixed commands, in the gauge frames.
+struct AccuracyPrediction {
+  int poses = 0;                                             ///< poses evaluated
+  double median = std::numeric_limits<double>::quiet_NaN();  ///< median predicted point error [m]
+  double max = std::numeric_limits<double>::quiet_NaN();     ///< largest [m]
+  /// The same after the best rigid re-alignment of the frames over these poses: the error the
+  /// platform's shape leaves once a rigid motion (a registration) takes out the gauge frames' own
+  /// uncertainty [m] (theory §13).
+  double aligned_median = std::numeric_limits<double>::quiet_NaN();
+  double aligned_max = std::numeric_limits<double>::quiet_NaN();
+  Vector6d range_low = Vector6d::Zero();   ///< the calibrated range: the stations' smallest pose [m, rad]
+  Vector6d range_high = Vector6d::Zero();  ///< and largest
+};
+
+/// Result of identify (caller-owned). The estimate, standard deviations and covariance are
+/// meaningful when `fitted`; `corrected` when the status is Ok.
 struct Identification {
-  PlatformParameters estimate;                   ///< least-squares estimate with the chosen sign
-  ParameterVector sd = ParameterVector::Zero();  ///< standard deviations, parameter order [m; rad for the rotation]
-  ParameterMatrix covariance = ParameterMatrix::Zero();  ///< sigma^2 (J^T J)^-1 in the parameter order
-  /// Noise per coordinate from the fit, sqrt(sum |e|^2 / (3K - 16)) [m]: compare with the tracker's.
-  double sigma = std::numeric_limits<double>::quiet_NaN();
-  int count = 0;              ///< observations K
-  Registration registration;  ///< the start: Kabsch of the points onto the nominal model's A
+  Status status = Status::NotIdentifiable;  ///< Ok, or why not (reason)
+  std::string reason;                       ///< one line, for a status other than Ok
+  std::string hint;                         ///< what to do about it (may be empty)
+  bool fitted = false;                      ///< the solver ran to a usable solution
+  ParameterSet parameters;                  ///< which parameters, in which order
+  Eigen::VectorXd nominal;                  ///< the start: the nominal model's parameters
+  Eigen::VectorXd estimate;                 ///< ParameterSet order [m; rad for the tracker rotation]
+  Eigen::VectorXd sd;                       ///< standard deviations, the same order
+  Eigen::MatrixXd covariance;               ///< sigma^2 (J^T J)^-1 in that order
+  double twist_sign = 1.0;                  ///< +1: the thread hands as configured, -1: all flipped
+  RigidTransform X_BT;                      ///< the tracker frame in the base frame
+  ModelSpec corrected;                      ///< the corrected platform (ParameterSet::platform of the estimate)
+  /// The joint centres' estimated displacement from the nominal ones and its standard deviation,
+  /// per leg: base [m, B], platform [m, P] (zero in the Basic model).
+  LegVectors base_shift = LegVectors::Zero(), base_shift_sd = LegVectors::Zero();
+  LegVectors platform_shift = LegVectors::Zero(), platform_shift_sd = LegVectors::Zero();
+  /// The axes' predicted standard deviations if all were fitted (both angles, the larger) [rad]:
+  /// legs 1..6 base, then platform; NaN where not computed. Which were fitted: parameters.axes().
+  std::array<double, 2 * kLegs> axis_sd;
+  int observations = 0;  ///< points used
+  int stations = 0;      ///< stations (runs of one command)
+  int groups = 0;        ///< stations times the targets they measured
+  double sigma =
+      std::numeric_limits<double>::quiet_NaN();  ///< the fit's noise per coordinate, sqrt(sum |e|^2 / (3K - p)) [m]
+  /// The tracker's noise per coordinate the test uses [m]: options.tracker_noise or the scatter at
+  /// rest, at least the floor.
+  double tracker_noise = std::numeric_limits<double>::quiet_NaN();
+  double scatter = std::numeric_limits<double>::quiet_NaN();  ///< the scatter at rest [m] (NaN without repeats)
+  /// The model-fit test (theory §13): T = sum_groups count |mean residual|^2 / tracker_noise^2 on
+  /// dof = 3 groups - p degrees of freedom, and its normal deviate z (Paulson's approximation of
+  /// the F distribution; the model fails the test above options.fit_sigmas).
+  double fit_statistic = std::numeric_limits<double>::quiet_NaN();
+  int fit_dof = 0;
+  double fit_z = std::numeric_limits<double>::quiet_NaN();
+  std::vector<StationResidual> worst;  ///< the stations with the largest shares of T, largest first (up to 5)
   double rms_before =
       std::numeric_limits<double>::quiet_NaN();  ///< rms 3-D residual of the nominal model after Kabsch [m]
   double rms_after = std::numeric_limits<double>::quiet_NaN();  ///< rms 3-D residual at the estimate [m]
   double max_after = std::numeric_limits<double>::quiet_NaN();  ///< largest 3-D residual at the estimate [m]
-  int max_after_index = -1;                                     ///< 0-based observation with the largest residual
-  std::vector<Vector3d> residual_B;  ///< per observation, X_BT p_T minus the model's A at the estimate [m, B]
+  int max_after_index = -1;                                     ///< 0-based observation with the largest
+  std::vector<Vector3d> residual_B;  ///< per observation, X_BT p_T minus the model's target [m, B]
   std::array<SignFit, 2> fits;       ///< the solves with sign +1 ([0]) and -1 ([1])
-  /// Cost of the rejected sign over the chosen one: far above 1 when the data fix the sign.
-  double cost_ratio = std::numeric_limits<double>::quiet_NaN();
-  /// Condition number of the column-scaled Jacobian at the estimate (at the start if the check there failed).
+  double cost_ratio = std::numeric_limits<double>::quiet_NaN();       ///< rejected sign's cost over the chosen one's
+  double sign_separation = std::numeric_limits<double>::quiet_NaN();  ///< 2 (C_rejected - C_chosen) / sigma^2
+  /// Condition number of the column-scaled Jacobian at the estimate (at the start if it failed there).
   double condition = std::numeric_limits<double>::infinity();
-  ParameterVector weakest = ParameterVector::Zero();  ///< least-determined unit combination of column-scaled parameters
-  std::string reason;  ///< for a status other than Ok: what failed, naming the parameters or the observation
+  Eigen::VectorXd weakest;   ///< least-determined unit combination of column-scaled parameters
+  std::string undetermined;  ///< the parameters that enter the undetermined combinations
+  CrossValidation cross_validation;
+  AccuracyPrediction accuracy;
+
+  Identification() { axis_sd.fill(std::numeric_limits<double>::quiet_NaN()); }
 };
 
-/// Estimates lead, twist sign, length offsets, observation point and X_BT from the observations
-/// by nonlinear least squares (Ceres, Levenberg-Marquardt, exact Jacobians by the implicit
-/// function theorem through twist-aware forward kinematics), once per twist sign from the
-/// nominal model and a Kabsch start; keeps the sign of lower cost. Returns Ok, NonFiniteInput,
-/// NotIdentifiable (too few observations, a failed start registration, a rank-deficient
-/// Jacobian, a leg without U-joint axes), SolverNoConvergence, or a forward kinematics status
-/// that stopped both solves; `out.reason` says which in one line.
+/// Identifies the platform from the observations (theory §13): the nominal model and a Kabsch
+/// start, both thread senses by Levenberg-Marquardt (Ceres), the sense of lower cost; with
+/// AxisFit::Auto the axes the data determine; then the decisions. Returns Ok, or: NonFiniteInput;
+/// NotIdentifiable (too few observations or stations, a failed start registration, a
+/// rank-deficient Jacobian naming the parameters, a leg without U-joint axes, an unknown tracker
+/// noise); SignUndecided (both senses fit alike); ModelMismatch (the fit leaves more than the
+/// tracker's noise: the worst stations and a hint are given); SolverNoConvergence; or a forward
+/// kinematics status. `out.reason` says why in one line; `out.hint` what to do.
 [[nodiscard]] Status identify(const Model& nominal, std::span<const Observation> observations, Identification& out,
                               const IdentificationOptions& options = {});
 
-/// Residuals e_k = X_BT p_T,k - A_B,k of the candidate `p` (3K, observation k at rows 3k..3k+2)
-/// [m, B], and optionally their Jacobian (3K x 16) with respect to the parameters in the order
-/// of ParameterVector (rotation as the left perturbation dw). Forward kinematics starts from home
-/// for every observation. TwistAndTravel needs nominal leads > 0 (identify checks it). Returns Ok
-/// or the first failing forward kinematics status.
-[[nodiscard]] Status identification_residuals(const Model& nominal, std::span<const Observation> observations,
-                                              const PlatformParameters& p, const IdentificationOptions& options,
-                                              Eigen::VectorXd& residuals, Eigen::MatrixXd* J);
+/// The residual of every observation, X_BT p_T - A_B [m, B] (3K, observation k at rows 3k..3k+2),
+/// of the platform theta with thread sense `sign` and tracker frame X_BT, and optionally their
+/// Jacobian (3K x set.size(), the rotation as the left perturbation dw). Returns Ok or the status
+/// of the candidate model or of a forward kinematics.
+[[nodiscard]] Status identification_residuals(const ParameterSet& set, std::span<const Observation> observations,
+                                              const Eigen::VectorXd& theta, double sign, const RigidTransform& X_BT,
+                                              const FkOptions& fk, Eigen::VectorXd& residuals, Eigen::MatrixXd* J);
 
-/// The nominal specification corrected by an estimate: every leg's lead, its thread from the twist
-/// sign (driven side kept, theory §4) and its length offset; the observation point.
-ModelSpec corrected_spec(const ModelSpec& nominal, const PlatformParameters& estimate);
+/// The prediction of AccuracyPrediction for a covariance `covariance` of the platform parameters
+/// (set.platform_size() square) at `theta`, `sign`, over `poses` poses drawn within [low, high]
+/// (seeded) inside every limit of the platform; the errors at each pose are written to `errors` if
+/// given [m]. Returns Ok, NotIdentifiable (no pose of the range inside the limits) or a forward
+/// kinematics status.
+[[nodiscard]] Status predicted_accuracy(const ParameterSet& set, const Eigen::VectorXd& theta, double sign,
+                                        const Eigen::MatrixXd& covariance, const Vector6d& low, const Vector6d& high,
+                                        int poses, std::uint64_t seed, AccuracyPrediction& out,
+                                        std::vector<Vector6d>* poses_out = nullptr,
+                                        std::vector<double>* errors = nullptr);
+
+/// The predicted point error [m] at each pose of `poses` (m, rad from home; NaN outside a limit),
+/// as AccuracyPrediction: for the map figure and for Python.
+[[nodiscard]] Status predicted_errors(const ParameterSet& set, const Eigen::VectorXd& theta, double sign,
+                                      const Eigen::MatrixXd& covariance, std::span<const Vector6d> poses,
+                                      std::vector<double>& errors);
+
+/// The predicted point error over a slice of the calibrated range (a map figure): positions on a
+/// grid in the plane of two coordinates, the third at the range's middle, the orientation zero.
+struct AccuracyMap {
+  int axis_u = 0, axis_v = 1;  ///< the plane's coordinates (0, 1, 2 = x, y, z)
+  std::vector<double> u, v;    ///< the grid's coordinates along them [m]
+  /// Predicted point error at (u[i], v[j]) in error[j * u.size() + i] [m]; NaN outside a limit.
+  std::vector<double> error;
+};
+
+/// The map of `range` in the plane of coordinates axis_u, axis_v with n x n positions (n >= 2), as
+/// predicted_errors. Returns its status.
+[[nodiscard]] Status accuracy_map(const ParameterSet& set, const Eigen::VectorXd& theta, double sign,
+                                  const Eigen::MatrixXd& covariance, const AccuracyPrediction& range, int axis_u,
+                                  int axis_v, int n, AccuracyMap& out);
 
 }  // namespace hexatwist

@@ -1,8 +1,10 @@
 // What a real platform may have that its nominal model does not, in the parameters a laser tracker
-// can reveal: the screw lead, the sign of the twist term, each leg's zero-length offset and the
-// observation point. `hexatwist synth` builds a platform with known errors from these; an
-// identification estimates them (docs/theory.md §12, §13).
+// can reveal: the U-joint centres and fixed axes, the screw leads, the sign of the twist term, each
+// leg's zero-length offset and the observation point. `hexatwist synth` builds a platform with known
+// errors from these; an identification estimates them (docs/theory/calibration.md §12, §13).
 #pragma once
+
+#include <cstdint>
 
 #include "hexatwist/kinematics/model.hpp"
 
@@ -10,30 +12,49 @@ namespace hexatwist {
 
 /// The real platform against the nominal model. The default is no error.
 struct ParameterErrors {
-  /// Relative error of the lead on every leg: real lead = (1 + lead_error) nominal lead [-]. The
-  /// nut then travels (1 + lead_error) times as far per motor turn, and the twist term
-  /// (twist_gain, Eq. 10) is (1 + lead_error) times as large.
-  double lead_error = 0.0;
-  /// The real twist term has the opposite sign (the other thread hand than the model says; the
-  /// sign the paper's Eq. 9 loses).
+  /// Relative error of each leg's lead: real lead = (1 + lead_error_i) nominal lead [-]. The drives
+  /// still turn their motors by the nominal lead's angles, so the nut travels (1 + lead_error_i)
+  /// times as far per commanded metre about the drives' reference, and the twist term (Eq. 10) is
+  /// (1 + lead_error_i) times as large.
+  Vector6d lead_error = Vector6d::Zero();
+  /// The real twist term has the opposite sign on every leg (the other thread hand than the model
+  /// says; the sign the paper's Eq. 9 loses).
   bool flip_twist_sign = false;
   /// Real minus nominal motor-side length of each leg at the same motor angle [m]: the error of
   /// each leg's zero (home) length.
   Vector6d zero_offset = Vector6d::Zero();
   /// Real minus nominal observation point [m, P].
   Vector3d observation_offset_P = Vector3d::Zero();
+  /// Real minus nominal base U-joint centres [m, B] (rows: legs). Without a rigid part (no common
+  /// translation, no common small rotation about the centroid): B stays the least-squares frame
+  /// of the six centres, the gauge of an identification (theory §13).
+  LegVectors base_offset_B = LegVectors::Zero();
+  /// Real minus nominal platform U-joint centres [m, P] (rows: legs), without a rigid part likewise.
+  LegVectors platform_offset_P = LegVectors::Zero();
+  /// Small rotation of each base U-joint's fixed axis, a rotation vector [rad, B] (rows: legs).
+  LegVectors base_axis_rotation = LegVectors::Zero();
+  /// Small rotation of each platform U-joint's fixed axis [rad, P] (rows: legs).
+  LegVectors platform_axis_rotation = LegVectors::Zero();
 };
 
-/// The real platform's model: `nominal` with every leg's lead scaled by 1 + lead_error, the thread
-/// hand flipped if flip_twist_sign, and the observation point moved by observation_offset_P.
-/// Throws hexatwist::Error (from Model) if that model is invalid, e.g. lead_error <= -1.
+/// The real platform's model: `nominal` with the joints and axes moved, every leg's lead scaled by
+/// 1 + lead_error_i while its drive keeps the nominal lead (LegSpec::drive_lead) and reference
+/// (LegSpec::home_command), the thread hands flipped if flip_twist_sign, the zero offsets added to
+/// the length offsets and the observation point moved. Motor-side forward kinematics of the
+/// nominal model's commands on it gives the pose the real platform takes. Throws hexatwist::Error
+/// (from Model) if that model is invalid, e.g. a lead error <= -1.
 Model real_model(const Model& nominal, const ParameterErrors& errors);
 
-/// The real motor-side lengths [m] of the legs when the nominal model reads `motor_nominal` [m]
-/// from the encoders: each leg is at its motor angle theta = (m - l_home) / c, where the real nut
-/// has travelled (1 + lead_error) c theta and the leg's zero is off by zero_offset:
-/// m_real = l_home + zero_offset + (1 + lead_error) (m - l_home).
-void real_motor_lengths(const Model& nominal, const ParameterErrors& errors, const Vector6d& motor_nominal,
-                        Vector6d& motor_real) noexcept;
+/// The displacements `d` of six points `points` (rows) with their rigid part removed: d minus the
+/// common translation and the small rotation about the points' centroid that fit d best, so that
+/// the least-squares frame of the moved points is the frame of the original ones (theory §13).
+LegVectors without_rigid_part(const LegVectors& points, const LegVectors& d);
+
+/// Joint-centre errors drawn independently and uniformly in [-bound, bound] per coordinate [m],
+/// their rigid part per set removed (without_rigid_part); axis rotations likewise within
+/// `axis_bound` [rad] about the two directions across each axis. A portable generator: the same
+/// seed gives the same errors everywhere.
+void random_geometry_errors(const Model& nominal, double bound, double axis_bound, std::uint64_t seed,
+                            ParameterErrors& errors);
 
 }  // namespace hexatwist

@@ -8,6 +8,7 @@
 
 #include "hexatwist/calibration/measurement.hpp"
 #include "hexatwist/calibration/parameter_errors.hpp"
+#include "hexatwist/calibration/point_log.hpp"
 
 namespace hexatwist {
 
@@ -22,6 +23,9 @@ struct SynthesisOptions {
   /// resolves the servo (poles at 10 Hz, bandwidth ~39 Hz) and keeps a log small.
   double rate = 100.0;
   std::uint64_t seed = 1;  ///< seed of the tracker's placement and of the noise
+  /// More targets on the platform besides the observation point, measured at every sample after
+  /// it, named T2, T3, ... in the log [m, P of the real platform].
+  std::vector<Vector3d> extra_targets_P;
 };
 
 /// A synthetic log and its truth.
@@ -45,8 +49,9 @@ Vector6d random_zero_offsets(double bound, std::uint64_t seed);
 
 /// Simulates `trajectory` on `rig` in closed loop (`simulate`, with options.strategy; the
 /// controller and its encoders know only the nominal model) and, at every tracker sample, maps
-/// the motors' positions through the real platform: real_motor_lengths, then twist-aware forward
-/// kinematics of real_model (warm-started), gives the real pose and the real observation point;
+/// the motors' positions through the real platform: twist-aware forward kinematics of real_model
+/// (its joints, leads, offsets and the drives' reference and scale; warm-started) gives the real
+/// pose, and there the real observation point and every extra target;
 /// it is moved into the tracker frame (random_tracker_frame(seed)) and gets Gaussian noise
 /// (portable generator: the same seed gives the same log everywhere). Returns the simulation's
 /// status (Ok, or where it stopped in `issue`; forward kinematics failing on the real platform is

@@ -45,14 +45,4 @@ Config load_config(std::string_view yaml_text, std::string_view source);
 /// The embedded seed configuration with its servo, load and study sections.
 Config default_config();
 
-/// The configuration `yaml_text` with what an identification corrects taken from `corrected`: the
-/// name, the lead and thread (in `screw`, and in every leg entry that gives its own), `length_offsets`
-/// and `observation_point`. Every other key keeps its value and its place; comments are dropped,
-/// and the lines of `header` (may be empty) open the text as comments. Numbers are written to
-/// round trip exactly. The legs of `corrected` must share one lead and thread (as
-/// corrected_spec's do). Throws hexatwist::Error as load_config for text that does not load, and
-/// for legs that differ in lead or thread.
-std::string corrected_config_yaml(std::string_view yaml_text, std::string_view source, const ModelSpec& corrected,
-                                  std::string_view header);
-
 }  // namespace hexatwist

@@ -1,0 +1,116 @@
+// The parameters an identification estimates, their order, names and gauge: screw leads, zero
+// offsets, the twelve U-joint centres (in the gauge that keeps B and P the least-squares frames of
+// their joints), the U-joint axes where the data determine them, the targets on the platform and
+// the tracker frame; and the platform a parameter vector describes. Theory:
+// docs/theory/calibration.md §13.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "hexatwist/kinematics/model.hpp"
+
+namespace hexatwist {
+
+/// Which platform parameters an identification fits.
+enum class CalibrationModel {
+  Basic,     ///< leads, thread sense, zero offsets, targets, tracker frame (the joints as configured)
+  Geometry,  ///< also the twelve U-joint centres, and the axes AxisSelection names (theory §13)
+};
+
+/// How a lead that differs from the nominal one shows in the measurements (theory §13).
+enum class LeadEffect {
+  TwistOnly,  ///< through the twist term only: the drives' travel is right (their scale was set with the real lead)
+  TwistAndTravel,  ///< also through the travel: the drives turn the screws by the nominal lead's angles
+};
+
+/// One flag per U-joint fixed axis: legs 1..6 at the base, then legs 1..6 at the platform.
+using AxisSelection = std::array<bool, 2 * kLegs>;
+
+/// The layout of the parameter vector theta (caller-owned, built once per identification).
+/// Order: leads (one, or one per leg where the nominal leads differ), the six zero offsets, the
+/// base joints (12 gauge coordinates), the platform joints (12), the selected axes (2 each),
+/// three coordinates per target [m, P], the tracker rotation dw [rad, B] and translation [m, B].
+/// Joints and axes only in the Geometry model.
+class ParameterSet {
+ public:
+  /// The layout for `nominal` (its leads decide one or six lead parameters).
+  ParameterSet(const Model& nominal, CalibrationModel model, LeadEffect lead_effect, const AxisSelection& axes,
+               int targets);
+  ParameterSet() = default;
+
+  CalibrationModel model() const noexcept { return model_; }
+  LeadEffect lead_effect() const noexcept { return lead_effect_; }
+  /// Number of parameters, the tracker frame's six included.
+  int size() const noexcept { return size_; }
+  /// Number of platform parameters (all but the tracker frame's six).
+  int platform_size() const noexcept { return rotation_; }
+  int lead_index() const noexcept { return 0; }
+  int lead_count() const noexcept { return lead_count_; }
+  int offset_index() const noexcept { return offset_; }
+  /// First gauge coordinate of the base / platform joints; -1 in the Basic model.
+  int base_index() const noexcept { return base_; }
+  int platform_index() const noexcept { return platform_; }
+  /// First axis parameter; each selected axis has two (rotations about e1, e2 across it).
+  int axis_index() const noexcept { return axis_; }
+  const AxisSelection& axes() const noexcept { return axes_; }
+  int axis_count() const noexcept { return axis_count_; }
+  int target_index() const noexcept { return target_; }
+  int targets() const noexcept { return targets_; }
+  int rotation_index() const noexcept { return rotation_; }
+  int translation_index() const noexcept { return rotation_ + 3; }
+
+  /// The parameter's name for reports: "lead" or "lead 1".., "offset 1".., "base joints g1"..
+  /// (gauge coordinates), "platform joints g1".., "base axis 2 e1", "A x" (target 0) or "target
+  /// 2 x", "rotation x", "translation x"; "?" outside.
+  std::string name(int i) const;
+  /// The parameter group a name belongs to ("lead", "offsets", "base joints", ...).
+  std::string group(int i) const;
+
+  /// Gauge basis of the base / platform joint displacements: an orthonormal 18 x 12 matrix whose
+  /// columns span the displacements (joint i's x, y, z in rows 3i..3i+2) without a rigid part; the
+  /// joint displacement is basis * (gauge coordinates).
+  const Eigen::MatrixXd& base_basis() const noexcept { return base_basis_; }
+  const Eigen::MatrixXd& platform_basis() const noexcept { return platform_basis_; }
+  /// The two unit directions across selected axis `a` (0..11) of the nominal model, e1 and e2.
+  const std::array<Vector3d, 2>& axis_directions(int a) const noexcept {
+    return axis_directions_[static_cast<std::size_t>(a)];
+  }
+
+  /// The nominal parameters (tracker frame zero; targets other than 0 at zero until the data place them).
+  Eigen::VectorXd nominal_vector() const;
+
+  /// The platform that theta describes with the thread sense `sign` (+1: every leg's hand as
+  /// configured, -1: every one flipped): the nominal specification with the joints, axes, leads,
+  /// threads, zero offsets and target 0 (the observation point) replaced. The drives keep the
+  /// nominal model's reference (home_command) and, with TwistAndTravel, its drive lead (theory §4).
+  ModelSpec platform(const Eigen::VectorXd& theta, double sign) const;
+
+  /// Target t's position in theta [m, P].
+  Vector3d target(const Eigen::VectorXd& theta, int t) const { return theta.segment<3>(target_ + 3 * t); }
+
+  /// The nominal model's specification this layout was built from.
+  const ModelSpec& nominal() const noexcept { return nominal_; }
+
+ private:
+  ModelSpec nominal_;
+  Vector6d nominal_drive_lead_ = Vector6d::Zero();
+  Vector6d nominal_home_command_ = Vector6d::Zero();
+  CalibrationModel model_ = CalibrationModel::Basic;
+  LeadEffect lead_effect_ = LeadEffect::TwistAndTravel;
+  AxisSelection axes_{};
+  int lead_count_ = 1, offset_ = 1, base_ = -1, platform_ = -1, axis_ = -1, axis_count_ = 0, target_ = 7, targets_ = 1,
+      rotation_ = 10, size_ = 16;
+  Eigen::MatrixXd base_basis_, platform_basis_;
+  std::array<std::array<Vector3d, 2>, 2 * kLegs> axis_directions_{};
+};
+
+/// Gauge basis of six points' displacements without a rigid part: an orthonormal 18 x 12 basis of
+/// the displacements d with sum d_i = 0 and sum (x_i - c) x d_i = 0 (c the centroid), the exact
+/// conditions under which the least-squares (Kabsch) frame of the moved points is that of `points`.
+Eigen::MatrixXd gauge_basis(const LegVectors& points);
+
+}  // namespace hexatwist

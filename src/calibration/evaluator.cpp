@@ -1,0 +1,192 @@
+#include "calibration/evaluator.hpp"
+
+#include <ceres/jet.h>
+
+#include <Eigen/LU>
+#include <cmath>
+
+#include "hexatwist/error.hpp"
+#include "hexatwist/kinematics/twist.hpp"
+#include "kinematics/geometry.hpp"
+
+namespace hexatwist::detail {
+namespace {
+
+// Leg-local parameters differentiated with dual numbers: the base joint (0..2), the platform joint
+// (3..5), the base axis turned towards e1, e2 (6, 7) and the platform axis likewise (8, 9).
+constexpr int kLocal = 10;
+using Jet = ceres::Jet<double, kLocal>;
+using Jet3 = std::array<Jet, 3>;
+
+Jet3 sub(const Jet3& a, const Jet3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Jet dot(const Jet3& a, const Jet3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Jet3 cross(const Jet3& a, const Jet3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+Jet3 rotate(const Matrix3d& R, const Jet3& v) {
+  Jet3 out;
+  for (int r = 0; r < 3; ++r) out[r] = R(r, 0) * v[0] + R(r, 1) * v[1] + R(r, 2) * v[2];
+  return out;
+}
+Jet3 constant(const Vector3d& v) { return {Jet(v.x()), Jet(v.y()), Jet(v.z())}; }
+// v + d v / d(variable k..k+2) = the unit vectors.
+Jet3 variable(const Vector3d& v, int k) { return {Jet(v.x(), k), Jet(v.y(), k + 1), Jet(v.z(), k + 2)}; }
+// An axis turned towards e1 (variable k) and e2 (variable k + 1).
+Jet3 axis_variable(const Vector3d& a, const std::array<Vector3d, 2>& e, int k) {
+  Jet3 out = constant(a);
+  for (int c = 0; c < 3; ++c) {
+    out[static_cast<std::size_t>(c)].v[k] = e[0][c];
+    out[static_cast<std::size_t>(c)].v[k + 1] = e[1][c];
+  }
+  return out;
+}
+
+// The twist angle jb -> je about s, theory §3: atan2(s . (ja x jd), ja . jd - (ja . s)(jd . s)),
+// homogeneous in the axes' lengths (so they need no normalising).
+Jet twist_angle(const Jet3& s, const Jet3& ja, const Jet3& jd) {
+  return atan2(dot(s, cross(ja, jd)), dot(ja, jd) - dot(ja, s) * dot(jd, s));
+}
+
+// d(|L_i| - k_i dtheta_i) with respect to leg i's local parameters at the placement x (theory §13):
+// the length and the twist since home, whose home angle moves with the joints and axes too.
+Eigen::Matrix<double, 1, kLocal> leg_gradient(const Model& candidate, const ParameterSet& set, int i,
+                                              const Placement& x) {
+  const ModelSpec& spec = candidate.spec();
+  const LegSpec& leg = spec.legs[static_cast<std::size_t>(i)];
+  const Jet3 b = variable(leg.base_B, 0), p = variable(leg.platform_P, 3);
+  const Jet3 arm = sub(p, constant(spec.pivot_P));
+  const Jet3 Rarm = rotate(x.R_BP, arm);
+  const Vector3d origin = candidate.pivot_home_B() + x.t;
+  const Jet3 L = sub({Rarm[0] + origin.x(), Rarm[1] + origin.y(), Rarm[2] + origin.z()}, b);
+  const Jet length = sqrt(dot(L, L));
+  Jet f = length;
+  const double k = candidate.leg(i).twist_gain;
+  if (!std::isnan(candidate.leg(i).theta_home) && k != 0.0) {
+    const Jet3 s = {L[0] / length, L[1] / length, L[2] / length};
+    const Jet3 ja = axis_variable(leg.axis_base_B, set.axis_directions(i), 6);
+    const Jet3 jd = axis_variable(leg.axis_platform_P, set.axis_directions(kLegs + i), 8);
+    const Jet3 L0 = sub({p[0], p[1], p[2] + spec.home_height}, b);
+    const Jet length0 = sqrt(dot(L0, L0));
+    const Jet3 s0 = {L0[0] / length0, L0[1] / length0, L0[2] / length0};
+    f -= k * (twist_angle(s, ja, rotate(x.R_BP, jd)) - twist_angle(s0, ja, jd));
+  }
+  return f.v.transpose();
+}
+
+}  // namespace
+
+Status pose_sensitivity(const Model& candidate, const ParameterSet& set, const FkResult& fk, const Vector6d& motor,
+                        Eigen::Matrix<double, 6, Eigen::Dynamic>& dx_dtheta) {
+  Matrix6d J_f_x;
+  if (const Status s = length_jacobian(candidate, fk.legs, LengthKind::Motor, J_f_x); s != Status::Ok) return s;
+  Vector6d dtheta = Vector6d::Zero();
+  if (candidate.has_twist())
+    if (const Status s = twist(candidate, fk.legs, dtheta); s != Status::Ok) return s;
+  const int n = set.platform_size();
+  Eigen::Matrix<double, 6, Eigen::Dynamic> df(6, n);
+  df.setZero();
+  const bool travel = set.lead_effect() == LeadEffect::TwistAndTravel;
+  const bool geometry = set.model() == CalibrationModel::Geometry;
+  const int joints = 3 * kLegs - 6;
+  for (int i = 0; i < kLegs; ++i) {
+    const Leg& leg = candidate.leg(i);
+    // The lead enters the twist term and, with the travel effect, the nut's travel about the
+    // drives' reference: u = h + (P / P_drive)(m - h) (theory §4, §13).
+    double d_lead = -leg.twist_sign * dtheta[i] / (2.0 * kPi);
+    if (travel && leg.lead > 0.0) d_lead -= (motor[i] - candidate.home_command()[i]) * leg.drive_scale / leg.lead;
+    df(i, set.lead_count() == 1 ? 0 : i) = d_lead;
+    df(i, set.offset_index() + i) = -1.0;
+    if (!geometry) continue;
+    const Eigen::Matrix<double, 1, kLocal> g = leg_gradient(candidate, set, i, fk.placement);
+    df.row(i).segment(set.base_index(), joints) = g.segment<3>(0) * set.base_basis().middleRows<3>(3 * i);
+    df.row(i).segment(set.platform_index(), joints) = g.segment<3>(3) * set.platform_basis().middleRows<3>(3 * i);
+    int k = set.axis_index();
+    for (int a = 0; a < 2 * kLegs; ++a) {
+      if (!set.axes()[static_cast<std::size_t>(a)]) continue;
+      if (a % kLegs == i) df.row(i).segment<2>(k) = g.segment<2>(a < kLegs ? 6 : 8);
+      k += 2;
+    }
+  }
+  const Eigen::PartialPivLU<Matrix6d> lu(J_f_x);
+  if (!(std::abs(lu.determinant()) > 0.0)) return Status::SingularJacobian;
+  dx_dtheta = -lu.solve(df);
+  return Status::Ok;
+}
+
+Vector3d target_B(const Model& candidate, const Placement& x, const ParameterSet& set, const Eigen::VectorXd& theta,
+                  int target) {
+  return platform_point_B(candidate, x, set.target(theta, target));
+}
+
+Eigen::Matrix<double, 3, Eigen::Dynamic> point_sensitivity(const ParameterSet& set, const FkResult& fk,
+                                                           const Eigen::Matrix<double, 6, Eigen::Dynamic>& dx_dtheta,
+                                                           const Eigen::VectorXd& theta, int target) {
+  // A_B = pivot_home + t + R (A_P - pivot_P): a left perturbation of R turns the arm (theory §13).
+  const Vector3d arm_B = fk.placement.R_BP * (set.target(theta, target) - set.nominal().pivot_P);
+  Eigen::Matrix<double, 3, 6> dA_dx;
+  dA_dx.leftCols<3>().setIdentity();
+  dA_dx.rightCols<3>() = -skew(arm_B);
+  Eigen::Matrix<double, 3, Eigen::Dynamic> G = dA_dx * dx_dtheta;
+  G.middleCols<3>(set.target_index() + 3 * target) += fk.placement.R_BP;
+  return G;
+}
+
+Evaluator::Evaluator(const ParameterSet& set, std::span<const Observation> observations,
+                     const ObservationGroups& groups, const FkOptions& fk)
+    : set_(set), observations_(observations), groups_(groups), fk_options_(fk) {
+  station_motor_.resize(static_cast<std::size_t>(groups.stations));
+  for (std::size_t g = 0; g < groups.station.size(); ++g)
+    station_motor_[static_cast<std::size_t>(groups.station[g])] = observations[groups.first[g]].motor;
+  poses_.assign(station_motor_.size(), Placement{});
+}
+
+Status Evaluator::evaluate(const Eigen::VectorXd& theta, double sign, const RigidTransform& X_BT, Eigen::VectorXd& e,
+                           Eigen::MatrixXd* J, std::span<const char> skip) {
+  candidate_.reset();
+  try {
+    candidate_.emplace(set_.platform(theta, sign));
+  } catch (const Error&) {
+    failed_station_ = -1;
+    return Status::NonFiniteInput;  // a lead, offset or joint the Model refuses
+  }
+  const Model& model = *candidate_;
+  const auto stations = static_cast<std::size_t>(groups_.stations);
+  const auto skipped = [&](std::size_t s) { return s < skip.size() && skip[s] != 0; };
+  std::vector<FkResult> fk(stations);
+  for (std::size_t s = 0; s < stations; ++s) {
+    if (skipped(s)) continue;
+    if (const Status st =
+            forward_kinematics(model, station_motor_[s], LengthKind::Motor, poses_[s], fk[s], fk_options_);
+        st != Status::Ok && st != Status::AssemblyModeChanged) {
+      failed_station_ = static_cast<int>(s);
+      return st;
+    }
+    poses_[s] = fk[s].placement;
+  }
+  std::vector<Eigen::Matrix<double, 6, Eigen::Dynamic>> dx(J != nullptr ? stations : 0);
+  for (std::size_t s = 0; s < dx.size(); ++s) {
+    if (skipped(s)) continue;
+    if (const Status st = pose_sensitivity(model, set_, fk[s], station_motor_[s], dx[s]); st != Status::Ok) {
+      failed_station_ = static_cast<int>(s);
+      return st;
+    }
+  }
+  const auto groups = static_cast<Eigen::Index>(groups_.station.size());
+  e.setZero(3 * groups);
+  if (J != nullptr) J->setZero(3 * groups, set_.size());
+  for (Eigen::Index g = 0; g < groups; ++g) {
+    const auto s = static_cast<std::size_t>(groups_.station[static_cast<std::size_t>(g)]);
+    if (skipped(s)) continue;
+    const int target = groups_.target[static_cast<std::size_t>(g)];
+    const double w = std::sqrt(static_cast<double>(groups_.count[static_cast<std::size_t>(g)]));
+    const Vector3d p_B = X_BT.R * groups_.mean_T[static_cast<std::size_t>(g)];
+    e.segment<3>(3 * g) = w * (p_B + X_BT.t - target_B(model, fk[s].placement, set_, theta, target));
+    if (J == nullptr) continue;
+    J->block(3 * g, 0, 3, set_.platform_size()) = -w * point_sensitivity(set_, fk[s], dx[s], theta, target);
+    J->block<3, 3>(3 * g, set_.rotation_index()) = -w * skew(p_B);  // exp(dw) R p = R p + dw x R p
+    J->block<3, 3>(3 * g, set_.translation_index()) = w * Matrix3d::Identity();
+  }
+  return Status::Ok;
+}
+
+}  // namespace hexatwist::detail

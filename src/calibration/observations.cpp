@@ -1,0 +1,91 @@
+#include "hexatwist/calibration/observations.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+
+#include "calibration/log_alignment.hpp"
+#include "hexatwist/error.hpp"
+
+namespace hexatwist {
+
+ObservationGroups group_observations(std::span<const Observation> observations) {
+  ObservationGroups g;
+  g.group_of.assign(observations.size(), -1);
+  // Stations are runs of one command; within a station, one group per target.
+  std::size_t begin = 0;
+  while (begin < observations.size()) {
+    std::size_t end = begin + 1;
+    while (end < observations.size() &&
+           (observations[end].motor - observations[begin].motor).cwiseAbs().maxCoeff() <= kSameCommand)
+      ++end;
+    const int station = g.stations++;
+    const auto first_group = static_cast<int>(g.station.size());
+    for (std::size_t k = begin; k < end; ++k) {
+      const int target = observations[k].target;
+      g.targets = std::max(g.targets, target + 1);
+      int group = -1;
+      for (int h = first_group; h < static_cast<int>(g.station.size()); ++h)
+        if (g.target[static_cast<std::size_t>(h)] == target) group = h;
+      if (group < 0) {
+        group = static_cast<int>(g.station.size());
+        g.station.push_back(station);
+        g.target.push_back(target);
+        g.count.push_back(0);
+        g.first.push_back(k);
+        g.mean_T.push_back(Vector3d::Zero());
+      }
+      g.group_of[k] = group;
+      ++g.count[static_cast<std::size_t>(group)];
+      g.mean_T[static_cast<std::size_t>(group)] += observations[k].p_T;
+    }
+    begin = end;
+  }
+  for (std::size_t h = 0; h < g.station.size(); ++h) g.mean_T[h] /= static_cast<double>(g.count[h]);
+  for (std::size_t k = 0; k < observations.size(); ++k)
+    g.scatter_sum += (observations[k].p_T - g.mean_T[static_cast<std::size_t>(g.group_of[k])]).squaredNorm();
+  g.scatter_dof = 3 * (observations.size() - g.station.size());
+  return g;
+}
+
+double tracker_scatter(const ObservationGroups& groups) noexcept {
+  return groups.scatter_dof >= 3 ? std::sqrt(groups.scatter_sum / static_cast<double>(groups.scatter_dof))
+                                 : std::numeric_limits<double>::quiet_NaN();
+}
+
+ObservationSet observations_at_rest(const Model& model, const TimedPoses& commanded, const PointLog& log,
+                                    const TimeAlignment& time, Strategy strategy, double settle) {
+  detail::check_settle(log.source, settle);
+  const std::vector<double> times = detail::aligned_times(commanded, log, time);
+  const std::vector<Pose> desired = interpolate(commanded, times);
+  ObservationSet set;
+  set.settle = settle;
+  set.targets = log.target_names.empty() ? std::vector<std::string>{"A"} : log.target_names;
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    if (!detail::at_rest(commanded, times[k], desired[k].to_vector(), settle)) continue;
+    Observation o;
+    LimitReport limit;
+    if (const Status s = motor_commands(model, desired[k], strategy, o.motor, limit); s != Status::Ok)
+      throw Error(fmt::format("{}: the commanded pose at t = {} s is outside a limit ({}); no command reached it",
+                              detail::point_location(log, k), times[k], describe(s)));
+    o.p_T = log.points_T[k];
+    o.target = k < log.targets.size() ? log.targets[k] : 0;
+    if (set.points.empty() ||
+        (desired[k].to_vector() - desired[set.points.back()].to_vector()).cwiseAbs().maxCoeff() > detail::kSamePose)
+      ++set.poses;
+    set.observations.push_back(o);
+    set.points.push_back(k);
+  }
+  if (set.observations.size() < kMinObservations)
+    throw Error(fmt::format(
+        "{}: only {} of the {} points {}; an identification needs at least {} (lower the settle time, or record "
+        "a run that stops at more poses: a stations run)",
+        log.source, set.observations.size(), times.size(),
+        settle > 0.0 ? fmt::format("are at rest (commanded pose unchanged for {} s)", settle)
+                     : std::string("are usable"),
+        kMinObservations));
+  return set;
+}
+
+}  // namespace hexatwist

@@ -1,0 +1,121 @@
+#include "hexatwist/io/platform_yaml.hpp"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <initializer_list>
+#include <set>
+#include <string>
+
+#include "hexatwist/error.hpp"
+#include "hexatwist/io/config.hpp"
+
+namespace hexatwist {
+namespace {
+
+// Shortest text that reads back to the same double.
+YAML::Node number(double v) { return YAML::Node(fmt::format("{}", v)); }
+
+YAML::Node flow(std::initializer_list<double> values) {
+  YAML::Node list(YAML::NodeType::Sequence);
+  for (const double v : values) list.push_back(number(v));
+  list.SetStyle(YAML::EmitterStyle::Flow);
+  return list;
+}
+
+YAML::Node flow(const Vector3d& v) { return flow({v.x(), v.y(), v.z()}); }
+
+YAML::Node flow(const Vector6d& v) { return flow({v[0], v[1], v[2], v[3], v[4], v[5]}); }
+
+// The keys that describe the platform: replaced by the block, wherever the user had them.
+const std::set<std::string> kPlatformKeys{"name",  "symmetric",      "legs",          "home_height",
+                                          "screw", "length_offsets", "home_commands", "observation_point"};
+
+const char* thread_name(ThreadSense t) { return t == ThreadSense::Right ? "right" : "left"; }
+const char* driven_name(DrivenSide d) { return d == DrivenSide::Base ? "base" : "platform"; }
+
+// Equal, NaN equal to NaN (a drive lead not given).
+bool same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+
+// The legs of `platform` in the legs form, the screw block's values left to it.
+YAML::Node legs_node(const ModelSpec& platform) {
+  const LegSpec& first = platform.legs[0];
+  YAML::Node legs(YAML::NodeType::Sequence);
+  for (const LegSpec& leg : platform.legs) {
+    YAML::Node n(YAML::NodeType::Map);
+    n["base"] = flow(leg.base_B);
+    n["platform"] = flow(leg.platform_P);
+    n["base_axis"] = flow(leg.axis_base_B);
+    n["platform_axis"] = flow(leg.axis_platform_P);
+    if (leg.lead != first.lead) n["lead"] = number(leg.lead);
+    // A leg that gives its own lead takes its drive lead from itself, not from the block.
+    if (!same(leg.drive_lead, first.drive_lead) || (leg.lead != first.lead && !std::isnan(leg.drive_lead)))
+      if (!std::isnan(leg.drive_lead)) n["drive_lead"] = number(leg.drive_lead);
+    if (leg.thread != first.thread) n["thread"] = thread_name(leg.thread);
+    if (leg.driven != first.driven) n["driven_side"] = driven_name(leg.driven);
+    legs.push_back(n);
+  }
+  return legs;
+}
+
+}  // namespace
+
+std::string platform_config_yaml(std::string_view yaml_text, std::string_view source, const ModelSpec& platform,
+                                 std::string_view header, bool write_home_commands) {
+  (void)load_config(yaml_text, source);  // located errors for text that does not load
+  const Model model(platform);           // and a platform that is no model
+  const LegSpec& first = platform.legs[0];
+  // The platform block, in the order the legs form reads.
+  YAML::Node block(YAML::NodeType::Map);
+  block["name"] = platform.name;
+  block["home_height"] = number(platform.home_height);
+  YAML::Node screw(YAML::NodeType::Map);
+  screw["lead"] = number(first.lead);
+  screw["thread"] = thread_name(first.thread);
+  screw["driven_side"] = driven_name(first.driven);
+  if (!std::isnan(first.drive_lead)) screw["drive_lead"] = number(first.drive_lead);
+  block["screw"] = screw;
+  block["legs"] = legs_node(platform);
+  Vector6d offsets, homes;
+  bool homes_differ = false;
+  for (int i = 0; i < kLegs; ++i) {
+    const LegSpec& leg = platform.legs[static_cast<std::size_t>(i)];
+    offsets[i] = leg.length_offset;
+    homes[i] = model.home_command()[i];
+    homes_differ = homes_differ || !std::isnan(leg.home_command);
+  }
+  block["length_offsets"] = flow(offsets);
+  if (write_home_commands || homes_differ) block["home_commands"] = flow(homes);
+  block["observation_point"] = flow(platform.observation_P);
+  // The user's keys in their order, the platform block where its first key stood.
+  const YAML::Node original = YAML::Load(std::string(yaml_text));
+  YAML::Node root(YAML::NodeType::Map);
+  bool placed = false;
+  for (const auto& kv : original) {
+    const std::string key = kv.first.as<std::string>();
+    if (kPlatformKeys.contains(key)) {
+      if (!placed)
+        for (const auto& b : block) root[b.first.as<std::string>()] = b.second;
+      placed = true;
+      continue;
+    }
+    root[key] = kv.second;
+  }
+  if (!placed)
+    for (const auto& b : block) root[b.first.as<std::string>()] = b.second;
+
+  std::string text;
+  for (std::size_t begin = 0; begin < header.size();) {
+    const std::size_t end = std::min(header.find('\n', begin), header.size());
+    text += "# " + std::string(header.substr(begin, end - begin)) + "\n";
+    begin = end + 1;
+  }
+  YAML::Emitter out;
+  out << root;
+  text += std::string(out.c_str()) + "\n";
+  (void)load_config(text, source);  // what is written loads (a bug here must not reach a file)
+  return text;
+}
+
+}  // namespace hexatwist
