@@ -13,6 +13,7 @@
 
 #include "cli_common.hpp"
 #include "json.hpp"
+#include "output_files.hpp"
 #include "run_options.hpp"
 #include "study_report.hpp"
 
@@ -150,6 +151,11 @@ std::string identify_json(const Model& nominal, const IdentifyOptions& o, const 
 }
 
 int run_identify(const IdentifyOptions& o) {
+  OutputFiles files("identify");
+  files.input("--config", o.run.model.config);
+  files.input("--trajectory", o.run.trajectory);
+  files.input("--points", o.log.points);
+  files.output("--out", o.out);
   const Config config = load_config_from(o.run.model);
   const Model& model = config.rig.model();
   const PointLogFormat format = log_format(o.log);
@@ -216,7 +222,7 @@ int run_identify(const IdentifyOptions& o) {
   }
   const std::string source_text = o.run.model.config.empty()
                                       ? std::string(seed_config_yaml())
-                                      : read_text_file(o.run.model.config, "--config", "config file");
+                                      : read_text_file(o.run.model.config, "--config", "config file", kMaxConfigBytes);
   ModelSpec corrected = corrected_spec(model.spec(), id.estimate);
   corrected.name = fmt::format("{} (identified from {})", model.spec().name, o.log.points);
   const std::string header = fmt::format(
@@ -234,12 +240,13 @@ int run_identify(const IdentifyOptions& o) {
          Status::NotIdentifiable);
   }
   try {
-    write_output_file(o.out, yaml);
+    files.add(o.out, yaml);
+    files.commit();
   } catch (const ExitError& e) {
     fail(e, status);
   }
   if (o.json) {
-    write_stdout_or_withdraw(identify_json(model, o, set, log, id, status, true, std::string()) + "\n", {o.out});
+    files.finish(identify_json(model, o, set, log, id, status, true, std::string()) + "\n");
     return kExitOk;
   }
 
@@ -277,7 +284,7 @@ int run_identify(const IdentifyOptions& o) {
       id.estimate.X_BT.t.x(), id.estimate.X_BT.t.y(), id.estimate.X_BT.t.z(), rad2deg(turn.angle()), turn.axis().x(),
       turn.axis().y(), turn.axis().z());
   text += fmt::format("wrote {}: the corrected configuration", o.out);
-  write_stdout_or_withdraw(text + "\n", {o.out});
+  files.finish(text + "\n");
   return kExitOk;
 }
 

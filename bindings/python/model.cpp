@@ -4,6 +4,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -229,14 +230,13 @@ std::pair<std::string, std::string> read_source(const py::object& path_or_text) 
                 std::string(py::str(py::type::of(path_or_text).attr("__name__"))));
   }
   source = py::str(os.attr("fspath")(path_or_text)).cast<std::string>();
-  std::ifstream in(source, std::ios::binary);
-  if (!in) {
+  std::error_code ec;
+  if (!std::filesystem::exists(source, ec)) {
     PyErr_SetString(PyExc_FileNotFoundError, (source + ": cannot open the file").c_str());
     throw py::error_already_set();
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return {ss.str(), source};
+  // The library's reader: a directory, an unreadable or an overlong file is a ConfigError, as in C.
+  return {read_text_file(source, "configuration file", kMaxConfigBytes), source};
 }
 
 }  // namespace

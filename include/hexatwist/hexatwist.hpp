@@ -34,3 +34,4 @@
 
 #include "hexatwist/io/config.hpp"
 #include "hexatwist/io/mjcf.hpp"
+#include "hexatwist/io/text_file.hpp"

@@ -28,6 +28,7 @@ enum class Status : int {
                            ///< condition number exceeds limits.jacobian_condition_max
   AssemblyModeChanged,  ///< forward kinematics found a solution on another assembly mode than its start (the Jacobian
                         ///< determinant changed sign)
+  InvalidArgument,      ///< an option or argument outside its documented range (check_fk_options, a length <= 0)
 };
 
 /// True for the statuses that mean "this pose is outside a limit".
