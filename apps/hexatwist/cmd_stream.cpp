@@ -276,6 +276,28 @@ void print_summary(const StreamState& state, const std::array<std::uint64_t, 64>
                  static_cast<unsigned long long>(refused), out_text.c_str());
 }
 
+// The next datagram as a line: waiting in the kernel, or spinning on a non-blocking receive
+// (--busy-poll: no sleep and wake-up between datagrams; the idle timeout kept by the clock).
+UdpSocket::Received receive_datagram(UdpSocket& in, const StreamOptions& o, std::array<char, 2048>& datagram,
+                                     std::string_view& line) {
+  std::size_t size = 0;
+  bool truncated = false;
+  auto r = UdpSocket::Received::Timeout;
+  if (o.busy_poll) {
+    const auto since = std::chrono::steady_clock::now();
+    const auto idle = std::chrono::duration<double>(o.idle_timeout > 0 ? o.idle_timeout : 1e300);
+    while (!g_stop && (r = in.try_receive(datagram, size, truncated)) == UdpSocket::Received::Timeout &&
+           std::chrono::steady_clock::now() - since < idle) {
+    }
+    if (g_stop) r = UdpSocket::Received::Interrupted;
+  } else {
+    r = in.receive(datagram, size, truncated);
+  }
+  // A datagram longer than the buffer cannot be a pose; the parser says so (too long).
+  line = std::string_view(datagram.data(), truncated ? datagram.size() : size);
+  return r;
+}
+
 int run_stream(const StreamOptions& o) {
   const Model model = load_model_from(o.model);
   const StreamSettings settings = settings_from(o);
@@ -326,28 +348,12 @@ int run_stream(const StreamOptions& o) {
   while (!g_stop && (o.count == 0 || state->inputs < o.count)) {
     std::string_view line;
     if (in_udp) {
-      std::size_t size = 0;
-      bool truncated = false;
-      auto r = UdpSocket::Received::Timeout;
-      if (o.busy_poll) {
-        // Spin on a non-blocking receive: no sleep and wake-up between datagrams. The idle
-        // timeout is kept by the clock.
-        const auto since = std::chrono::steady_clock::now();
-        const auto idle = std::chrono::duration<double>(o.idle_timeout > 0 ? o.idle_timeout : 1e300);
-        while (!g_stop && (r = in_udp->try_receive(datagram, size, truncated)) == UdpSocket::Received::Timeout &&
-               std::chrono::steady_clock::now() - since < idle) {
-        }
-        if (g_stop) r = UdpSocket::Received::Interrupted;
-      } else {
-        r = in_udp->receive(datagram, size, truncated);
-      }
+      const auto r = receive_datagram(*in_udp, o, datagram, line);
       if (r == UdpSocket::Received::Timeout) {
         stop_reason = fmt::format("no datagram for {} s (--idle-timeout)", o.idle_timeout);
         break;
       }
       if (r == UdpSocket::Received::Interrupted) break;
-      // A datagram longer than the buffer cannot be a pose; the parser says so (too long).
-      line = std::string_view(datagram.data(), truncated ? datagram.size() : size);
     } else {
       if (!reader.has_complete_line()) sink.flush();  // about to wait: what was answered goes out now
       const auto r = reader.next(line);

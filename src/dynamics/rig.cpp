@@ -40,7 +40,7 @@ void check_servo(const ServoSpec& s) {
   positive(s.friction_speed, 1e4, "servo.friction_speed", "rad/s");
   non_negative(s.torque_time_constant, 1.0, "servo.torque_time_constant", "s");
   positive(s.torque_limit, 1e5, "servo.torque_limit", "N m");
-  positive(s.max_speed, 1e5 * 2.0 * kPi / 60.0, "servo.max_speed", "rad/s (1e5 rpm)");
+  positive(s.max_speed, 1e6 * 2.0 * kPi / 60.0, "servo.max_speed", "rad/s (1e6 rpm)");
   if (!std::isfinite(s.encoder_counts) || s.encoder_counts < 1.0 || s.encoder_counts > 4294967296.0 ||
       s.encoder_counts != std::floor(s.encoder_counts))
     fail("servo.encoder_counts",

@@ -15,30 +15,14 @@
 
 #include "hexatwist/error.hpp"
 #include "hexatwist/io/config.hpp"
+#include "motion/csv.hpp"
 
 namespace hexatwist::config_detail {
 
 // Text from the document or a file name as it may appear inside a one-line message: control
 // characters escaped, and (if `max` is set) cut at a character boundary after `max` bytes.
 inline std::string one_line(std::string_view s, std::size_t max = std::string_view::npos) {
-  std::size_t n = std::min(s.size(), max);
-  while (n < s.size() && n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;  // UTF-8 continuation
-  std::string out;
-  for (const char c : s.substr(0, n)) {
-    const auto u = static_cast<unsigned char>(c);
-    if (c == '\n')
-      out += "\\n";
-    else if (c == '\r')
-      out += "\\r";
-    else if (c == '\t')
-      out += "\\t";
-    else if (u < 0x20 || u == 0x7f)
-      out += fmt::format("\\x{:02x}", u);
-    else
-      out += c;
-  }
-  if (n < s.size()) out += "...";
-  return out;
+  return detail::printable(s, max);
 }
 
 // A document value quoted for a message.

@@ -88,9 +88,10 @@ void Model::check_limits_spec() {
     fail(fmt::format("limits.singularity_margin: expected an angle in (0, 90) deg, got {:.10g} deg",
                      rad2deg(lim.singularity_margin)));
   require_finite(lim.jacobian_condition_max, "limits.jacobian_condition_max");
-  if (!(lim.jacobian_condition_max > 1.0 && lim.jacobian_condition_max <= kMaxHomeCondition))
-    fail(fmt::format("limits.jacobian_condition_max: expected a condition number > 1 and at most {:g}, got {}",
-                     kMaxHomeCondition, lim.jacobian_condition_max));
+  // A huge limit is no limit (a meaningful choice); at most 1 no pose passes.
+  if (!(lim.jacobian_condition_max > 1.0))
+    fail(fmt::format("limits.jacobian_condition_max: expected a condition number > 1, got {}",
+                     lim.jacobian_condition_max));
   require_point(spec.observation_P, "observation_point");
   require_point(spec.pivot_P, "pivot");
 
@@ -175,6 +176,14 @@ void Model::build_leg(int i) {
   }
   has_drive_scale_ = has_drive_scale_ || leg.drive_scale != 1.0;
 
+  build_leg_axes(i);
+}
+
+void Model::build_leg_axes(int i) {
+  const LimitSpec& lim = spec_.limits;
+  const LegSpec& ls = spec_.legs[static_cast<std::size_t>(i)];
+  Leg& leg = legs_[static_cast<std::size_t>(i)];
+  const std::string who = fmt::format("leg {}", i + 1);
   // Axes are needed for the twist (lead > 0). With lead 0 they may be omitted (all zero).
   const bool axes_given = !ls.axis_base_B.isZero(0.0) || !ls.axis_platform_P.isZero(0.0);
   if (ls.lead > 0.0 || axes_given) {

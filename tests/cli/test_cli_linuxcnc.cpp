@@ -78,4 +78,27 @@ TEST(CliLinuxcnc, UnitsStrategyAndOutputs) {
   EXPECT_NE(read_file(err).find("cannot write to standard output"), std::string::npos) << read_file(err);
 }
 
+TEST(CliLinuxcnc, ValuesThatWouldChangeTheIniOrItsLoadrtLineAreRefused) {
+  // A newline in --display would start a second [KINS] section selecting another kinematics.
+  expect_error(run({"linuxcnc", "--display", "axis\n[KINS]\nKINEMATICS = trivkins"}), 2, {"--display", "one line"});
+  // LinuxCNC's loadrt splits the module's arguments at white space: config=/a b.yaml breaks it.
+  const std::filesystem::path dir = temp_dir() / "with space";
+  std::filesystem::create_directories(dir);
+  const std::string spaced = (dir / "p.yaml").string();
+  std::ofstream(spaced) << hexatwist::test::kSymmetricYaml;
+  expect_error(run({"linuxcnc", "--config", spaced}), 2, {"--config", "loadrt"});
+  const Outcome ok = run({"linuxcnc", "--display", "my-ui"});
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_EQ(ini_value(ok.out, "DISPLAY", "DISPLAY"), "my-ui");
+}
+
+TEST(CliLinuxcnc, APlatformWithoutScrewsSaysWhatItLacksNotTheSimulation) {
+  const std::string plain = write_file("plain-linuxcnc.yaml", replace_line(kSymmetric, 9, "  lead: 0"));
+  for (const char* command : {"linuxcnc", "mjcf"}) {
+    const Outcome r = run({command, "--config", plain});
+    expect_error(r, 2, {"screw.lead", "needs a lead screw"});
+    EXPECT_EQ(r.err.find("simulation"), std::string::npos) << r.err;
+  }
+}
+
 }  // namespace

@@ -44,4 +44,47 @@ TEST(CliOptions, OptionsWithoutEffectInTheChosenModeAreRefused) {
   expect_error(run({"stream", "--rate", "50"}, &none), 2, {"--rate", "--max-velocity"});
 }
 
+TEST(CliOptions, UnsignedOptionsRefuseNegativeNumbersInsteadOfWrappingThem) {
+  const std::string none;
+  expect_error(run({"stream", "--count", "-1"}, &none), 2, {"--count", "whole number >= 0", "'-1'"});
+  expect_error(run({"synth", "--test", "Lz", "--seed", "-1", "--out", (temp_dir() / "wrap.csv").string()}), 2,
+               {"--seed", "whole number >= 0"});
+  expect_error(run({"synth", "--stations", "3", "--station-seed=-5", "--out", (temp_dir() / "wrap.csv").string()}), 2,
+               {"--station-seed"});
+  EXPECT_FALSE(std::filesystem::exists(temp_dir() / "wrap.csv"));
+}
+
+TEST(CliStream, OptionsWithoutMeaningInTheirModeAreRefusedAndTheShorthandIsTheAddress) {
+  const std::string none;
+  expect_error(run({"stream", "--format", "json", "--header"}, &none), 2, {"--header", "--format csv"});
+  expect_error(run({"stream", "--max-velocity", "1", "--rate", "1e-300"}, &none), 2,
+               {"--max-velocity 1 with --rate 1e-300", "never apply"});
+  expect_error(run({"stream", "--max-acceleration", "1e6", "--rate", "1"}, &none), 2,
+               {"--max-acceleration", "never apply"});
+  expect_error(run({"stream", "--output", "udp://127.0.0.1:0"}, &none), 2, {"--output", "port 0"});
+  expect_error(run({"stream", "--cpu", "-1"}, &none), 2, {"--cpu -1", ">= 0"});
+  // The same UDP endpoint in and out would answer itself forever.
+  expect_error(run({"stream", "--input", "udp://127.0.0.1:47111", "--output", "udp://127.0.0.1:47111"}, &none), 2,
+               {"--output", "where --input listens"});
+  expect_error(run({"stream", "--input", "udp://0.0.0.0:47112", "--output", "udp://127.0.0.1:47112"}, &none), 2,
+               {"--output", "where --input listens"});
+  // The documented shorthand is the UDP input: --idle-timeout belongs to it.
+  // (Its port, 9000, may be taken on a shared machine: then it cannot listen, but says so.)
+  const Outcome r = run({"stream", "--input", "udp", "--output", "udp://127.0.0.1:47113", "--idle-timeout", "0.05"});
+  EXPECT_EQ(r.err.find("only with --input"), std::string::npos) << r.err;
+  if (r.code == 0)
+    EXPECT_NE(r.err.find("no datagram for 0.05 s"), std::string::npos) << r.err;
+  else
+    expect_error(r, 2, {"--input", "cannot listen on udp://127.0.0.1:9000"});
+}
+
+TEST(CliOptions, AForwardKinematicsThatEndsOnAnotherAssemblyModeSaysSo) {
+  // Lengths and a guess (found by a seeded search) whose solution lies on another assembly mode:
+  // the lengths are within reach, and the message says what happened.
+  const Outcome r = run(
+      {"fk", "--lengths=1.6846,1.8329,2.1050,2.0978,2.2555,1.8955", "--guess=0.338,0.056,0.035,-37.691,59.105,86.387"});
+  expect_error(r, 3, {"assembly_mode_changed", "another assembly mode"});
+  EXPECT_EQ(r.err.find("out of reach"), std::string::npos) << r.err;
+}
+
 }  // namespace

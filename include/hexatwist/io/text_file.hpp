@@ -17,9 +17,9 @@ inline constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;
 inline constexpr std::size_t kMaxDataBytes = std::size_t{256} << 20;
 
 /// Reads the whole file `path`, at most `max_bytes` bytes (a device such as /dev/zero is cut off
-/// there). Throws hexatwist::Error with one line "WHAT 'PATH': ..." for a directory, a file that
-/// cannot be opened or read (with the system's reason), or one longer than `max_bytes`. `what`
-/// names the file's role ("configuration file").
+/// there). Throws hexatwist::Error with one line "PATH: ..." for a directory, a file that cannot
+/// be opened or read ("PATH: cannot read the WHAT: " and the system's reason), or one longer than
+/// `max_bytes`. `what` names the file's role ("configuration file").
 std::string read_text_file(const std::string& path, std::string_view what, std::size_t max_bytes);
 
 }  // namespace hexatwist

@@ -78,9 +78,9 @@ class JerkLimitedMove {
 
 /// Most samples of one trajectory the library makes or runs (sweep_trajectory, waypoint_trajectory,
 /// resample; simulate and size_motors refuse longer ones): 1,000,000, e.g. 1000 s at a 1 kHz control
-/// rate. The bound fits a machine of 2 cores and 24 GB: `hexatwist study` or `simulate` on a
-/// trajectory this long holds about 3 GB (three simulations and their CSVs) and runs for minutes;
-/// `dynamics` about 2 GB.
+/// rate. The bound fits a machine of 2 cores and 24 GB: `hexatwist simulate` on a trajectory this
+/// long holds about 3 GB (three simulations and their CSVs) for about 2 minutes, `dynamics` about
+/// 1.4 GB (measured at 10^5 samples: 300 MB and 11 s, 140 MB and 2 s).
 inline constexpr std::size_t kMaxTrajectorySamples = 1'000'000;
 
 /// A pose trajectory sampled at a fixed period: poses[k] is the pose at time t0 + k*dt.
