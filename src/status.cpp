@@ -42,6 +42,8 @@ std::string_view to_string(Status s) noexcept {
       return "platform_singularity";
     case Status::AssemblyModeChanged:
       return "assembly_mode_changed";
+    case Status::InvalidArgument:
+      return "invalid_argument";
     case Status::SignUndecided:
       return "sign_undecided";
     case Status::ModelMismatch:
@@ -91,6 +93,8 @@ std::string_view describe(Status s) noexcept {
     case Status::AssemblyModeChanged:
       return "forward kinematics found a solution on another assembly mode than its start (the Jacobian determinant "
              "changed sign)";
+    case Status::InvalidArgument:
+      return "an option or argument is outside its documented range";
     case Status::SignUndecided:
       return "both thread senses explain the measurements about as well: the twist's sign is not decided";
     case Status::ModelMismatch:

@@ -36,113 +36,13 @@ std::string model_source(const ModelOptions& opts) {
   return opts.config.empty() ? std::string("embedded seed platform") : opts.config;
 }
 
-std::string read_text_file(const std::string& path, const std::string& option, const std::string& what) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw ExitError(kExitBadInput, fmt::format("{}: '{}' is a directory, expected {}", option, printable(path), what));
-  errno = 0;
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw ExitError(kExitBadInput, fmt::format("{}: cannot read {} '{}': {}", option, what, printable(path),
-                                               errno != 0 ? std::strerror(errno) : "cannot open"));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-void write_file_or_stdout(const std::string& path, std::string_view content) {
-  if (path.empty())
-    write_stdout(content);
-  else
-    write_output_file(path, content);
-}
-
-void write_output_file(const std::string& file, std::string_view content) {
-  OutputSet set;
-  set.add(file, std::string(content));
-  set.commit();
-}
-
-void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
-  namespace fs = std::filesystem;
-  for (std::size_t a = 0; a < outputs.size(); ++a)
-    for (std::size_t b = a + 1; b < outputs.size(); ++b) {
-      if (outputs[a].second.empty() || outputs[b].second.empty()) continue;
-      std::error_code ea, eb;
-      const fs::path pa = fs::weakly_canonical(outputs[a].second, ea);
-      const fs::path pb = fs::weakly_canonical(outputs[b].second, eb);
-      if ((!ea && !eb) ? pa == pb : outputs[a].second == outputs[b].second)
-        throw ExitError(kExitBadInput, fmt::format("{} and {} both name '{}': one run's outputs never overwrite each "
-                                                   "other; nothing was written",
-                                                   outputs[a].first, outputs[b].first, printable(outputs[b].second)));
-    }
-}
-
-OutputSet::~OutputSet() {
-  if (!committed_) roll_back();
-}
-
-void OutputSet::add(const std::string& path, std::string content) {
-  pending_.push_back({path, path + ".tmp", std::move(content)});
-  paths_.push_back(path);
-}
-
-void OutputSet::adopt(const std::string& path) {
-  adopted_.push_back(path);
-  paths_.push_back(path);
-}
-
-void OutputSet::roll_back() noexcept {
-  std::error_code ec;
-  for (const Pending& p : pending_)
-    if (p.staged) std::filesystem::remove(p.tmp, ec);
-  for (const std::string& a : adopted_) std::filesystem::remove(a, ec);
-}
-
-void OutputSet::stage() {
-  namespace fs = std::filesystem;
-  for (Pending& p : pending_) {
-    if (p.staged) continue;
-    std::error_code ec;
-    if (fs::is_directory(p.path, ec)) {
-      roll_back();
-      throw ExitError(kExitOutputFailed,
-                      fmt::format("cannot write '{}': it is a directory; nothing was written", printable(p.path)));
-    }
-    errno = 0;
-    std::ofstream out(p.tmp, std::ios::binary | std::ios::trunc);
-    p.staged = static_cast<bool>(out);  // from here on, the temporary is ours to remove
-    out.write(p.content.data(), static_cast<std::streamsize>(p.content.size()));
-    out.close();
-    if (!out) {
-      const int err = errno;
-      roll_back();
-      throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}': {}; nothing was written", printable(p.path),
-                                                     err != 0 ? std::strerror(err) : "write error"));
-    }
-    p.content.clear();
-    p.content.shrink_to_fit();
+std::string read_text_file(const std::string& path, const std::string& option, const std::string& what,
+                           std::size_t max_bytes) {
+  try {
+    return hexatwist::read_text_file(path, what, max_bytes);
+  } catch (const Error& e) {
+    throw ExitError(kExitBadInput, fmt::format("{}: {}", option, e.what()));
   }
-}
-
-void OutputSet::commit() {
-  namespace fs = std::filesystem;
-  stage();
-  for (std::size_t k = 0; k < pending_.size(); ++k) {
-    std::error_code ec;
-    fs::rename(pending_[k].tmp, pending_[k].path, ec);
-    if (ec) {
-      // The files already renamed are this run's: remove them with the rest, so no partial set is left.
-      std::error_code ignore;
-      for (std::size_t r = 0; r < k; ++r) fs::remove(pending_[r].path, ignore);
-      roll_back();
-      committed_ = true;
-      throw ExitError(kExitOutputFailed, fmt::format("cannot write '{}': {}; nothing was written",
-                                                     printable(pending_[k].path), ec.message()));
-    }
-    pending_[k].staged = false;
-  }
-  committed_ = true;
 }
 
 void write_stdout(std::string_view text) {
@@ -153,20 +53,10 @@ void write_stdout(std::string_view text) {
                                                    errno != 0 ? std::strerror(errno) : "write error"));
 }
 
-void write_stdout_or_withdraw(std::string_view text, const std::vector<std::string>& files) {
-  try {
-    write_stdout(text);
-  } catch (const ExitError&) {
-    std::error_code ignored;
-    for (const std::string& f : files) std::filesystem::remove(f, ignored);
-    throw;
-  }
-}
-
 Model load_model_from(const ModelOptions& opts) {
   try {
     if (opts.config.empty()) return default_model();
-    return load_model(read_text_file(opts.config, "--config", "config file"), opts.config);
+    return load_model(read_text_file(opts.config, "--config", "config file", kMaxConfigBytes), opts.config);
   } catch (const Error& e) {
     throw ExitError(kExitBadInput, e.what());
   }
@@ -175,7 +65,7 @@ Model load_model_from(const ModelOptions& opts) {
 Config load_config_from(const ModelOptions& opts) {
   try {
     if (opts.config.empty()) return default_config();
-    return load_config(read_text_file(opts.config, "--config", "config file"), opts.config);
+    return load_config(read_text_file(opts.config, "--config", "config file", kMaxConfigBytes), opts.config);
   } catch (const Error& e) {
     throw ExitError(kExitBadInput, e.what());
   }

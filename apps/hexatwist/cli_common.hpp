@@ -51,61 +51,15 @@ Model load_model_from(const ModelOptions& opts);
 /// Loads the whole configuration (platform, servo, load, simulation, study) the same way.
 Config load_config_from(const ModelOptions& opts);
 
-/// Reads a whole file; a missing, unreadable or directory path becomes ExitError(2) naming `option`.
-std::string read_text_file(const std::string& path, const std::string& option, const std::string& what);
-
-/// Writes `content` to the file whole: to a temporary name first, then renamed; ExitError(4)
-/// naming the file if it cannot be written (no temporary is left).
-void write_output_file(const std::string& path, std::string_view content);
-
-/// `content` to the file `path` (as write_output_file), or to standard output when `path` is empty.
-void write_file_or_stdout(const std::string& path, std::string_view content);
-
-/// ExitError(2) if two of the (option, path) pairs name the same file (`synth --out c.csv
-/// --run-out c.csv`): one command's outputs never overwrite each other. Empty paths are skipped.
-void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs);
-
-/// The files one run writes, put in place as a set: stage() writes each whole to a temporary
-/// name beside it, commit() renames them all. If anything fails before commit() ends, no file of
-/// the set and no temporary is left (files adopted with adopt(), already in place, are removed
-/// too) and ExitError(4) names the file.
-class OutputSet {
- public:
-  OutputSet() = default;
-  OutputSet(const OutputSet&) = delete;
-  OutputSet& operator=(const OutputSet&) = delete;
-  ~OutputSet();
-
-  /// Adds a file to write.
-  void add(const std::string& path, std::string content);
-  /// A file already put in place by someone else (a figure) that belongs to the set.
-  void adopt(const std::string& path);
-  /// Writes every added file to its temporary name.
-  void stage();
-  /// Stages what is not staged yet, then renames every temporary to its file.
-  void commit();
-  /// Every file of the set, in the order added (adopted ones included).
-  const std::vector<std::string>& paths() const { return paths_; }
-
- private:
-  struct Pending {
-    std::string path, tmp, content;
-    bool staged = false;
-  };
-  void roll_back() noexcept;
-  std::vector<Pending> pending_;
-  std::vector<std::string> adopted_;
-  std::vector<std::string> paths_;
-  bool committed_ = false;
-};
+/// Reads a whole file of at most `max_bytes` (hexatwist::read_text_file: kMaxDataBytes for data,
+/// kMaxConfigBytes for a configuration); a missing, unreadable, directory or longer path becomes
+/// ExitError(2) naming `option`.
+std::string read_text_file(const std::string& path, const std::string& option, const std::string& what,
+                           std::size_t max_bytes = kMaxDataBytes);
 
 /// Writes `text` to standard output and flushes it; ExitError(4) if it could not be written whole
 /// (a full disk, a closed pipe).
 void write_stdout(std::string_view text);
-
-/// Writes `text` to standard output (write_stdout); if that fails, first removes `files`, the
-/// outputs the run has just written, so that a failed run leaves none of them behind.
-void write_stdout_or_withdraw(std::string_view text, const std::vector<std::string>& files);
 
 /// Name of the platform source for messages.
 std::string model_source(const ModelOptions& opts);

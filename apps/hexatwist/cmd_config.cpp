@@ -25,88 +25,86 @@ std::string v3(const Vector3d& v) {
 struct ServoView {
   std::optional<Config> config;
   std::string why_not;
-  Vector6d holding = Vector6d::Zero();  // torque holding the load at home [N m]
+  Vector6d holding = Vector6d::Zero();  // torque holding the mechanism at rest at home [N m]
 };
 
-ServoView servo_view(const ModelOptions& opts) {
+// The drives of a configuration whose platform loaded: a platform without a screw on some leg
+// (lead 0, plain Stewart) has none, and says why; any other error of the other sections is the
+// configuration's, exit 2 as for every command.
+ServoView servo_view(const ModelOptions& opts, const Model& model) {
   ServoView v;
   try {
     v.config.emplace(load_config_from(opts));
   } catch (const ExitError& e) {
+    bool screwless = false;
+    for (const Leg& leg : model.legs()) screwless = screwless || !(leg.lead > 0.0);
+    if (!screwless) throw;
     v.why_not = e.what();
     return v;
   }
-  const Rig& rig = v.config->rig;
-  LegState home;
-  LegDynamics dyn;
-  if (inverse_kinematics(rig.model(), Placement{}, home) == Status::Ok &&
-      leg_dynamics(rig.model(), rig.load(), home, LengthKind::Motor, dyn) == Status::Ok)
-    v.holding = -rig.motor_gain().cwiseProduct(dyn.gravity);
+  // What the simulation checks against servo.torque_limit: the whole mechanism at rest.
+  if (holding_torque(v.config->rig, Pose{}, v.holding) != Status::Ok) v.holding.setConstant(std::nan(""));
   return v;
 }
 
-int run_config(const ConfigOptions& o) {
-  if (o.yaml) {
-    if (!o.model.config.empty())
-      throw ExitError(kExitBadInput, "--yaml prints the embedded seed config; drop --config");
-    if (o.json) throw ExitError(kExitBadInput, "--json: not with --yaml (which prints the seed configuration as YAML)");
-    write_stdout(seed_config_yaml());
-    return kExitOk;
-  }
-  const Model model = load_model_from(o.model);
+// `config --json`: the model, its legs and the drives derived from the configuration (SI).
+std::string config_json(const Model& model, const ModelOptions& source) {
   const ModelSpec& spec = model.spec();
   const LimitSpec& lim = spec.limits;
-  if (o.json) {
-    JsonWriter j;
-    j.begin_object().field("status", "ok").field("name", spec.name).field("source", model_source(o.model));
-    j.field("home_height", spec.home_height);
-    j.key("pivot").vector(spec.pivot_P);
-    j.key("observation_point").vector(spec.observation_P);
-    j.key("limits").begin_object().field("length_min", lim.length_min).field("length_max", lim.length_max);
-    j.field("bend_max", lim.bend_max).field("singularity_margin", lim.singularity_margin);
-    j.field("jacobian_condition_max", lim.jacobian_condition_max).end_object();
-    j.key("legs").begin_array(true);
-    for (int i = 0; i < kLegs; ++i) {
-      const Leg& l = model.leg(i);
-      const bool axes = !std::isnan(l.theta_home);
-      j.begin_object().field("leg", i + 1);
-      j.key("base").vector(l.base_B);
-      j.key("platform").vector(l.platform_P);
-      j.key("base_axis");
-      axes ? j.vector(l.axis_base_B) : j.null();
-      j.key("platform_axis");
-      axes ? j.vector(l.axis_platform_P) : j.null();
-      j.field("lead", l.lead).field("thread", l.thread == ThreadSense::Right ? "right" : "left");
-      j.field("driven_side", l.driven == DrivenSide::Base ? "base" : "platform").field("twist_gain", l.twist_gain);
-      j.field("length_offset", l.length_offset).field("length_home", l.length_home);
-      j.key("direction_home").vector(l.s_home_B);
-      j.key("twist_home_absolute");
-      axes ? j.value(l.theta_home) : j.null();
-      j.end_object();
-    }
-    j.end_array();
-    const ServoView sv = servo_view(o.model);
-    j.key("servo");
-    if (sv.config) {
-      const Rig& rig = sv.config->rig;
-      j.begin_object();
-      j.key("motor_gain").vector(rig.motor_gain());
-      j.field("drive_inertia", rig.drive_inertia());
-      j.key("nominal_inertia").vector(rig.nominal_inertia());
-      j.key("kp").vector(rig.kp());
-      j.key("ki").vector(rig.ki());
-      j.key("kd").vector(rig.kd());
-      j.key("holding_torque_home").vector(sv.holding);
-      j.field("torque_limit", rig.servo().torque_limit).field("control_period", rig.control_period());
-      j.field("plant_step", rig.plant_step()).end_object();
-    } else {
-      j.null();
-    }
+  JsonWriter j;
+  j.begin_object().field("status", "ok").field("name", spec.name).field("source", model_source(source));
+  j.field("home_height", spec.home_height);
+  j.key("pivot").vector(spec.pivot_P);
+  j.key("observation_point").vector(spec.observation_P);
+  j.key("limits").begin_object().field("length_min", lim.length_min).field("length_max", lim.length_max);
+  j.field("bend_max", lim.bend_max).field("singularity_margin", lim.singularity_margin);
+  j.field("jacobian_condition_max", lim.jacobian_condition_max).end_object();
+  j.key("legs").begin_array(true);
+  for (int i = 0; i < kLegs; ++i) {
+    const Leg& l = model.leg(i);
+    const bool axes = !std::isnan(l.theta_home);
+    j.begin_object().field("leg", i + 1);
+    j.key("base").vector(l.base_B);
+    j.key("platform").vector(l.platform_P);
+    j.key("base_axis");
+    axes ? j.vector(l.axis_base_B) : j.null();
+    j.key("platform_axis");
+    axes ? j.vector(l.axis_platform_P) : j.null();
+    j.field("lead", l.lead).field("thread", l.thread == ThreadSense::Right ? "right" : "left");
+    j.field("driven_side", l.driven == DrivenSide::Base ? "base" : "platform").field("twist_gain", l.twist_gain);
+    j.field("length_offset", l.length_offset).field("length_home", l.length_home);
+    j.key("direction_home").vector(l.s_home_B);
+    j.key("twist_home_absolute");
+    axes ? j.value(l.theta_home) : j.null();
     j.end_object();
-    write_stdout(j.str());
-    return kExitOk;
   }
-  std::string out = fmt::format("platform: {}\nsource: {}\n", spec.name, model_source(o.model));
+  j.end_array();
+  const ServoView sv = servo_view(source, model);
+  j.key("servo");
+  if (sv.config) {
+    const Rig& rig = sv.config->rig;
+    j.begin_object();
+    j.key("motor_gain").vector(rig.motor_gain());
+    j.field("drive_inertia", rig.drive_inertia());
+    j.key("nominal_inertia").vector(rig.nominal_inertia());
+    j.key("kp").vector(rig.kp());
+    j.key("ki").vector(rig.ki());
+    j.key("kd").vector(rig.kd());
+    j.key("holding_torque_home").vector(sv.holding);
+    j.field("torque_limit", rig.servo().torque_limit).field("control_period", rig.control_period());
+    j.field("plant_step", rig.plant_step()).end_object();
+  } else {
+    j.null();
+  }
+  j.end_object();
+  return j.str();
+}
+
+// `config`: the same for a person (mm where a person reads it).
+std::string config_text(const Model& model, const ModelOptions& source) {
+  const ModelSpec& spec = model.spec();
+  const LimitSpec& lim = spec.limits;
+  std::string out = fmt::format("platform: {}\nsource: {}\n", spec.name, model_source(source));
   out += fmt::format("home height: {:.6f} m; pivot {} m [P]; observation point {} m [P]\n", spec.home_height,
                      v3(spec.pivot_P), v3(spec.observation_P));
   out += fmt::format(
@@ -130,7 +128,7 @@ int run_config(const ConfigOptions& o) {
     if (!std::isnan(l.theta_home)) out += fmt::format(", absolute twist at home {:.4f} deg", rad2deg(l.theta_home));
     out += "\n";
   }
-  const ServoView sv = servo_view(o.model);
+  const ServoView sv = servo_view(source, model);
   if (sv.config) {
     const Rig& rig = sv.config->rig;
     const ServoSpec& ss = rig.servo();
@@ -150,10 +148,21 @@ int run_config(const ConfigOptions& o) {
   } else {
     out += fmt::format("servo (study, simulate): not usable: {}\n", sv.why_not);
   }
-  write_stdout(out);
-  return kExitOk;
+  return out;
 }
 
+int run_config(const ConfigOptions& o) {
+  if (o.yaml) {
+    if (!o.model.config.empty())
+      throw ExitError(kExitBadInput, "--yaml prints the embedded seed config; drop --config");
+    if (o.json) throw ExitError(kExitBadInput, "--json: not with --yaml (which prints the seed configuration as YAML)");
+    write_stdout(seed_config_yaml());
+    return kExitOk;
+  }
+  const Model model = load_model_from(o.model);
+  write_stdout(o.json ? config_json(model, o.model) : config_text(model, o.model));
+  return kExitOk;
+}
 }  // namespace
 
 Command make_config_command(CLI::App& root) {

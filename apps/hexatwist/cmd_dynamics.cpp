@@ -11,6 +11,7 @@
 #include "cli_common.hpp"
 #include "figures.hpp"
 #include "json.hpp"
+#include "output_files.hpp"
 #include "study_report.hpp"
 
 namespace hexatwist::cli {
@@ -228,6 +229,10 @@ int run_dynamics(const DynamicsOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   const Config config = load_config_from(o.model);
   const Rig& rig = config.rig;
+  OutputFiles files("dynamics");
+  files.input("--config", o.model.config);
+  files.input("--trajectory", o.trajectory);
+  files.folder("--out", o.out);
   // Read and resampled at the control rate as simulate does (ExitError(2) on a bad file).
   const ReportedTest input = reported_trajectory_file(o.trajectory, rig.control_period());
   const Trajectory& traj = input.trajectory;
@@ -243,9 +248,7 @@ int run_dynamics(const DynamicsOptions& o) {
   }
 
   // Every file is written as one set: all of them or none (exit 4).
-  prepare_output_folder(o.out);
   const fs::path dir(o.out);
-  OutputSet set;
   std::vector<std::string> names;
   const std::string csv_name = input.name + "_dynamics.csv";
   if (!o.no_csv) names.push_back(csv_name);
@@ -256,19 +259,17 @@ int run_dynamics(const DynamicsOptions& o) {
     names.push_back(input.name + "_torque_speed.svg");
   }
   names.push_back("summary.json");
-  if (!o.no_csv) set.add((dir / csv_name).string(), per_sample_csv(sizing));
-  set.add((dir / "summary.json").string(), summary_json(rig, o, traj, sizing, names));
-  set.stage();
-  if (!figures.empty()) {
-    write_figures(figures);
-    for (const char* ext : {".png", ".svg"}) set.adopt(figures.front().stem + ext);
-  }
-  set.commit();
+  if (!o.no_csv) files.add((dir / csv_name).string(), per_sample_csv(sizing));
+  files.add((dir / "summary.json").string(), summary_json(rig, o, traj, sizing, names));
+  files.stage();
+  for (Figure& f : figures) f.stem = files.external(f.stem, {".png", ".svg"});
+  if (!figures.empty()) write_figures(figures);
+  files.commit();
 
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::string text = table(rig, o, traj, sizing);
-  text += fmt::format("\n{} files written to {} in {:.1f} s\n", set.paths().size(), o.out, wall);
-  write_stdout_or_withdraw(text, set.paths());
+  text += fmt::format("\n{} files written to {} in {:.1f} s\n", files.paths().size(), o.out, wall);
+  files.finish(text);
   // A motor outside its envelope is the run's finding: the report is complete and kept.
   if (sizing.violation.check != EnvelopeCheck::None)
     throw ExitError(kExitOutOfLimit,

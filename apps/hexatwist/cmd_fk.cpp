@@ -63,10 +63,16 @@ int run_fk(const FkOptionsCli& o) {
     write_stdout(out);
   }
   if (status != Status::Ok) {
-    std::fprintf(stderr,
-                 "hexatwist: forward kinematics failed: %s after %d iterations, residual %.3g m (lengths out of reach, "
-                 "or try --guess near the expected pose)\n",
-                 std::string(to_string(status)).c_str(), result->iterations, result->residual);
+    // What the status means for these lengths, not a guess that fits another status.
+    const char* why = status == Status::AssemblyModeChanged
+                          ? "it converged on another assembly mode than the guess's (the Jacobian's determinant "
+                            "changed sign): the platform cannot move there without a singularity; give a --guess on "
+                            "the branch you mean"
+                      : status == Status::SingularJacobian
+                          ? "it met a singular Jacobian: try --guess nearer the pose"
+                          : "lengths out of reach, or try --guess near the expected pose";
+    std::fprintf(stderr, "hexatwist: forward kinematics failed: %s after %d iterations, residual %.3g m (%s)\n",
+                 std::string(to_string(status)).c_str(), result->iterations, result->residual, why);
     return kExitOutOfLimit;
   }
   if (final_status != Status::Ok) {

@@ -11,6 +11,7 @@
 #include "cli_common.hpp"
 #include "figures.hpp"
 #include "json.hpp"
+#include "output_files.hpp"
 #include "run_options.hpp"
 
 namespace hexatwist::cli {
@@ -365,6 +366,18 @@ Figure accuracy_figure(const Identification& id, const std::string& stem) {
 }
 
 int run_identify(const IdentifyOptions& o) {
+  // Inputs and outputs first: an output that is an input is refused before any work.
+  OutputFiles files("identify");
+  files.input("--config", o.run.model.config);
+  files.input("--trajectory", o.run.trajectory);
+  files.input("--points", o.log.points);
+  files.output("--out", o.out);
+  const std::filesystem::path out_path(o.out);
+  const std::string figure_stem = (out_path.parent_path() / (out_path.stem().string() + "_accuracy")).string();
+  if (!o.no_figures) {
+    files.output("the accuracy map beside --out", figure_stem + ".png");
+    files.output("the accuracy map beside --out", figure_stem + ".svg");
+  }
   const Config config = load_config_from(o.run.model);
   const Model& model = config.rig.model();
   const PointLogFormat format = log_format(o.log);
@@ -422,18 +435,15 @@ int run_identify(const IdentifyOptions& o) {
                    fmt::format("{}: the corrected configuration does not load: {}; nothing was written",
                                printable(o.out), e.what())));
   }
-  OutputSet files;
   files.add(o.out, yaml);
   if (!o.no_figures) {
-    const std::filesystem::path out(o.out);
-    const std::string stem = (out.parent_path() / (out.stem().string() + "_accuracy")).string();
+    Figure figure = accuracy_figure(id, figure_stem);
+    figure.stem = files.external(figure_stem, {".png", ".svg"});
     try {
-      write_figures({accuracy_figure(id, stem)});
+      write_figures({figure});
     } catch (const ExitError& e) {
       fail(e);
     }
-    files.adopt(stem + ".png");
-    files.adopt(stem + ".svg");
   }
   try {
     files.commit();
@@ -443,8 +453,8 @@ int run_identify(const IdentifyOptions& o) {
   std::string text = o.json ? json_report(report, std::string(), true) : text_report(report);
   if (!o.json)
     text += fmt::format("wrote {}: the corrected configuration (legs form){}\n", o.out,
-                        o.no_figures ? "" : ", and the map of its predicted accuracy beside it");
-  write_stdout_or_withdraw(text, files.paths());
+                        o.no_figures ? "" : fmt::format(", and the map of its predicted accuracy {}.png/.svg", figure_stem));
+  files.finish(text);
   return kExitOk;
 }
 

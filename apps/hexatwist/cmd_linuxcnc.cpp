@@ -3,10 +3,12 @@
 // HOME_OFFSET and limits, each axis' reach).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 
 #include "cli_common.hpp"
+#include "output_files.hpp"
 
 namespace hexatwist::cli {
 namespace {
@@ -105,10 +107,39 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
   return t;
 }
 
+// What LinuxCNC reads back as the value we wrote: an INI value is one line, and the kinematics
+// module's arguments (KINEMATICS, read by halcmd's loadrt) are split at white space and quotes.
+void check_ini_values(const LinuxcncOptions& o) {
+  const auto has = [](const std::string& text, std::string_view chars) {
+    return std::any_of(text.begin(), text.end(), [&](char c) {
+      const auto u = static_cast<unsigned char>(c);
+      return u < 0x20 || u == 0x7f || chars.find(c) != std::string_view::npos;
+    });
+  };
+  if (o.display.empty() || has(o.display, "") || o.display.front() == ' ' || o.display.back() == ' ')
+    throw ExitError(kExitBadInput, fmt::format("--display '{}': expected a program name on one line, without control "
+                                               "characters or surrounding spaces ([DISPLAY] DISPLAY is one INI value)",
+                                               printable(o.display)));
+  if (!o.model.config.empty()) {
+    const std::string path = std::filesystem::absolute(o.model.config).string();
+    if (has(path, " \t\"'\\"))
+      throw ExitError(kExitBadInput,
+                      fmt::format("--config '{}': its path {} holds a space, quote or control character, which "
+                                  "LinuxCNC's loadrt line ([KINS] KINEMATICS config=PATH) cannot carry; move or "
+                                  "link the file to a path without them",
+                                  printable(o.model.config), printable(path)));
+  }
+}
+
 int run_linuxcnc(const LinuxcncOptions& o, const std::string& command_line) {
+  check_ini_values(o);
+  OutputFiles files("linuxcnc");
+  files.input("--config", o.model.config);
+  files.output("--out", o.out);
   const Config config = load_config_from(o.model);
   const std::string text = ini_text(o, config, command_line);
-  write_file_or_stdout(o.out, text);
+  if (!o.out.empty()) files.add(o.out, text);
+  files.finish(o.out.empty() ? text : std::string());
   return kExitOk;
 }
 
@@ -135,7 +166,7 @@ Command make_linuxcnc_command(CLI::App& root) {
             std::string line = "hexatwist linuxcnc";
             for (const CLI::Option* opt : app->get_options())
               if (opt->count() > 0 && opt->get_name() != "--out" && opt->get_name() != "--help")
-                line += fmt::format(" {}={}", opt->get_name(), opt->as<std::string>());
+                line += fmt::format(" {}={}", opt->get_name(), printable(opt->as<std::string>()));
             return run_linuxcnc(*opts, line);
           }};
 }

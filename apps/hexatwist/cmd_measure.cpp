@@ -13,6 +13,7 @@
 
 #include "cli_common.hpp"
 #include "json.hpp"
+#include "output_files.hpp"
 #include "run_options.hpp"
 #include "study_report.hpp"
 
@@ -34,6 +35,11 @@ struct MeasureOptions {
 
 int run_measure(const MeasureOptions& o) {
   const auto start = std::chrono::steady_clock::now();
+  OutputFiles files("measure");
+  files.input("--config", o.run.model.config);
+  files.input("--trajectory", o.run.trajectory);
+  files.input("--points", o.log.points);
+  files.folder("--out", o.out);
   const Config config = load_config_from(o.run.model);
   const Rig& rig = config.rig;
   const PointLogFormat format = log_format(o.log);
@@ -117,7 +123,7 @@ int run_measure(const MeasureOptions& o) {
     t.measured = std::move(measured);
     return s;
   };
-  simulate_and_report(rig, ro, tests, start, compare);
+  simulate_and_report(rig, ro, tests, files, start, compare);
   return kExitOk;
 }
 

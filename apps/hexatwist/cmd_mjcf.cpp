@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "cli_common.hpp"
+#include "output_files.hpp"
 
 namespace hexatwist::cli {
 namespace {
@@ -14,13 +15,17 @@ struct MjcfOptions {
 };
 
 int run_mjcf(const MjcfOptions& o) {
+  OutputFiles files("mjcf");
+  files.input("--config", o.model.config);
+  files.output("--out", o.out);
   const Config config = load_config_from(o.model);
   std::string text = mjcf_model(config.rig);
   // Name the configuration in the header comment ("--" may not appear inside an XML comment).
   std::string source = printable(model_source(o.model));
   for (std::size_t k = source.find("--"); k != std::string::npos; k = source.find("--")) source.replace(k, 2, "- -");
   text.insert(0, fmt::format("<!-- Configuration: {} -->\n", source));
-  write_file_or_stdout(o.out, text);
+  if (!o.out.empty()) files.add(o.out, text);
+  files.finish(o.out.empty() ? text : std::string());
   return kExitOk;
 }
 

@@ -136,9 +136,20 @@ StreamSettings settings_from(const StreamOptions& o) {
   s.period = 1.0 / o.rate;
   if (o.max_velocity > 0) s.max_velocity = o.max_velocity;
   if (o.max_acceleration > 0) s.max_acceleration = o.max_acceleration;
-  if (const std::string_view why = check_stream_settings(s); !why.empty())
-    throw ExitError(kExitBadInput, fmt::format("stream settings: {}", why));
   return s;
+}
+
+// The library's check of the settings on the model, its fields named as the options that set them.
+void check_settings(const Model& model, const StreamSettings& s, const StreamOptions& o) {
+  const std::string_view why = check_stream_settings(model, s);
+  if (why.empty()) return;
+  if (why.starts_with("max_velocity: "))
+    throw ExitError(kExitBadInput,
+                    fmt::format("--max-velocity {:g} with --rate {:g}: {}", o.max_velocity, o.rate, why.substr(14)));
+  if (why.starts_with("max_acceleration: "))
+    throw ExitError(kExitBadInput, fmt::format("--max-acceleration {:g} with --rate {:g}: {}", o.max_acceleration,
+                                               o.rate, why.substr(18)));
+  throw ExitError(kExitBadInput, fmt::format("stream settings: {}", why));
 }
 
 // Where answers go: stdout (flushed whenever no further input is waiting) or one datagram each.
@@ -207,11 +218,90 @@ void enter_realtime(int priority) {
 constexpr const char* kDefaultUdpInput = "udp://127.0.0.1:9000";
 constexpr const char* kDefaultUdpOutput = "udp://127.0.0.1:9001";
 
-int run_stream(StreamOptions o) {
-  if (o.input == "udp") o.input = kDefaultUdpInput;
-  if (o.output == "udp") o.output = kDefaultUdpOutput;
+// The stream's ends: stdin or a bound UDP socket in, stdout or a connected one out.
+struct Endpoints {
+  std::optional<UdpSocket> in, out;
+  std::string in_text = "stdin", out_text = "stdout";
+};
+
+Endpoints open_endpoints(const StreamOptions& o) {
+  Endpoints e;
+  if (is_udp(o.input)) {
+    const UdpAddress local = parse_udp_address(o.input, "--input");
+    e.in = UdpSocket::bound(local, "--input");
+    e.in->set_receive_buffer(o.receive_buffer, "--receive-buffer");
+    e.in_text = udp_text(local.host, e.in->local_port());  // the port it got, also for port 0
+  } else if (o.input != "stdin" && o.input != "-") {
+    throw ExitError(kExitBadInput,
+                    fmt::format("--input: '{}' is neither stdin nor udp://HOST:PORT", printable(o.input)));
+  }
+  if (is_udp(o.output)) {
+    const UdpAddress peer = parse_udp_address(o.output, "--output");
+    if (udp_port(peer) == 0)
+      throw ExitError(kExitBadInput, fmt::format("--output {}: port 0 is no address to send to (it picks a free port "
+                                                 "only where the stream listens, --input)",
+                                                 printable(o.output)));
+    // Answers sent to where the poses arrive would be read back as poses, forever.
+    if (e.in && reaches(peer, parse_udp_address(o.input, "--input"), e.in->local_port()))
+      throw ExitError(kExitBadInput,
+                      fmt::format("--output {}: is where --input listens ({}): the stream would read its own answers "
+                                  "as poses, forever; give another port",
+                                  printable(o.output), e.in_text));
+    e.out = UdpSocket::connected(peer, "--output");
+    e.out_text = peer.text;
+  } else if (o.output != "stdout" && o.output != "-") {
+    throw ExitError(kExitBadInput,
+                    fmt::format("--output: '{}' is neither stdout nor udp://HOST:PORT", printable(o.output)));
+  }
+  return e;
+}
+
+// The summary on stderr: why the stream ended, what it answered, what was refused.
+void print_summary(const StreamState& state, const std::array<std::uint64_t, 64>& by_status,
+                   const std::array<std::uint64_t, 3>& by_action, const std::string& stop_reason, std::uint64_t refused,
+                   const std::string& out_text) {
+  const std::uint64_t rejected = state.inputs - by_status[0];
+  std::string reasons;
+  for (std::size_t k = 1; k < by_status.size(); ++k)
+    if (by_status[k] > 0)
+      reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", by_status[k], to_string(static_cast<Status>(k)));
+  std::fprintf(stderr,
+               "hexatwist stream: %s; %llu inputs; commands: %llu new, %llu held, %llu none; %llu rejected%s%s%s\n",
+               stop_reason.c_str(), static_cast<unsigned long long>(state.inputs),
+               static_cast<unsigned long long>(by_action[0]), static_cast<unsigned long long>(by_action[1]),
+               static_cast<unsigned long long>(by_action[2]), static_cast<unsigned long long>(rejected),
+               reasons.empty() ? "" : " (", reasons.c_str(), reasons.empty() ? "" : ")");
+  if (refused > 0)
+    std::fprintf(stderr, "hexatwist stream: %llu answers were refused by %s (nobody listening)\n",
+                 static_cast<unsigned long long>(refused), out_text.c_str());
+}
+
+// The next datagram as a line: waiting in the kernel, or spinning on a non-blocking receive
+// (--busy-poll: no sleep and wake-up between datagrams; the idle timeout kept by the clock).
+UdpSocket::Received receive_datagram(UdpSocket& in, const StreamOptions& o, std::array<char, 2048>& datagram,
+                                     std::string_view& line) {
+  std::size_t size = 0;
+  bool truncated = false;
+  auto r = UdpSocket::Received::Timeout;
+  if (o.busy_poll) {
+    const auto since = std::chrono::steady_clock::now();
+    const auto idle = std::chrono::duration<double>(o.idle_timeout > 0 ? o.idle_timeout : 1e300);
+    while (!g_stop && (r = in.try_receive(datagram, size, truncated)) == UdpSocket::Received::Timeout &&
+           std::chrono::steady_clock::now() - since < idle) {
+    }
+    if (g_stop) r = UdpSocket::Received::Interrupted;
+  } else {
+    r = in.receive(datagram, size, truncated);
+  }
+  // A datagram longer than the buffer cannot be a pose; the parser says so (too long).
+  line = std::string_view(datagram.data(), truncated ? datagram.size() : size);
+  return r;
+}
+
+int run_stream(const StreamOptions& o) {
   const Model model = load_model_from(o.model);
   const StreamSettings settings = settings_from(o);
+  check_settings(model, settings, o);
   const StreamFormat format =
       parse_choice<StreamFormat>(o.format, "--format", {{"csv", StreamFormat::Csv}, {"json", StreamFormat::Json}});
   const AngleUnit unit = o.si ? AngleUnit::Radians : AngleUnit::Degrees;
@@ -225,25 +315,10 @@ int run_stream(StreamOptions o) {
       throw ExitError(kExitOutOfLimit, fmt::format("--start: {} ({})", to_string(s), describe(s)));
   }
 
-  std::optional<UdpSocket> in_udp, out_udp;
-  std::string in_text = "stdin", out_text = "stdout";
-  if (is_udp(o.input)) {
-    const UdpAddress local = parse_udp_address(o.input, "--input");
-    in_udp = UdpSocket::bound(local, "--input");
-    in_udp->set_receive_buffer(o.receive_buffer, "--receive-buffer");
-    in_text = udp_text(local.host, in_udp->local_port());  // the port it got, also for port 0
-  } else if (o.input != "stdin" && o.input != "-") {
-    throw ExitError(kExitBadInput,
-                    fmt::format("--input: '{}' is neither stdin nor udp://HOST:PORT", printable(o.input)));
-  }
-  if (is_udp(o.output)) {
-    const UdpAddress peer = parse_udp_address(o.output, "--output");
-    out_udp = UdpSocket::connected(peer, "--output");
-    out_text = peer.text;
-  } else if (o.output != "stdout" && o.output != "-") {
-    throw ExitError(kExitBadInput,
-                    fmt::format("--output: '{}' is neither stdout nor udp://HOST:PORT", printable(o.output)));
-  }
+  Endpoints ends = open_endpoints(o);
+  std::optional<UdpSocket>& in_udp = ends.in;
+  const std::string& in_text = ends.in_text;
+  const std::string& out_text = ends.out_text;
   if (o.busy_poll && o.rt_priority > 0 && rt_throttled())
     throw ExitError(kExitBadInput,
                     "--busy-poll with --rt-priority: the kernel throttles a SCHED_FIFO task that never sleeps (for "
@@ -256,7 +331,7 @@ int run_stream(StreamOptions o) {
     std::fprintf(stderr, "hexatwist stream: listening on %s, answering to %s\n", in_text.c_str(), out_text.c_str());
     std::fflush(stderr);
   }
-  AnswerSink sink(std::move(out_udp));
+  AnswerSink sink(std::move(ends.out));
   install_stop_handlers();
 
   if (o.header && format == StreamFormat::Csv) sink.write(kStreamCsvHeader);
@@ -273,28 +348,12 @@ int run_stream(StreamOptions o) {
   while (!g_stop && (o.count == 0 || state->inputs < o.count)) {
     std::string_view line;
     if (in_udp) {
-      std::size_t size = 0;
-      bool truncated = false;
-      auto r = UdpSocket::Received::Timeout;
-      if (o.busy_poll) {
-        // Spin on a non-blocking receive: no sleep and wake-up between datagrams. The idle
-        // timeout is kept by the clock.
-        const auto since = std::chrono::steady_clock::now();
-        const auto idle = std::chrono::duration<double>(o.idle_timeout > 0 ? o.idle_timeout : 1e300);
-        while (!g_stop && (r = in_udp->try_receive(datagram, size, truncated)) == UdpSocket::Received::Timeout &&
-               std::chrono::steady_clock::now() - since < idle) {
-        }
-        if (g_stop) r = UdpSocket::Received::Interrupted;
-      } else {
-        r = in_udp->receive(datagram, size, truncated);
-      }
+      const auto r = receive_datagram(*in_udp, o, datagram, line);
       if (r == UdpSocket::Received::Timeout) {
         stop_reason = fmt::format("no datagram for {} s (--idle-timeout)", o.idle_timeout);
         break;
       }
       if (r == UdpSocket::Received::Interrupted) break;
-      // A datagram longer than the buffer cannot be a pose; the parser says so (too long).
-      line = std::string_view(datagram.data(), truncated ? datagram.size() : size);
     } else {
       if (!reader.has_complete_line()) sink.flush();  // about to wait: what was answered goes out now
       const auto r = reader.next(line);
@@ -310,26 +369,49 @@ int run_stream(StreamOptions o) {
   if (g_stop) stop_reason = "signal";
   if (o.count != 0 && state->inputs >= o.count) stop_reason = fmt::format("--count {}", o.count);
 
+  if (!o.quiet) print_summary(*state, by_status, by_action, stop_reason, sink.refused(), out_text);
   const std::uint64_t rejected = state->inputs - by_status[0];
-  if (!o.quiet) {
-    std::string reasons;
-    for (std::size_t k = 1; k < by_status.size(); ++k)
-      if (by_status[k] > 0)
-        reasons += fmt::format("{}{} {}", reasons.empty() ? "" : ", ", by_status[k], to_string(static_cast<Status>(k)));
-    std::fprintf(stderr,
-                 "hexatwist stream: %s; %llu inputs; commands: %llu new, %llu held, %llu none; %llu rejected%s%s%s\n",
-                 stop_reason.c_str(), static_cast<unsigned long long>(state->inputs),
-                 static_cast<unsigned long long>(by_action[0]), static_cast<unsigned long long>(by_action[1]),
-                 static_cast<unsigned long long>(by_action[2]), static_cast<unsigned long long>(rejected),
-                 reasons.empty() ? "" : " (", reasons.c_str(), reasons.empty() ? "" : ")");
-    if (sink.refused() > 0)
-      std::fprintf(stderr, "hexatwist stream: %llu answers were refused by %s (nobody listening)\n",
-                   static_cast<unsigned long long>(sink.refused()), out_text.c_str());
-  }
   return rejected == 0 ? kExitOk : kExitOutOfLimit;
 }
 
 }  // namespace
+
+// The options' meaning in the mode chosen: the shorthands resolved, and an option that would
+// have no effect refused, not ignored; number options in their ranges.
+void check_mode(StreamOptions& o, const CLI::App& app) {
+  // The documented shorthand first, so that the checks below see the address it means.
+  if (o.input == "udp") o.input = kDefaultUdpInput;
+  if (o.output == "udp") o.output = kDefaultUdpOutput;
+  // An option that has no effect in the chosen mode is refused, not ignored.
+  if (app.count("--header") > 0 && o.format != "csv")
+    throw ExitError(kExitBadInput, "--header: only with --format csv (JSON answers carry their field names)");
+  if (app.count("--cpu") > 0 && o.cpu < 0)
+    throw ExitError(kExitBadInput, fmt::format("--cpu {}: expected a CPU number >= 0", o.cpu));
+  if (!is_udp(o.input))
+    for (const char* udp_only : {"--idle-timeout", "--receive-buffer", "--busy-poll"})
+      if (app.count(udp_only) > 0)
+        throw ExitError(kExitBadInput, fmt::format("{}: only with --input udp://HOST:PORT", udp_only));
+  if (app.count("--rate") > 0 && o.max_velocity == 0 && o.max_acceleration == 0)
+    throw ExitError(kExitBadInput,
+                    "--rate: only with --max-velocity or --max-acceleration (the input rate "
+                    "their limits assume)");
+  if (!(o.rate > 0) || !std::isfinite(o.rate)) throw ExitError(kExitBadInput, "--rate: expected a positive rate [Hz]");
+  // Finite but absurd: no input arrives (or is parsed) faster than every microsecond.
+  if (o.rate > 1e6)
+    throw ExitError(kExitBadInput, fmt::format("--rate {:g}: expected at most 1e6 Hz (one input per "
+                                               "microsecond) [Hz]",
+                                               o.rate));
+  if (o.rt_priority < 0 || o.rt_priority > sched_get_priority_max(SCHED_FIFO))
+    throw ExitError(kExitBadInput,
+                    fmt::format("--rt-priority {}: expected a SCHED_FIFO priority {}..{}, or 0 "
+                                "for none",
+                                o.rt_priority, sched_get_priority_min(SCHED_FIFO), sched_get_priority_max(SCHED_FIFO)));
+  if (o.max_velocity < 0 || o.max_acceleration < 0 || !std::isfinite(o.max_velocity) ||
+      !std::isfinite(o.max_acceleration))
+    throw ExitError(kExitBadInput, "--max-velocity, --max-acceleration: expected a positive limit, or 0 for none");
+  if (o.idle_timeout < 0 || !std::isfinite(o.idle_timeout))
+    throw ExitError(kExitBadInput, "--idle-timeout: expected seconds >= 0");
+}
 
 Command make_stream_command(CLI::App& root) {
   auto o = std::make_shared<StreamOptions>();
@@ -385,34 +467,7 @@ Command make_stream_command(CLI::App& root) {
                 "at 100 %)");
   app->add_flag("--quiet", o->quiet, "no summary on stderr");
   return {app, [o, app] {
-            // An option that has no effect in the chosen mode is refused, not ignored.
-            if (!is_udp(o->input))
-              for (const char* udp_only : {"--idle-timeout", "--receive-buffer", "--busy-poll"})
-                if (app->count(udp_only) > 0)
-                  throw ExitError(kExitBadInput, fmt::format("{}: only with --input udp://HOST:PORT", udp_only));
-            if (app->count("--rate") > 0 && o->max_velocity == 0 && o->max_acceleration == 0)
-              throw ExitError(kExitBadInput,
-                              "--rate: only with --max-velocity or --max-acceleration (the input rate "
-                              "their limits assume)");
-            if (!(o->rate > 0) || !std::isfinite(o->rate))
-              throw ExitError(kExitBadInput, "--rate: expected a positive rate [Hz]");
-            // Finite but absurd: no input arrives (or is parsed) faster than every microsecond.
-            if (o->rate > 1e6)
-              throw ExitError(kExitBadInput, fmt::format("--rate {:g}: expected at most 1e6 Hz (one input per "
-                                                         "microsecond) [Hz]",
-                                                         o->rate));
-            if (o->rt_priority < 0 || o->rt_priority > sched_get_priority_max(SCHED_FIFO))
-              throw ExitError(
-                  kExitBadInput,
-                  fmt::format("--rt-priority {}: expected a SCHED_FIFO priority {}..{}, or 0 "
-                              "for none",
-                              o->rt_priority, sched_get_priority_min(SCHED_FIFO), sched_get_priority_max(SCHED_FIFO)));
-            if (o->max_velocity < 0 || o->max_acceleration < 0 || !std::isfinite(o->max_velocity) ||
-                !std::isfinite(o->max_acceleration))
-              throw ExitError(kExitBadInput,
-                              "--max-velocity, --max-acceleration: expected a positive limit, or 0 for none");
-            if (o->idle_timeout < 0 || !std::isfinite(o->idle_timeout))
-              throw ExitError(kExitBadInput, "--idle-timeout: expected seconds >= 0");
+            check_mode(*o, *app);
             return run_stream(*o);
           }};
 }

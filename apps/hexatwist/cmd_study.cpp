@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "cli_common.hpp"
+#include "output_files.hpp"
 #include "study_report.hpp"
 
 namespace hexatwist::cli {
@@ -21,41 +22,54 @@ struct StudyOptions {
   bool no_csv = false;
 };
 
+// The run's files: its inputs and the report folder, declared before anything is computed.
+struct StudyFiles {
+  OutputFiles files;
+  explicit StudyFiles(const std::string& command, const StudyOptions& o) : files(command) {
+    files.input("--config", o.model.config);
+    files.input("--trajectory", o.trajectory);
+    files.folder("--out", o.out);
+  }
+};
+
 int finish(const Rig& rig, const StudyOptions& o, const std::string& command, std::vector<ReportedTest>& tests,
-           std::chrono::steady_clock::time_point start) {
+           OutputFiles& files, std::chrono::steady_clock::time_point start) {
   const ReportOptions ro{o.out, command, model_source(o.model), !o.no_figures, !o.no_csv};
-  simulate_and_report(rig, ro, tests, start);
+  simulate_and_report(rig, ro, tests, files, start);
   return kExitOk;
 }
 
 int run_study(const StudyOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   const Config config = load_config_from(o.model);
-  const std::vector<StudyTest> all = seed_tests(config.study);
   std::vector<ReportedTest> tests;
   std::size_t begin = 0;
   for (;;) {
     const std::size_t comma = o.tests.find(',', begin);
     const std::string name = o.tests.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
-    const StudyTest* found = nullptr;
-    for (const StudyTest& t : all) found = t.name == name ? &t : found;
-    if (found == nullptr)
-      throw ExitError(kExitBadInput, fmt::format("--tests: unknown test '{}'; expected some of Lz,Lx,Rz,Ry", name));
+    StudyTest found;
+    try {
+      found = study_test(config.study, name);
+    } catch (const Error& e) {
+      throw ExitError(kExitBadInput, fmt::format("--tests: {}", e.what()));
+    }
     for (const ReportedTest& t : tests)
       if (t.name == name) throw ExitError(kExitBadInput, fmt::format("--tests: '{}' given twice", name));
-    ReportedTest& t = tests.emplace_back(reported_test(*found));
-    t.trajectory = test_trajectory(config.study, *found, config.rig.control_period());
+    ReportedTest& t = tests.emplace_back(reported_test(found));
+    t.trajectory = test_trajectory(config.study, found, config.rig.control_period());
     if (comma == std::string::npos) break;
     begin = comma + 1;
   }
-  return finish(config.rig, o, "study", tests, start);
+  StudyFiles out("study", o);
+  return finish(config.rig, o, "study", tests, out.files, start);
 }
 
 int run_simulate(const StudyOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   const Config config = load_config_from(o.model);
+  StudyFiles out("simulate", o);
   std::vector<ReportedTest> tests{reported_trajectory_file(o.trajectory, config.rig.control_period())};
-  return finish(config.rig, o, "simulate", tests, start);
+  return finish(config.rig, o, "simulate", tests, out.files, start);
 }
 
 void add_common(CLI::App& app, StudyOptions& o) {

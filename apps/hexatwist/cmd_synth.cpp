@@ -13,6 +13,7 @@
 
 #include "cli_common.hpp"
 #include "json.hpp"
+#include "output_files.hpp"
 #include "run_options.hpp"
 #include "study_report.hpp"
 
@@ -121,7 +122,12 @@ int run_synth(const SynthOptions& o) {
   const std::string out = o.out.empty() ? fmt::format("tracker_{}.csv", run.test.name) : o.out;
   const std::filesystem::path csv(out);
   const std::string truth = (csv.parent_path() / (csv.stem().string() + ".truth.json")).string();
-  check_distinct_outputs({{"--out", out}, {"the truth beside --out", truth}, {"--run-out", o.run_out}});
+  OutputFiles files("synth");
+  files.input("--config", o.run.model.config);
+  files.input("--trajectory", o.run.trajectory);
+  files.output("--out", out);
+  files.output("the truth beside --out", truth);
+  files.output("--run-out", o.run_out);
   // Finite but absurd values are refused too: a noise, an offset or a point error as large as the
   // whole stroke leaves nothing in the log to measure or identify.
   const double stroke_um = 1e6 * (rig.model().spec().limits.length_max - rig.model().spec().limits.length_min);
@@ -223,7 +229,6 @@ int run_synth(const SynthOptions& o) {
       fmt::format_to(std::back_inserter(b), "{},", log.log.target_names[static_cast<std::size_t>(log.log.targets[k])]);
     fmt::format_to(std::back_inserter(b), "{:.6f},{:.6f},{:.6f}\n", p.x(), p.y(), p.z());
   }
-  OutputSet files;
   files.add(out, fmt::to_string(b));
   files.add(truth, truth_json(config, o, run, so, log));
   if (!o.run_out.empty())
@@ -263,7 +268,7 @@ int run_synth(const SynthOptions& o) {
                             : fmt::format("wrote {}, {} and the run {}", out, truth, o.run_out);
   if (std::isfinite(run.calibration_end))
     text += fmt::format("; measure registers on the calibration moves, t <= {:.3f} s", run.calibration_end);
-  write_stdout_or_withdraw(text + "\n", files.paths());
+  files.finish(text + "\n");
   return kExitOk;
 }
 

@@ -1,12 +1,35 @@
 // Every subcommand of the tool, registered in the order `--help` lists them.
+#include <charconv>
+#include <cstdint>
+
 #include "cli_common.hpp"
 
 namespace hexatwist::cli {
+namespace {
+
+// CLI11 reads "-1" into an unsigned option as 2^64 - 1 (a seed, a count): every unsigned option
+// takes a whole number >= 0 written as such, or is refused naming itself.
+const CLI::Validator kWholeNumber(
+    [](std::string& text) {
+      std::uint64_t v = 0;
+      const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+      if (text.empty() || ec != std::errc() || end != text.data() + text.size())
+        return std::string("expected a whole number >= 0, got '") + printable(text) + "'";
+      return std::string();
+    },
+    "", "whole number");
+
+}  // namespace
 
 std::vector<Command> add_commands(CLI::App& app) {
-  return {make_study_command(app),   make_simulate_command(app), make_dynamics_command(app), make_synth_command(app),
-          make_measure_command(app), make_identify_command(app), make_stream_command(app),   make_ik_command(app),
-          make_fk_command(app),      make_config_command(app),   make_linuxcnc_command(app), make_mjcf_command(app)};
+  std::vector<Command> commands{make_study_command(app),  make_simulate_command(app), make_dynamics_command(app),
+                                make_synth_command(app),  make_measure_command(app),  make_identify_command(app),
+                                make_stream_command(app), make_ik_command(app),       make_fk_command(app),
+                                make_config_command(app), make_linuxcnc_command(app), make_mjcf_command(app)};
+  for (const Command& c : commands)
+    for (CLI::Option* opt : c.app->get_options())
+      if (opt->get_type_name() == "UINT") opt->check(kWholeNumber);
+  return commands;
 }
 
 }  // namespace hexatwist::cli

@@ -37,16 +37,17 @@ Run build_run(const Config& config, const RunOptions& o) {
     run.commanded = timed_poses(run.test.trajectory);
     return run;
   }
-  for (const StudyTest& t : seed_tests(config.study)) {
-    if (t.name != o.test) continue;
-    run.test = reported_test(t);
-    run.test.description += ", after the calibration moves";
-    run.test.trajectory = measured_test_trajectory(config.study, t, CalibrationSpec{}, dt, run.calibration_end);
-    run.commanded = timed_poses(run.test.trajectory);
-    return run;
+  StudyTest t;
+  try {
+    t = study_test(config.study, o.test);
+  } catch (const Error& e) {
+    throw ExitError(kExitBadInput, fmt::format("--test: {}", e.what()));
   }
-  throw ExitError(kExitBadInput,
-                  fmt::format("--test: unknown test '{}'; expected Lz, Lx, Rz or Ry", printable(o.test)));
+  run.test = reported_test(t);
+  run.test.description += ", after the calibration moves";
+  run.test.trajectory = measured_test_trajectory(config.study, t, CalibrationSpec{}, dt, run.calibration_end);
+  run.commanded = timed_poses(run.test.trajectory);
+  return run;
 }
 
 void add_run_options(CLI::App& app, RunOptions& o) {

@@ -8,20 +8,17 @@
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
-#include <sstream>
 
 #include "cli_common.hpp"
-#include "figures.hpp"
 #include "json.hpp"
+#include "output_files.hpp"
+#include "study_figures.hpp"
 
 namespace hexatwist::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr const char* kCoordinateNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
 
 // The paper's Table 1 (mm), columns Lz, Lx, Rz, Ry: for comparison in summary.md only.
 struct PaperRow {
@@ -35,22 +32,6 @@ constexpr PaperRow kPaperTable1[] = {
     {"paper, experiment, compensated", {0.1431, 0.4954, 0.7534, 0.6362}},
 };
 constexpr const char* kPaperColumns[4] = {"Lz", "Lx", "Rz", "Ry"};
-
-// The swept coordinate of a sample as plotted: m for translations, deg for rotations, or time.
-double displacement(const ReportedTest& t, double time, const Vector6d& desired) {
-  if (t.coordinate < 0) return time;
-  const double v = desired[t.coordinate];
-  return t.coordinate < 3 ? v : rad2deg(v);
-}
-double displacement(const ReportedTest& t, const SimulationSample& s) { return displacement(t, s.time, s.desired); }
-
-const char* strategy_name(Strategy s) { return s == Strategy::Compensated ? "compensated" : "conventional"; }
-
-std::string displacement_label(const ReportedTest& t) {
-  if (t.coordinate < 0) return "time [s]";
-  if (t.coordinate < 3) return fmt::format("commanded {} displacement [m]", kCoordinateNames[t.coordinate]);
-  return fmt::format("commanded {} angle [deg]", kCoordinateNames[t.coordinate]);
-}
 
 std::string csv(const ReportedTest& t, const StrategyRun& run, const Model& model) {
   fmt::memory_buffer b;
@@ -98,29 +79,8 @@ std::string measured_csv(const ReportedMeasurement& r) {
   return fmt::to_string(b);
 }
 
-// What a run did besides the three errors.
-struct RunFigures {
-  double max_torque = 0.0;             // [N m]
-  std::size_t saturated = 0;           // ticks with some torque at the limit
-  double max_following_error = 0.0;    // largest |target - true motor-side length| [m]
-  double max_orientation_error = 0.0;  // largest angle between real and commanded orientation [rad]
-};
-
-RunFigures run_figures(const Rig& rig, const StrategyRun& r) {
-  RunFigures f;
-  for (const SimulationSample& s : r.samples) {
-    const double m = s.torque.cwiseAbs().maxCoeff();
-    f.max_torque = std::max(f.max_torque, m);
-    f.saturated += m >= rig.servo().torque_limit ? 1 : 0;
-    f.max_following_error = std::max(f.max_following_error, (s.command - s.motor).cwiseAbs().maxCoeff());
-    const Matrix3d dR = rotation_from_rpy(s.actual.tail<3>()) * rotation_from_rpy(s.desired.tail<3>()).transpose();
-    f.max_orientation_error = std::max(f.max_orientation_error, Eigen::AngleAxisd(dR).angle());
-  }
-  return f;
-}
-
 void stats_json(JsonWriter& j, const StrategyRun& r, const Rig& rig) {
-  const RunFigures f = run_figures(rig, r);
+  const RunMetrics f = run_metrics(rig, r.samples);
   j.begin_object()
       .field("max_error_total", r.total.max)
       .field("max_error_twist_only", r.twist_only.max)
@@ -131,7 +91,7 @@ void stats_json(JsonWriter& j, const StrategyRun& r, const Rig& rig) {
       .field("max_orientation_error", f.max_orientation_error)
       .field("max_following_error", f.max_following_error)
       .field("max_torque", f.max_torque)
-      .field("saturated_ticks", static_cast<int>(f.saturated))
+      .field("saturated_ticks", static_cast<int>(f.saturated_ticks))
       .end_object();
 }
 
@@ -299,123 +259,6 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
   return s;
 }
 
-// The experiment beside the simulation: the error against the swept coordinate (or time), and its
-// components in the base frame against time.
-Figure measured_figure(const fs::path& dir, const ReportedTest& t) {
-  const ReportedMeasurement& r = *t.measured;
-  const Measurement& m = r.measurement;
-  const char* strategy = strategy_name(r.strategy);
-  Series measured{fmt::format("measured ({})", strategy), {}, {}, Series::Style::Solid};
-  Series simulated{fmt::format("simulated ({}, closed loop)", strategy), {}, {}, Series::Style::Dashed};
-  std::array<Series, 3> axes;
-  for (int a = 0; a < 3; ++a)
-    axes[static_cast<std::size_t>(a)].label = fmt::format("{} (base frame)", kCoordinateNames[a]);
-  for (std::size_t k = m.window; k < m.points.size(); ++k) {
-    const MeasuredPoint& p = m.points[k];
-    const double x = displacement(t, p.time, p.desired);
-    measured.x.push_back(x);
-    measured.y.push_back(1e3 * p.error_B.norm());
-    simulated.x.push_back(x);
-    simulated.y.push_back(1e3 * r.simulated[k - m.window]);
-    for (int a = 0; a < 3; ++a) {
-      axes[static_cast<std::size_t>(a)].x.push_back(p.time);
-      axes[static_cast<std::size_t>(a)].y.push_back(1e3 * p.error_B[a]);
-    }
-  }
-  Figure f{(dir / (t.name + "_measured")).string(), "", {}};
-  f.panels.push_back({fmt::format("{} ({}): measured and simulated error of point A", t.name, t.description),
-                      displacement_label(t),
-                      "position error [mm]",
-                      {std::move(measured), std::move(simulated)}});
-  f.panels.push_back({fmt::format("Measured error by axis, registered on {} points (rms residual {:.4f} mm)",
-                                  m.registration.count, 1e3 * m.registration.rms_residual),
-                      "time [s]",
-                      "error [mm]",
-                      {axes.begin(), axes.end()}});
-  return f;
-}
-
-std::vector<Figure> figures_of(const fs::path& dir, const ReportedTest& t, const Model& model) {
-  // x: the swept coordinate (or time) by default; time for the transients of the servo.
-  const auto series = [&](const std::string& label, const std::vector<SimulationSample>& samples, auto value,
-                          Series::Style style = Series::Style::Solid, bool against_time = false) {
-    Series s{label, {}, {}, style};
-    s.x.reserve(samples.size());
-    s.y.reserve(samples.size());
-    for (std::size_t k = 0; k < samples.size(); ++k) {
-      s.x.push_back(against_time ? samples[k].time : displacement(t, samples[k]));
-      s.y.push_back(value(k, samples[k]));
-    }
-    return s;
-  };
-  const auto tracking = [&](double scale) {
-    return [&t, scale](std::size_t k, const SimulationSample&) {
-      return k < t.run.tracking_only.size() ? scale * t.run.tracking_only[k] : NAN;
-    };
-  };
-  const auto& conv = t.run.conventional.samples;
-  const auto& comp = t.run.compensated.samples;
-  Figure error{(dir / (t.name + "_error")).string(), "", {}};
-  Panel p{fmt::format("{} ({}): observation-point error", t.name, t.description),
-          displacement_label(t),
-          "position error [mm]",
-          {}};
-  p.series.push_back(
-      series("conventional, closed loop", conv, [](std::size_t, const SimulationSample& s) { return 1e3 * s.error; }));
-  p.series.push_back(series(
-      "conventional, perfect servo", conv,
-      [](std::size_t, const SimulationSample& s) { return 1e3 * s.error_twist_only; }, Series::Style::Dashed));
-  p.series.push_back(
-      series("compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) { return 1e3 * s.error; }));
-  error.panels.push_back(std::move(p));
-  // On the scale of the twist error the compensated strategy is a flat line: zoom in on it,
-  // against time, where the servo's transients (starts, stops, reversals) are apart.
-  Panel zoom{fmt::format("Compensated, zoomed: the servo's own error (with perfect servos it is {:.1e} µm)",
-                         1e6 * t.run.compensated.twist_only.max),
-             "time [s]",
-             "position error [µm]",
-             {}};
-  zoom.series.push_back(series(
-      "compensated, closed loop", comp, [](std::size_t, const SimulationSample& s) { return 1e6 * s.error; },
-      Series::Style::Solid, true));
-  zoom.series.push_back(series("servo alone (no twist)", comp, tracking(1e6), Series::Style::Dashed, true));
-  error.panels.push_back(std::move(zoom));
-
-  // Legs that move alike (symmetry) would hide each other: say so in the legend.
-  std::array<int, kLegs> same{};
-  for (int i = 0; i < kLegs; ++i) {
-    same[static_cast<std::size_t>(i)] = -1;
-    for (int j = 0; j < i && same[static_cast<std::size_t>(i)] < 0; ++j) {
-      double d = 0.0;
-      for (const SimulationSample& s : conv) d = std::max(d, std::abs(s.twist[i] - s.twist[j]));
-      if (d < 1e-6) same[static_cast<std::size_t>(i)] = j;
-    }
-  }
-  const auto leg_label = [&](int i) {
-    const int j = same[static_cast<std::size_t>(i)];
-    return j < 0 ? fmt::format("leg {}", i + 1) : fmt::format("leg {} (= leg {})", i + 1, j + 1);
-  };
-  Figure legs{(dir / (t.name + "_legs")).string(), "", {}};
-  Panel twist{fmt::format("{} ({}): twist of each leg (conventional run)", t.name, t.description),
-              displacement_label(t),
-              "twist [deg]",
-              {}};
-  Panel length{
-      "Length error of each leg, real minus motor-side (Eq. 10)", displacement_label(t), "length error [mm]", {}};
-  for (int i = 0; i < kLegs; ++i) {
-    twist.series.push_back(
-        series(leg_label(i), conv, [i](std::size_t, const SimulationSample& s) { return rad2deg(s.twist[i]); }));
-    const double g = model.geometry().twist_gain[i];
-    length.series.push_back(
-        series(leg_label(i), conv, [i, g](std::size_t, const SimulationSample& s) { return 1e3 * g * s.twist[i]; }));
-  }
-  legs.panels.push_back(std::move(twist));
-  legs.panels.push_back(std::move(length));
-  std::vector<Figure> out{std::move(error), std::move(legs)};
-  if (t.measured) out.push_back(measured_figure(dir, t));
-  return out;
-}
-
 // A progress bar on stderr, drawn only on a terminal.
 class Progress {
  public:
@@ -446,7 +289,7 @@ std::string where(const ReportedTest& t, const SimulationIssue& issue) {
 
 }  // namespace
 
-void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std::string& out_dir) {
+void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests) {
   for (const ReportedTest& t : tests) {
     SimulationIssue issue;
     if (const Status s = check_trajectory(rig, t.trajectory, issue); s != Status::Ok)
@@ -454,7 +297,6 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std:
                       fmt::format("{}: {}; nothing was simulated", where(t, issue),
                                   is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
   }
-  prepare_output_folder(out_dir);
   std::size_t total = 0;
   for (const ReportedTest& t : tests) total += 3 * t.trajectory.poses.size();
   Progress bar(total);
@@ -474,10 +316,10 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std:
   bar.finish();
 }
 
-void simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<ReportedTest>& tests,
+void simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<ReportedTest>& tests, OutputFiles& files,
                          std::chrono::steady_clock::time_point start,
                          const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation) {
-  simulate_tests(rig, tests, o.out_dir);
+  simulate_tests(rig, tests);
   const double simulated = [&] {
     double d = 0.0;
     for (const ReportedTest& t : tests) d += 3.0 * t.trajectory.duration();
@@ -485,15 +327,15 @@ void simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<Rep
   }();
   const double sim_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string preamble = after_simulation ? after_simulation(tests) : std::string();
-  const std::vector<std::string> files = write_report(rig, o, tests);
+  write_report(rig, o, tests, files);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::string out = fmt::format("hexatwist {} on {}: {}\n", o.command, o.config_source, rig.model().spec().name);
   out += preamble + "\n";
   out += summary_table(tests);
   out += report_notes(rig, tests);
   out += fmt::format("\n{:.1f} s simulated ({} runs) in {:.1f} s; {} files written to {} in {:.1f} s in all\n",
-                     simulated, 3 * tests.size(), sim_wall, files.size(), o.out_dir, wall);
-  write_stdout_or_withdraw(out, files);
+                     simulated, 3 * tests.size(), sim_wall, files.paths().size(), o.out_dir, wall);
+  files.finish(out);
 }
 
 std::string summary_table(const std::vector<ReportedTest>& tests) {
@@ -559,70 +401,21 @@ ReportedTest reported_trajectory_file(const std::string& path, double dt, TimedP
   return t;
 }
 
-void prepare_output_folder(const std::string& out_dir) {
-  std::error_code ec;
-  fs::create_directories(out_dir, ec);
-  if (ec || !fs::is_directory(out_dir))
-    throw ExitError(kExitOutputFailed, fmt::format("--out: cannot create the output folder '{}'{}", printable(out_dir),
-                                                   ec ? ": " + ec.message() : std::string()));
-}
-
 std::string report_notes(const Rig& rig, const std::vector<ReportedTest>& tests) {
   std::string s;
   for (const ReportedTest& t : tests)
     for (const bool comp : {false, true}) {
-      const RunFigures f = run_figures(rig, comp ? t.run.compensated : t.run.conventional);
-      if (f.saturated > 0)
+      const RunMetrics f = run_metrics(rig, (comp ? t.run.compensated : t.run.conventional).samples);
+      if (f.saturated_ticks > 0)
         s += fmt::format("note: {} {}: the torque limit {:g} N m was reached on {} of {} ticks\n", t.label,
-                         comp ? "compensated" : "conventional", rig.servo().torque_limit, f.saturated,
+                         comp ? "compensated" : "conventional", rig.servo().torque_limit, f.saturated_ticks,
                          (comp ? t.run.compensated : t.run.conventional).samples.size());
     }
   return s;
 }
 
-namespace {
-
-// The files an earlier run left in the folder: every entry, and those its summary.json lists
-// as written by it (file names).
-struct EarlierRun {
-  std::vector<std::string> entries;
-  std::vector<std::string> listed;
-};
-
-EarlierRun earlier_run(const fs::path& dir) {
-  EarlierRun e;
-  std::error_code ec;
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
-    e.entries.push_back(it->path().filename().string());
-  std::sort(e.entries.begin(), e.entries.end());
-  const fs::path summary = dir / "summary.json";
-  if (!fs::is_regular_file(summary, ec)) return e;
-  // The list is one JSON array of plain file names (our own writer): read it without a parser.
-  std::ifstream in(summary, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  const std::string t = text.str();
-  const std::size_t key = t.rfind("\"files\": [");
-  if (key == std::string::npos) return e;
-  const std::size_t close = t.find(']', key);
-  for (std::size_t q = t.find('"', key + 9); q < close; q = t.find('"', q + 1)) {
-    const std::size_t r = t.find('"', q + 1);
-    if (r == std::string::npos || r > close) break;
-    const std::string name = t.substr(q + 1, r - q - 1);
-    if (!name.empty() && name.find('/') == std::string::npos && name.find('\\') == std::string::npos)
-      e.listed.push_back(name);
-    q = r;
-  }
-  return e;
-}
-
-}  // namespace
-
-std::vector<std::string> write_report(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests) {
+void write_report(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests, OutputFiles& set) {
   const fs::path dir(o.out_dir);
-  prepare_output_folder(o.out_dir);
-  const EarlierRun earlier = earlier_run(dir);
-  OutputSet set;
   std::vector<std::string> names;  // this run's files other than the summaries, as named in them
   const auto put = [&](const std::string& name, std::string content) {
     set.add((dir / name).string(), std::move(content));
@@ -640,49 +433,13 @@ std::vector<std::string> write_report(const Rig& rig, const ReportOptions& o, co
   }
   for (const Figure& f : figures)
     for (const char* ext : {".png", ".svg"}) names.push_back(fs::path(f.stem + ext).filename().string());
-  std::vector<std::string> all = names;
-  all.push_back("summary.md");
-  all.push_back("summary.json");
   set.add((dir / "summary.md").string(), summary_md(rig, o, tests, names));
   set.add((dir / "summary.json").string(), summary_json(rig, o, tests, names));
   // Everything is written before anything is put in place: a failure leaves the folder as it was.
   set.stage();
-  if (!figures.empty()) {
-    write_figures(figures);
-    for (const Figure& f : figures)
-      for (const char* ext : {".png", ".svg"}) set.adopt(f.stem + ext);
-  }
+  for (Figure& f : figures) f.stem = set.external(f.stem, {".png", ".svg"});
+  if (!figures.empty()) write_figures(figures);
   set.commit();
-
-  // A reused folder: the earlier run's files (as its summary listed them) that this run did not
-  // write are removed, so the summary never sits beside results it does not describe; other files
-  // are left and named.
-  if (!earlier.entries.empty()) {
-    const auto ours = [&](const std::string& n) { return std::find(all.begin(), all.end(), n) != all.end(); };
-    std::size_t replaced = 0, removed = 0;
-    std::vector<std::string> others;
-    for (const std::string& n : earlier.entries) {
-      if (ours(n)) {
-        ++replaced;
-      } else if (std::find(earlier.listed.begin(), earlier.listed.end(), n) != earlier.listed.end()) {
-        std::error_code ec;
-        if (fs::remove(dir / n, ec)) ++removed;
-      } else {
-        others.push_back(n);
-      }
-    }
-    std::string note = fmt::format(
-        "hexatwist {}: note: --out '{}' was not empty: {} files replaced, {} of an earlier "
-        "run removed",
-        o.command, printable(o.out_dir), replaced, removed);
-    if (!others.empty()) {
-      note += fmt::format("; {} other files left, not described by the summary:", others.size());
-      for (std::size_t k = 0; k < others.size() && k < 5; ++k) note += " " + printable(others[k]);
-      if (others.size() > 5) note += " ...";
-    }
-    std::fprintf(stderr, "%s\n", note.c_str());
-  }
-  return set.paths();
 }
 
 }  // namespace hexatwist::cli

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "hexatwist/hexatwist.hpp"
+#include "output_files.hpp"
 
 namespace hexatwist::cli {
 
@@ -51,22 +52,18 @@ struct ReportOptions {
   bool csv = true;            ///< write the per-tick CSVs
 };
 
-/// Creates the output folder (if missing) and checks it is a folder; ExitError(4) otherwise.
-/// Called before anything is simulated, so that a bad --out fails at once.
-void prepare_output_folder(const std::string& out_dir);
-
 /// Checks every test's trajectory against the limits first (ExitError(3) naming the test, time and
-/// limit, and nothing runs, if one fails), creates the output folder, then runs each test's three
-/// simulations (run_test), with a progress bar on stderr when it is a terminal.
-void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const std::string& out_dir);
+/// limit, and nothing runs, if one fails), then runs each test's three simulations (run_test), with a
+/// progress bar on stderr when it is a terminal.
+void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests);
 
-/// What study, simulate and measure do once their tests are set up: simulate_tests, then
-/// `after_simulation` (may be empty; returns lines to print before the table, e.g. the
-/// measurement's registration), then write_report, then prints the text for the terminal: the
-/// platform, those lines, the table, the notes, and the time taken since `start`. If standard
-/// output cannot be written, the report's files are removed (ExitError(4)): all or nothing.
+/// What study, simulate and measure do once their tests are set up and `files` knows their inputs
+/// and folder: simulate_tests, then `after_simulation` (may be empty; returns lines to print before
+/// the table, e.g. the measurement's registration), then write_report, then files.finish() with
+/// the text for the terminal: the platform, those lines, the table, the notes, and the time taken
+/// since `start`. All or nothing: a failure at any step leaves the folder as it was.
 void simulate_and_report(const Rig& rig, const ReportOptions& options, std::vector<ReportedTest>& tests,
-                         std::chrono::steady_clock::time_point start,
+                         OutputFiles& files, std::chrono::steady_clock::time_point start,
                          const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation = {});
 
 /// Notes for the reader that the table does not show (torque saturation); empty if none.
@@ -76,12 +73,11 @@ std::string report_notes(const Rig& rig, const std::vector<ReportedTest>& tests)
 /// the tests with a measurement.
 std::string summary_table(const std::vector<ReportedTest>& tests);
 
-/// Writes summary.json, summary.md, the CSVs and (optionally) the figures into out_dir as one set
-/// (OutputSet): on failure ExitError(kExitOutputFailed) names the file and none of the set nor any
-/// temporary is left. The summaries list the files written. In a folder that was not empty, the
-/// files an earlier summary listed and this run did not write are removed, and a note on stderr
-/// says what was replaced, removed and left. Returns the files written.
-std::vector<std::string> write_report(const Rig& rig, const ReportOptions& options,
-                                      const std::vector<ReportedTest>& tests);
+/// Adds summary.json, summary.md, the CSVs and (optionally) the figures in out_dir to `files` and
+/// commits them (OutputFiles: on failure ExitError(kExitOutputFailed) names the file and the folder
+/// is left as it was; an earlier run's files are moved aside). The summaries list the files written
+/// besides themselves.
+void write_report(const Rig& rig, const ReportOptions& options, const std::vector<ReportedTest>& tests,
+                  OutputFiles& files);
 
 }  // namespace hexatwist::cli

@@ -60,6 +60,32 @@ UdpAddress parse_udp_address(std::string_view spec, std::string_view option) {
   return a;
 }
 
+int udp_port(const UdpAddress& a) {
+  if (a.addr.ss_family == AF_INET) return ntohs(reinterpret_cast<const sockaddr_in*>(&a.addr)->sin_port);
+  if (a.addr.ss_family == AF_INET6) return ntohs(reinterpret_cast<const sockaddr_in6*>(&a.addr)->sin6_port);
+  return -1;
+}
+
+bool reaches(const UdpAddress& peer, const UdpAddress& local, int local_port) {
+  if (udp_port(peer) != local_port) return false;
+  const auto kind = [](const UdpAddress& a) {  // 0 wildcard, 1 loopback, 2 other
+    if (a.addr.ss_family == AF_INET) {
+      const std::uint32_t ip = ntohl(reinterpret_cast<const sockaddr_in*>(&a.addr)->sin_addr.s_addr);
+      return ip == INADDR_ANY ? 0 : (ip >> 24) == 127 ? 1 : 2;
+    }
+    const in6_addr& ip = reinterpret_cast<const sockaddr_in6*>(&a.addr)->sin6_addr;
+    return IN6_IS_ADDR_UNSPECIFIED(&ip) ? 0 : IN6_IS_ADDR_LOOPBACK(&ip) ? 1 : 2;
+  };
+  const int l = kind(local), p = kind(peer);
+  if (l == 0 || (l == 1 && p == 1)) return true;
+  if (peer.addr.ss_family != local.addr.ss_family) return false;
+  if (peer.addr.ss_family == AF_INET)
+    return reinterpret_cast<const sockaddr_in*>(&peer.addr)->sin_addr.s_addr ==
+           reinterpret_cast<const sockaddr_in*>(&local.addr)->sin_addr.s_addr;
+  return std::memcmp(&reinterpret_cast<const sockaddr_in6*>(&peer.addr)->sin6_addr,
+                     &reinterpret_cast<const sockaddr_in6*>(&local.addr)->sin6_addr, sizeof(in6_addr)) == 0;
+}
+
 std::string udp_text(const std::string& host, int port) {
   return host.find(':') != std::string::npos ? fmt::format("udp://[{}]:{}", host, port)
                                              : fmt::format("udp://{}:{}", host, port);

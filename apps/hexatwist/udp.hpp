@@ -29,6 +29,13 @@ bool is_udp(std::string_view spec);
 /// address or a name (resolved once). Errors are ExitError(2) naming `option`.
 UdpAddress parse_udp_address(std::string_view spec, std::string_view option);
 
+/// The port of a resolved address.
+int udp_port(const UdpAddress& a);
+
+/// True if datagrams sent to `peer` arrive at a socket bound to `local` on `local_port` (the port it
+/// got): the same port, and the same address, or `local` a wildcard address, or both loopback.
+bool reaches(const UdpAddress& peer, const UdpAddress& local, int local_port);
+
 /// An open UDP socket, closed on destruction.
 class UdpSocket {
  public:

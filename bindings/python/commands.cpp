@@ -32,7 +32,7 @@ py::dict commands_batch(const Model& model, const py::object& poses_in, const st
       }
     }
   });
-  raise_non_finite(ps, n, "poses");
+  raise_non_finite(ps, n, "poses", poses.data);
   py::dict d;
   d["commands"] = commands;
   d["status"] = status;

@@ -87,8 +87,9 @@ inline Pose pose_row(const double* data, std::size_t i) noexcept {
   return p;
 }
 
-/// Throws ValueError "name row i holds NaN or inf" if any status is NonFiniteInput.
-void raise_non_finite(const std::int8_t* status, std::size_t n, const char* name);
+/// Throws InputError naming the first row whose status is NonFiniteInput ("holds NaN or inf", or
+/// "too large to compute with" when `rows`, the (n, 6) input, shows it finite) or InvalidArgument (a length <= 0).
+void raise_non_finite(const std::int8_t* status, std::size_t n, const char* name, const double* rows = nullptr);
 
 /// hexatwist.Rig: a validated configuration and the YAML text it came from (for pickling).
 struct PyRig {

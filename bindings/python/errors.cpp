@@ -100,10 +100,18 @@ LengthKind length_kind_from(const std::string& name) {
   raise_input("kind: expected 'motor' or 'geometric', got '" + name + "'");
 }
 
-void raise_non_finite(const std::int8_t* status, std::size_t n, const char* name) {
-  for (std::size_t i = 0; i < n; ++i)
-    if (status[i] == static_cast<std::int8_t>(Status::NonFiniteInput))
-      raise_input(std::string(name) + ": row " + std::to_string(i) + " holds NaN or inf");
+void raise_non_finite(const std::int8_t* status, std::size_t n, const char* name, const double* rows) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (status[i] == static_cast<std::int8_t>(Status::InvalidArgument))
+      raise_input(std::string(name) + ": row " + std::to_string(i) + " holds a length <= 0 m");
+    if (status[i] != static_cast<std::int8_t>(Status::NonFiniteInput)) continue;
+    // Finite numbers whose computation overflows (1e300 m) are too large, not NaN or inf.
+    bool finite = rows != nullptr;
+    for (int k = 0; finite && k < 6; ++k) finite = std::isfinite(rows[6 * i + static_cast<std::size_t>(k)]);
+    raise_input(std::string(name) + ": row " + std::to_string(i) +
+                (finite ? " is too large to compute with (a length or pose beyond the platform's reach overflows)"
+                        : " holds NaN or inf"));
+  }
 }
 
 void expose_errors(py::module_& m) {

@@ -8,6 +8,15 @@
 namespace hexatwist::python {
 namespace {
 
+// The library's options from Python's arguments, checked as the library checks them (check_fk_options).
+FkOptions fk_options(int max_iterations, double tolerance) {
+  FkOptions options;
+  options.max_iterations = max_iterations;
+  options.tolerance = tolerance;
+  if (const std::string_view why = check_fk_options(options); !why.empty()) raise_input(std::string(why));
+  return options;
+}
+
 py::dict fk_batch(const Model& model, const py::object& lengths_in, const std::string& kind_name,
                   const py::object& guess_in, int max_iterations, double tolerance) {
   const LengthKind kind = length_kind_from(kind_name);
@@ -23,11 +32,7 @@ py::dict fk_batch(const Model& model, const py::object& lengths_in, const std::s
     for (std::size_t i = 0; i < guess.rows * 6; ++i)
       if (!std::isfinite(guess.data[i])) raise_input("guess: row " + std::to_string(i / 6) + " holds NaN or inf");
   }
-  if (max_iterations < 1) raise_input("max_iterations: must be at least 1");
-  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) raise_input("tolerance: must be a finite number > 0 [m]");
-  FkOptions options;
-  options.max_iterations = max_iterations;
-  options.tolerance = tolerance;
+  const FkOptions options = fk_options(max_iterations, tolerance);
   auto poses = new_rows(n, 6, lengths.single);
   auto status = new_column<std::int8_t>(n, lengths.single);
   auto iterations = new_column<std::int32_t>(n, lengths.single);
@@ -50,7 +55,7 @@ py::dict fk_batch(const Model& model, const py::object& lengths_in, const std::s
       if (chain && s == Status::Ok) start = r.placement;
     }
   });
-  raise_non_finite(ps, n, "lengths");
+  raise_non_finite(ps, n, "lengths", lengths.data);
   py::dict d;
   d["poses"] = poses;
   d["status"] = status;
@@ -65,15 +70,6 @@ struct PyFkTracker {
   LengthKind kind = LengthKind::Motor;
   FkTracker tracker;
 };
-
-FkOptions fk_options(int max_iterations, double tolerance) {
-  if (max_iterations < 1) raise_input("max_iterations: must be at least 1");
-  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) raise_input("tolerance: must be a finite number > 0 [m]");
-  FkOptions options;
-  options.max_iterations = max_iterations;
-  options.tolerance = tolerance;
-  return options;
-}
 
 void tracker_set(PyFkTracker& t, const py::object& pose_in) {
   const Rows6 r = rows6(pose_in, "pose");
@@ -113,7 +109,7 @@ py::dict tracker_track(PyFkTracker& t, const py::object& lengths_in, int max_ite
       for (int k = 0; k < 6; ++k) pq[6 * i + k] = s == Status::Ok ? q[k] : NAN;
     }
   }
-  raise_non_finite(ps, n, "lengths");
+  raise_non_finite(ps, n, "lengths", lengths.data);
   py::dict d;
   d["poses"] = poses;
   d["status"] = status;

@@ -38,7 +38,7 @@ py::dict ik_batch(const Model& model, const py::object& poses_in) {
       }
     }
   });
-  raise_non_finite(ps, n, "poses");
+  raise_non_finite(ps, n, "poses", poses.data);
   py::dict d;
   d["lengths"] = lengths;
   d["axes"] = axes;
@@ -74,7 +74,7 @@ py::dict twist_batch(const Model& model, const py::object& poses_in) {
       }
     }
   });
-  raise_non_finite(ps, n, "poses");
+  raise_non_finite(ps, n, "poses", poses.data);
   py::dict d;
   d["twist"] = tw;
   d["length_error"] = err;

@@ -3,6 +3,7 @@
 // bias force, forward dynamics, the energies, the motor angles and their Jacobian.
 // Platform velocity everywhere: x' = [v of the pivot [m/s, B]; w [rad/s, B]].
 #include <array>
+#include <cmath>
 
 #include "common.hpp"
 
@@ -205,7 +206,10 @@ void expose_mechanism(py::module_& m) {
       "[rad/m | rad/rad].");
   m.def(
       "peak_torque_at",
-      [](const py::object& config, double speed) { return peak_torque_at(rig_of(config)->config->rig.servo(), speed); },
+      [](const py::object& config, double speed) {
+        if (!std::isfinite(speed)) raise_input("speed: expected a finite motor speed [rad/s]");
+        return peak_torque_at(rig_of(config)->config->rig.servo(), speed);
+      },
       py::arg("config"), py::arg("speed"),
       "The motor's intermittent torque envelope at `speed` [rad/s] (its magnitude is used) [N m].");
 }

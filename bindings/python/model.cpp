@@ -4,6 +4,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -216,7 +217,7 @@ ModelPtr from_state(const py::tuple& t) {
 }
 
 // YAML text, or the path of a file holding it.
-std::pair<std::string, std::string> read_source(const py::object& path_or_text) {
+std::pair<std::string, std::string> read_source(const py::object& path_or_text, std::size_t max_bytes) {
   py::object os = py::module_::import("os");
   std::string text, source;
   bool is_path = py::isinstance(path_or_text, os.attr("PathLike"));
@@ -229,20 +230,25 @@ std::pair<std::string, std::string> read_source(const py::object& path_or_text) 
                 std::string(py::str(py::type::of(path_or_text).attr("__name__"))));
   }
   source = py::str(os.attr("fspath")(path_or_text)).cast<std::string>();
-  std::ifstream in(source, std::ios::binary);
-  if (!in) {
+  std::error_code ec;
+  if (!std::filesystem::exists(source, ec)) {
     PyErr_SetString(PyExc_FileNotFoundError, (source + ": cannot open the file").c_str());
     throw py::error_already_set();
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return {ss.str(), source};
+  // The library's reader: a directory, an unreadable or an overlong file is a ConfigError, as in C.
+  return {read_text_file(source, max_bytes == kMaxConfigBytes ? "configuration file" : "file", max_bytes), source};
 }
 
 }  // namespace
 
+// A data file (trajectory CSV, point log: up to kMaxDataBytes) or its text.
 std::pair<std::string, std::string> read_yaml_source(const py::object& path_or_text) {
-  return read_source(path_or_text);
+  return read_source(path_or_text, kMaxDataBytes);
+}
+
+// A configuration file (up to kMaxConfigBytes) or its text.
+std::pair<std::string, std::string> read_config_source(const py::object& path_or_text) {
+  return read_source(path_or_text, kMaxConfigBytes);
 }
 
 void expose_model(py::module_& m) {
@@ -337,7 +343,7 @@ void expose_model(py::module_& m) {
   m.def(
       "load_model",
       [](const py::object& src) {
-        auto [text, source] = read_source(src);
+        auto [text, source] = read_source(src, kMaxConfigBytes);
         return std::make_shared<Model>(load_model(text, source));
       },
       py::arg("path_or_yaml"),

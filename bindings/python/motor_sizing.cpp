@@ -86,6 +86,9 @@ Trajectory trajectory_from(const Config& config, const py::object& csv, const py
   Trajectory tr;
   tr.t0 = t0;
   tr.dt = dt_in.is_none() ? period : dt_in.cast<double>();
+  // The library's check of a trajectory's samples, before any memory is taken for them.
+  if (const std::string_view why = check_trajectory_samples(tr.t0, tr.dt, q.rows); !why.empty())
+    raise_input("size_motors: " + std::string(why));
   tr.poses.resize(q.rows);
   for (std::size_t i = 0; i < q.rows; ++i) tr.poses[i] = pose_row(q.data, i);
   return tr;

@@ -9,7 +9,7 @@
 
 namespace hexatwist::python {
 
-std::pair<std::string, std::string> read_yaml_source(const py::object& path_or_text);
+std::pair<std::string, std::string> read_config_source(const py::object& path_or_text);
 
 Vector6d vector6(const py::handle& obj, const char* name) {
   const Rows6 r = rows6(obj, name);
@@ -32,7 +32,7 @@ std::shared_ptr<const PyRig> rig_from_source(const py::object& src) {
     r->source = "seed";
     return r;
   }
-  auto [text, source] = read_yaml_source(src);
+  auto [text, source] = read_config_source(src);
   r->config = std::make_shared<const Config>(load_config(text, source));
   r->yaml = std::move(text);
   r->source = std::move(source);

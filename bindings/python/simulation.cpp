@@ -62,23 +62,31 @@ py::dict issue_dict(Status s, const SimulationIssue& issue) {
   return d;
 }
 
-Trajectory trajectory_of(const Config& config, const std::string& test, const py::object& poses_in) {
+// The trajectory of one of the paper's tests (`test`, default Rz) or of `poses`, not both.
+Trajectory trajectory_of(const Config& config, const py::object& test, const py::object& poses_in) {
   const double dt = config.rig.control_period();
   if (!poses_in.is_none()) {
+    if (!test.is_none()) raise_input("give test or poses, not both");
     const Rows6 rows = rows6(poses_in, "poses", false);
+    if (rows.rows == 0) raise_input("poses: expected at least one pose");
+    if (const std::string_view why = check_trajectory_samples(0.0, dt, std::max<std::size_t>(rows.rows, 2));
+        !why.empty())
+      raise_input(std::string(why));
     Trajectory tr;
     tr.dt = dt;
     tr.poses.resize(rows.rows);
     for (std::size_t i = 0; i < rows.rows; ++i) tr.poses[i] = pose_row(rows.data, i);
-    if (tr.poses.empty()) raise_input("poses: expected at least one pose");
     return tr;
   }
-  for (const StudyTest& t : seed_tests(config.study))
-    if (t.name == test) return test_trajectory(config.study, t, dt);
-  raise_input("test: unknown test '" + test + "'; expected Lz, Lx, Rz or Ry");
+  const std::string name = test.is_none() ? std::string("Rz") : test.cast<std::string>();
+  try {
+    return test_trajectory(config.study, study_test(config.study, name), dt);
+  } catch (const Error& e) {
+    raise_input(std::string("test: ") + e.what());
+  }
 }
 
-py::dict simulate_py(const py::object& config_src, const std::string& test, const py::object& poses,
+py::dict simulate_py(const py::object& config_src, const py::object& test, const py::object& poses,
                      const std::string& strategy, bool twist_in_plant) {
   const Config config = config_of(config_src);
   const Trajectory tr = trajectory_of(config, test, poses);
@@ -97,8 +105,9 @@ py::dict simulate_py(const py::object& config_src, const std::string& test, cons
   for (std::size_t k = 0; k < samples.size(); ++k) err[k] = samples[k].error;
   const ErrorStats st = error_stats(err);
   py::dict summary = issue_dict(s, issue);
-  summary["error_max"] = st.max;
-  summary["error_rms"] = st.rms;
+  // A run stopped by a limit has no error to report: None, not the zeros of no ticks.
+  summary["error_max"] = s == Status::Ok ? py::object(py::float_(st.max)) : py::none();
+  summary["error_rms"] = s == Status::Ok ? py::object(py::float_(st.rms)) : py::none();
   summary["ticks"] = samples.size();
   d["summary"] = summary;
   return d;
@@ -111,7 +120,21 @@ py::dict stats(const ErrorStats& e) {
   return d;
 }
 
-py::dict study_py(const py::object& config_src, const std::string& test, const py::object& poses) {
+// A strategy's errors and what else the run did (study.hpp's run_metrics, as summary.json has them).
+py::dict strategy_summary(const Rig& rig, const StrategyRun& r) {
+  py::dict d;
+  d["total"] = stats(r.total);
+  d["twist_only"] = stats(r.twist_only);
+  d["tracking_only"] = stats(r.tracking_only);
+  const RunMetrics m = run_metrics(rig, r.samples);
+  d["max_torque"] = m.max_torque;
+  d["saturated_ticks"] = m.saturated_ticks;
+  d["max_following_error"] = m.max_following_error;
+  d["max_orientation_error"] = m.max_orientation_error;
+  return d;
+}
+
+py::dict study_py(const py::object& config_src, const py::object& test, const py::object& poses) {
   const Config config = config_of(config_src);
   const Trajectory tr = trajectory_of(config, test, poses);
   TestRun run;
@@ -123,15 +146,12 @@ py::dict study_py(const py::object& config_src, const std::string& test, const p
   }
   py::dict d;
   py::dict summary = issue_dict(s, issue);
-  summary["test"] = poses.is_none() ? test : std::string("poses");
+  summary["test"] = poses.is_none() ? (test.is_none() ? std::string("Rz") : test.cast<std::string>()) : "poses";
   for (auto [name, r] : {std::pair<const char*, const StrategyRun*>{"conventional", &run.conventional},
                          std::pair<const char*, const StrategyRun*>{"compensated", &run.compensated}}) {
     d[name] = samples_dict(r->samples);
-    py::dict sd;
-    sd["total"] = stats(r->total);
-    sd["twist_only"] = stats(r->twist_only);
-    sd["tracking_only"] = stats(r->tracking_only);
-    summary[name] = sd;
+    // A run stopped by a limit has no errors to report: None, not the zeros of no ticks.
+    summary[name] = s == Status::Ok ? py::object(strategy_summary(config.rig, *r)) : py::none();
   }
   d["tracking_only"] =
       py::array_t<double>(static_cast<py::ssize_t>(run.tracking_only.size()), run.tracking_only.data());
@@ -142,9 +162,11 @@ py::dict study_py(const py::object& config_src, const std::string& test, const p
 }  // namespace
 
 void expose_simulation(py::module_& m) {
-  m.def("_simulate", &simulate_py, py::arg("config") = py::none(), py::arg("test") = "Rz",
+  m.attr("MAX_TRAJECTORY_SAMPLES") = kMaxTrajectorySamples;
+  m.def("_simulate", &simulate_py, py::arg("config") = py::none(), py::arg("test") = py::none(),
         py::arg("poses") = py::none(), py::arg("strategy") = "compensated", py::arg("twist_in_plant") = true);
-  m.def("_study", &study_py, py::arg("config") = py::none(), py::arg("test") = "Rz", py::arg("poses") = py::none());
+  m.def("_study", &study_py, py::arg("config") = py::none(), py::arg("test") = py::none(),
+        py::arg("poses") = py::none());
   m.def(
       "control_period", [](const py::object& c) { return config_of(c).rig.control_period(); },
       py::arg("config") = py::none(), "The configuration's control period [s] (poses of simulate are this far apart).");
@@ -152,7 +174,7 @@ void expose_simulation(py::module_& m) {
       "study_trajectory",
       [](const py::object& c, const std::string& test) {
         const Config config = config_of(c);
-        const Trajectory tr = trajectory_of(config, test, py::none());
+        const Trajectory tr = trajectory_of(config, py::str(test), py::none());
         py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
         for (std::size_t k = 0; k < tr.poses.size(); ++k) {
           const Vector6d v = tr.poses[k].to_vector();

@@ -39,7 +39,7 @@ void expose_stream(py::module_& m) {
              s->settings.period = period;
              s->settings.max_velocity = max_velocity;
              s->settings.max_acceleration = max_acceleration;
-             if (auto why = check_stream_settings(s->settings); !why.empty()) raise_input(std::string(why));
+             if (auto why = check_stream_settings(*s->model, s->settings); !why.empty()) raise_input(std::string(why));
              return s;
            }),
            py::arg("model"), py::arg("strategy") = "compensated", py::arg("on_reject") = "hold",

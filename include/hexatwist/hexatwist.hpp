@@ -39,3 +39,4 @@
 #include "hexatwist/io/config.hpp"
 #include "hexatwist/io/mjcf.hpp"
 #include "hexatwist/io/platform_yaml.hpp"
+#include "hexatwist/io/text_file.hpp"

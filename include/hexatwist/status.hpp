@@ -27,9 +27,10 @@ enum class Status : int {
   PlatformSingularity,     ///< the pose is too close to a platform (Jacobian) singularity: the motor-side Jacobian's
                            ///< condition number exceeds limits.jacobian_condition_max
   AssemblyModeChanged,  ///< forward kinematics found a solution on another assembly mode than its start (the Jacobian
+                        ///< determinant changed sign)
+  InvalidArgument,      ///< an option or argument outside its documented range (check_fk_options, a length <= 0)
   SignUndecided,        ///< an identification: both thread senses explain the measurements about as well
-  ModelMismatch,  ///< an identification: the identified model leaves an error the tracker's noise does not explain
-                  ///< determinant changed sign)
+  ModelMismatch,        ///< an identification: the identified model leaves an error the tracker's noise does not explain
 };
 
 /// The last status: every status is in Ok .. kLastStatus.

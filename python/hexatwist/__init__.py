@@ -16,6 +16,7 @@ import numpy as np
 
 from ._hexatwist import (  # noqa: F401  (re-exported)
     BLOCK,
+    MAX_TRAJECTORY_SAMPLES,
     STATUS_NAMES,
     ConfigError,
     DTypeError,
@@ -51,7 +52,7 @@ from . import _hexatwist as _core
 from .distributed import map_batch, map_simulations  # noqa: F401
 
 __all__ = [
-    "BLOCK", "STATUS_NAMES", "Status", "Result", "Error", "ConfigError", "InputError", "DTypeError", "StatusError",
+    "BLOCK", "MAX_TRAJECTORY_SAMPLES", "STATUS_NAMES", "Status", "Result", "Error", "ConfigError", "InputError", "DTypeError", "StatusError",
     "Model", "Stream", "default_model", "load_model", "seed_config_yaml", "control_period", "study_trajectory",
     "inverse_kinematics", "twist", "length_error", "commands", "motor_command", "forward",
     "simulate", "study", "read_point_log", "measured_test", "observations_at_rest", "identify",
@@ -140,16 +141,17 @@ def forward(model: Model, lengths, kind: str = "motor", guess=None, max_iteratio
     return Result(_core._forward(model, lengths, kind, guess, max_iterations, tolerance))
 
 
-def simulate(config=None, test: str = "Rz", poses=None, strategy: str = "compensated",
+def simulate(config=None, test: str | None = None, poses=None, strategy: str = "compensated",
              twist_in_plant: bool = True) -> Result:
     """Closed-loop simulation under the six servo loops (simulation.hpp).
 
     ``config``: YAML text, a path, or None for the embedded seed configuration. The trajectory is one
-    of the paper's tests (``test``: Lz, Lx, Rz, Ry) or ``poses`` (T, 6) [m, rad] one per control period.
-    Returns time series ``time`` (T,) [s]; ``desired``, ``actual`` poses (T, 6) [m, rad]; ``command``,
+    of the paper's tests (``test``: Lz, Lx, Rz, Ry; Rz when neither is given) or ``poses`` (T, 6) [m, rad]
+    one per control period (at most ``MAX_TRAJECTORY_SAMPLES``); both is an InputError. Returns time series ``time`` (T,) [s]; ``desired``, ``actual`` poses (T, 6) [m, rad]; ``command``,
     ``encoder``, ``motor`` motor-side and ``length`` real lengths (T, 6) [m]; ``twist`` (T, 6) [rad];
     ``torque`` (T, 6) [N m]; observation errors ``error``, ``error_twist_only`` (T,) [m]; and
-    ``summary`` (dict: status, issue index/time/leg/value/bound, error_max, error_rms [m], ticks).
+    ``summary`` (dict: status, issue index/time/leg/value/bound, error_max, error_rms [m] (None unless the
+    status is ok), ticks).
     """
     r = Result(_core._simulate(config, test, poses, strategy, twist_in_plant))
     for k, v in list(r.items()):
@@ -158,12 +160,16 @@ def simulate(config=None, test: str = "Rz", poses=None, strategy: str = "compens
     return r
 
 
-def study(config=None, test: str = "Rz", poses=None) -> Result:
-    """One test of the paper's study (§4, Table 1): the twist-free, conventional and compensated runs.
+def study(config=None, test: str | None = None, poses=None) -> Result:
+    """One test of the paper's study (§4, Table 1): the twist-free, conventional and compensated runs of
+    ``test`` (Lz, Lx, Rz, Ry; Rz when neither is given) or of ``poses`` (T, 6) [m, rad], not both.
 
     Returns ``conventional`` and ``compensated`` (each a Result of time series as :func:`simulate`),
-    ``tracking_only`` (T,) observation error of the twist-free run [m], and ``summary``: status, and per
-    strategy the max / rms of the total, twist-only and tracking-only errors [m].
+    ``tracking_only`` (T,) observation error of the twist-free run [m], and ``summary``: status (a limit or
+    numerical failure with its index/time/leg/value/bound), and per strategy (None unless the status is ok)
+    the max / rms of the total, twist-only and tracking-only errors [m] and what ``hexatwist study`` reports
+    beside them in summary.json (the library's run_metrics): ``max_torque`` [N m], ``saturated_ticks``,
+    ``max_following_error`` [m] and ``max_orientation_error`` [rad].
     """
     r = Result(_core._study(config, test, poses))
     r["conventional"] = Result(r["conventional"])

@@ -59,6 +59,8 @@ def map_batch(function: str, model, array, client=None, chunk: int | None = None
         raise hexatwist.DTypeError(f"array: expected dtype float64, got {rows.dtype}")
     if rows.ndim != 2 or rows.shape[1] != 6:
         raise hexatwist.InputError(f"array: expected shape (N, 6), got {rows.shape}")
+    if chunk is not None and (isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1):
+        raise hexatwist.InputError(f"chunk: expected a whole number of rows >= 1, got {chunk!r}")
     if client is None:
         return fn(model, rows, **kwargs)
     block = hexatwist.BLOCK

@@ -39,7 +39,9 @@ inline Vector6d to_vector(const double v[kLegs]) noexcept { return Eigen::Map<co
 
 inline void from_vector(const Vector6d& v, double out[kLegs]) noexcept { Eigen::Map<Vector6d>{out} = v; }
 
-inline hexatwist_status to_c(Status s) noexcept { return static_cast<hexatwist_status>(static_cast<int>(s)); }
+inline hexatwist_status to_c(Status s) noexcept {
+  return s == Status::InvalidArgument ? HEXATWIST_INVALID_ARGUMENT : static_cast<hexatwist_status>(static_cast<int>(s));
+}
 
 /// The C limit report: legs counted from 1, 0 for a limit of the whole platform.
 inline void from_limit(const LimitReport& r, hexatwist_limit* out) noexcept {

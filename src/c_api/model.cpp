@@ -1,14 +1,12 @@
 // C API: building, freeing and reading the opaque model. The only calls of the C API that
 // allocate; every exception stops here and becomes a NULL model and a one-line message.
-#include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <new>
-#include <sstream>
 
 #include "c_api.hpp"
 #include "hexatwist/error.hpp"
 #include "hexatwist/io/config.hpp"
+#include "hexatwist/io/text_file.hpp"
 
 namespace {
 
@@ -41,18 +39,8 @@ hexatwist_model* hexatwist_model_from_file(const char* path, char* error, size_t
     write_error("configuration file: no path given (NULL)", error, error_size);
     return nullptr;
   }
-  return build(
-      [&] {
-        errno = 0;
-        std::ifstream in(path, std::ios::binary);
-        std::ostringstream text;
-        if (in) text << in.rdbuf();
-        if (!in || in.bad())
-          throw Error(std::string(path) +
-                      ": cannot read the configuration file: " + (errno != 0 ? std::strerror(errno) : "cannot open"));
-        return load_model(text.str(), path);
-      },
-      error, error_size);
+  return build([&] { return load_model(read_text_file(path, "configuration file", kMaxConfigBytes), path); }, error,
+               error_size);
 }
 
 hexatwist_model* hexatwist_model_from_yaml(const char* yaml_text, const char* source, char* error, size_t error_size) {

@@ -32,7 +32,8 @@ const char* hexatwist_status_name(hexatwist_status status) {
 }
 
 const char* hexatwist_status_describe(hexatwist_status status) {
-  if (status == HEXATWIST_INVALID_ARGUMENT) return "a null pointer or an unknown enum value was passed";
+  if (status == HEXATWIST_INVALID_ARGUMENT)
+    return "a null pointer, an unknown enum value or an option outside its documented range was passed";
   return c_str(hexatwist::describe(static_cast<Status>(status)));
 }
 

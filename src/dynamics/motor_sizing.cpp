@@ -117,8 +117,10 @@ Status size_motors(const Rig& rig, const Trajectory& trajectory, MotorSizing& ou
   out = MotorSizing{};
   const std::vector<Pose>& poses = trajectory.poses;
   const std::size_t n = poses.size();
-  if (n < 2 || !(trajectory.dt > 0.0) || !std::isfinite(trajectory.dt))
+  if (n < 2 || !(trajectory.dt > 0.0) || !std::isfinite(trajectory.dt) || !std::isfinite(trajectory.t0))
     return fail(out, Status::NonFiniteInput, 0, trajectory);
+  if (!check_trajectory_samples(trajectory.t0, trajectory.dt, n).empty())
+    return fail(out, Status::InvalidArgument, 0, trajectory);
   const double dt = trajectory.dt;
   out.samples.reserve(n);
   CommandReport commands;

@@ -64,47 +64,168 @@ Matrix3d leg_body_inertia(const LegBodySpec& b, double lumped, const char* field
   return Matrix3d(Vector3d(transverse, transverse, axial).asDiagonal());
 }
 
-}  // namespace
+// One leg's frame at home: the axes of its joints, its length and where its bodies' mass sits.
+struct LegFrame {
+  int n;                       // 1-based
+  Vector3d s, ja, jd, jb, je;  // leg axis and the U-joints' axes [-, B]
+  double L;                    // home length [m]
+  bool base_driven;
+  Matrix3d I_h, I_r;  // housing and rod inertia about their centres of mass [kg m^2, B]
+  Vector3d c_h, c_r;  // their centres of mass from the base joint, at home [m, B]
+};
 
-std::string mjcf_model(const Rig& rig) {
-  const Model& model = rig.model();
-  const ServoSpec& servo = rig.servo();
-  const LoadSpec& load = rig.load();
-  const MechanismSpec& mech = rig.mechanism();
-  const double N = servo.gear_ratio;
-  const double Jm = servo.motor_inertia, Js = servo.screw_inertia;
+// What every leg's bodies share: the rig's numbers and the inertias lumped into the leg bodies.
+struct LegBodies {
+  const Rig& rig;
+  double Jm, Js, lumped;
+  Matrix3d I_housing_base, I_housing_plain, I_rod_platform, I_rod_plain;
+  double housing_share, rod_share, housing_whole, rod_whole, load_share;
+  Matrix3d load_inertia_share;
+
   // A disc's transverse inertia is half its axial; a little more, as MuJoCo checks A + B >= C after
   // rounding.
-  const auto disc = [](double axial) { return 0.5 * axial + kTinyInertia; };
-  const double lumped = disc(Jm) + disc(Js);
-  const Vector3d platform_home_B(0.0, 0.0, model.spec().home_height);
-  for (int i = 0; i < kLegs; ++i) {
-    const Leg& leg = model.leg(i);
-    if (!(leg.lead > 0.0))
-      throw Error(
-          fmt::format("leg {}: the MuJoCo model needs a lead screw on every leg (lead 0 has no screw to "
-                      "couple the motor to the leg)",
-                      i + 1));
-    if (!(leg.axis_base_B.squaredNorm() > 0.0) || !(leg.axis_platform_P.squaredNorm() > 0.0))
-      throw Error(fmt::format("leg {}: the MuJoCo model needs both U-joint axes", i + 1));
-  }
-  // Which leg body carries motor and screw decides the inertia lumped into it.
-  bool any_base = false, any_platform = false;
-  for (const Leg& leg : model.legs()) (leg.driven == DrivenSide::Base ? any_base : any_platform) = true;
-  const Matrix3d I_housing_base =
-      any_base ? leg_body_inertia(mech.housing, lumped, "mechanism.housing.transverse_inertia") : Matrix3d::Zero();
-  const Matrix3d I_housing_plain = leg_body_inertia(mech.housing, 0.0, "mechanism.housing.transverse_inertia");
-  const Matrix3d I_rod_platform =
-      any_platform ? leg_body_inertia(mech.rod, lumped, "mechanism.rod.transverse_inertia") : Matrix3d::Zero();
-  const Matrix3d I_rod_plain = leg_body_inertia(mech.rod, 0.0, "mechanism.rod.transverse_inertia");
-  // The mass of the body carrying motor and screw is split in three (itself, rotor, screw).
-  const double housing_share = std::max(mech.housing.mass / 3.0, kTinyMass);
-  const double rod_share = std::max(mech.rod.mass / 3.0, kTinyMass);
-  const double housing_whole = std::max(mech.housing.mass, kTinyMass);
-  const double rod_whole = std::max(mech.rod.mass, kTinyMass);
-  const double load_share = std::max(load.mass * kLoadShare, kTinyMass);
-  const Matrix3d load_inertia_share = kLoadShare * load.inertia_tensor();
+  static double disc(double axial) { return 0.5 * axial + kTinyInertia; }
 
+  explicit LegBodies(const Rig& r) : rig(r) {
+    const ServoSpec& servo = rig.servo();
+    const MechanismSpec& mech = rig.mechanism();
+    Jm = servo.motor_inertia;
+    Js = servo.screw_inertia;
+    lumped = disc(Jm) + disc(Js);
+    // Which leg body carries motor and screw decides the inertia lumped into it.
+    bool any_base = false, any_platform = false;
+    for (const Leg& leg : rig.model().legs()) (leg.driven == DrivenSide::Base ? any_base : any_platform) = true;
+    I_housing_base =
+        any_base ? leg_body_inertia(mech.housing, lumped, "mechanism.housing.transverse_inertia") : Matrix3d::Zero();
+    I_housing_plain = leg_body_inertia(mech.housing, 0.0, "mechanism.housing.transverse_inertia");
+    I_rod_platform =
+        any_platform ? leg_body_inertia(mech.rod, lumped, "mechanism.rod.transverse_inertia") : Matrix3d::Zero();
+    I_rod_plain = leg_body_inertia(mech.rod, 0.0, "mechanism.rod.transverse_inertia");
+    // The mass of the body carrying motor and screw is split in three (itself, rotor, screw).
+    housing_share = std::max(mech.housing.mass / 3.0, kTinyMass);
+    rod_share = std::max(mech.rod.mass / 3.0, kTinyMass);
+    housing_whole = std::max(mech.housing.mass, kTinyMass);
+    rod_whole = std::max(mech.rod.mass, kTinyMass);
+    load_share = std::max(rig.load().mass * kLoadShare, kTinyMass);
+    load_inertia_share = kLoadShare * rig.load().inertia_tensor();
+  }
+
+  std::string leg(int i) const;
+
+ private:
+  LegFrame frame(int i) const;
+  std::string rotor(const LegFrame& f, int level, const Vector3d& com) const;
+  std::string end(const LegFrame& f, int level) const;
+};
+
+std::string indent(int level) { return std::string(static_cast<std::size_t>(2 * level), ' '); }
+
+LegFrame LegBodies::frame(int i) const {
+  const Leg& leg = rig.model().leg(i);
+  const MechanismSpec& mech = rig.mechanism();
+  LegFrame f;
+  f.n = i + 1;
+  f.s = leg.s_home_B;
+  f.L = leg.length_home;
+  f.ja = leg.axis_base_B.normalized();
+  f.jd = leg.axis_platform_P.normalized();  // P is aligned with B at home
+  f.jb = f.s.cross(f.ja).normalized();
+  f.je = f.s.cross(f.jd).normalized();
+  f.base_driven = leg.driven == DrivenSide::Base;
+  // Leg-body inertia in the body frame (aligned with B at home), rotated onto s.
+  Eigen::Matrix3d R;  // columns: two unit vectors across s, then s
+  R.col(2) = f.s;
+  R.col(0) = f.jb;
+  R.col(1) = f.s.cross(f.jb);
+  f.I_h = R * (f.base_driven ? I_housing_base : I_housing_plain) * R.transpose();
+  f.I_r = R * (f.base_driven ? I_rod_plain : I_rod_platform) * R.transpose();
+  f.c_h = mech.housing.center * f.s;
+  f.c_r = (f.L - mech.rod.center) * f.s;
+  return f;
+}
+
+std::string LegBodies::rotor(const LegFrame& f, int level, const Vector3d& com) const {
+  return fmt::format(
+      "{0}<body name=\"rotor{1}\">\n"
+      "{0}  <joint name=\"leg{1}_rotor\" type=\"hinge\" axis=\"{2}\" damping=\"{4}\" frictionloss=\"{5}\"/>\n"
+      "{0}  {3}\n"
+      "{0}</body>\n",
+      indent(level), f.n, vec(f.s),
+      inertial(com, f.base_driven ? housing_share : rod_share, axisymmetric(f.s, Jm, disc(Jm))),
+      num(rig.servo().viscous_friction), num(rig.servo().coulomb_friction));
+}
+
+std::string LegBodies::end(const LegFrame& f, int level) const {
+  return fmt::format(
+      "{0}<body name=\"end{1}\">\n"
+      "{0}  <joint name=\"leg{1}_je\" type=\"hinge\" axis=\"{2}\"/>\n"
+      "{0}  <joint name=\"leg{1}_jd\" type=\"hinge\" axis=\"{3}\"/>\n"
+      "{0}  {4}\n"
+      "{0}</body>\n",
+      indent(level), f.n, vec(f.je), vec(f.jd),
+      inertial(rig.load().center_of_mass_P - rig.model().leg(f.n - 1).platform_P, load_share, load_inertia_share));
+}
+
+// Leg i's bodies: housing (on the base U-joint), rotor, screw, rod and rod end, nested as the joints
+// connect them; which holds the rotor and screw depends on the driven side.
+std::string LegBodies::leg(int i) const {
+  const Leg& leg = rig.model().leg(i);
+  const MechanismSpec& mech = rig.mechanism();
+  const LegFrame f = frame(i);
+  const int n = f.n;
+  const Vector3d& s = f.s;
+  const std::string rod_geom = fmt::format(
+      "<geom type=\"capsule\" fromto=\"0 0 0 {}\" size=\"0.02\" rgba=\"0.7 0.7 0.75 1\"/>", vec(-0.5 * f.L * s));
+  const std::string housing_geom = fmt::format(
+      "<geom type=\"capsule\" fromto=\"0 0 0 {}\" size=\"0.04\" rgba=\"0.3 0.3 0.35 1\"/>", vec(0.6 * f.L * s));
+  std::string t = fmt::format("    <!-- leg {}: {}-driven, {}-hand thread, lead {} m, home length {} m -->\n", n,
+                              f.base_driven ? "base" : "platform", leg.thread == ThreadSense::Right ? "right" : "left",
+                              num(leg.lead), num(f.L));
+  t += fmt::format(
+      "    <body name=\"housing{0}\" pos=\"{1}\">\n"
+      "      <joint name=\"leg{0}_ja\" type=\"hinge\" axis=\"{2}\"/>\n"
+      "      <joint name=\"leg{0}_jb\" type=\"hinge\" axis=\"{3}\"/>\n"
+      "      {4}\n"
+      "      {5}\n",
+      n, vec(leg.base_B), vec(f.ja), vec(f.jb), inertial(f.c_h, f.base_driven ? housing_share : housing_whole, f.I_h),
+      housing_geom);
+  if (f.base_driven) {
+    // Motor and screw in the housing, nut in the rod.
+    t += rotor(f, 3, f.c_h);
+    t += fmt::format(
+        "      <body name=\"screw{0}\">\n"
+        "        <joint name=\"leg{0}_screw\" type=\"hinge\" axis=\"{1}\"/>\n"
+        "        {2}\n"
+        "        <body name=\"rod{0}\" pos=\"{3}\">\n"
+        "          <joint name=\"leg{0}_nut\" type=\"hinge\" axis=\"{1}\"/>\n"
+        "          <joint name=\"leg{0}_slide\" type=\"slide\" axis=\"{1}\"/>\n"
+        "          {4}\n"
+        "          {5}\n",
+        n, vec(s), inertial(f.c_h, housing_share, axisymmetric(s, Js, disc(Js))), vec(f.L * s),
+        inertial(-mech.rod.center * s, rod_whole, f.I_r), rod_geom);
+  } else {
+    // Motor and screw in the rod, nut in the housing: the screw turns in the nut and slides
+    // with the rod.
+    t += fmt::format(
+        "      <body name=\"screw{0}\">\n"
+        "        <joint name=\"leg{0}_nut\" type=\"hinge\" axis=\"{1}\"/>\n"
+        "        <joint name=\"leg{0}_slide\" type=\"slide\" axis=\"{1}\"/>\n"
+        "        {2}\n"
+        "        <body name=\"rod{0}\" pos=\"{3}\">\n"
+        "          <joint name=\"leg{0}_screw\" type=\"hinge\" axis=\"{1}\"/>\n"
+        "          {4}\n"
+        "          {5}\n",
+        n, vec(s), inertial(f.c_r, rod_share, axisymmetric(s, Js, disc(Js))), vec(f.L * s),
+        inertial(-mech.rod.center * s, rod_share, f.I_r), rod_geom);
+    t += rotor(f, 5, -mech.rod.center * s);
+  }
+  t += end(f, 5);
+  t += "        </body>\n      </body>\n";
+  return t + "    </body>\n";
+}
+
+// The header comment and the global settings, up to the world body's light.
+std::string preamble(const Rig& rig) {
   std::string t = fmt::format(
       "<!-- MuJoCo model (MJCF) of the lead-screw Stewart platform \"{}\", written by hexatwist (hexatwist mjcf).\n"
       "     Frames: the world is the base frame B; body \"platform\" is the platform frame P, at home B raised by\n"
@@ -119,7 +240,7 @@ std::string mjcf_model(const Rig& rig) {
       "     welded to the platform); rotor, screw and the leg body carrying them 1/3 of its mass each, all at its\n"
       "     centre of mass; the rotor's and screw's transverse inertia (J/2, a disc's) is taken out of that body.\n"
       "     docs/theory.md section 14 describes the model. -->\n",
-      comment_text(model.spec().name));
+      comment_text(rig.model().spec().name));
   t += fmt::format(
       "<mujoco model=\"hexatwist\">\n"
       "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>\n"
@@ -133,110 +254,14 @@ std::string mjcf_model(const Rig& rig) {
       "  </default>\n"
       "  <worldbody>\n"
       "    <light pos=\"0 0 6\" dir=\"0 0 -1\" directional=\"true\"/>\n",
-      num(kTimestep), num(-load.gravity), num(kTimeConstant));
-  for (int i = 0; i < kLegs; ++i) {
-    const Leg& leg = model.leg(i);
-    const int n = i + 1;
-    const Vector3d& s = leg.s_home_B;
-    const double L = leg.length_home;
-    const Vector3d ja = leg.axis_base_B.normalized();
-    const Vector3d jd = leg.axis_platform_P.normalized();  // P is aligned with B at home
-    const Vector3d jb = s.cross(ja).normalized();
-    const Vector3d je = s.cross(jd).normalized();
-    const bool base_driven = leg.driven == DrivenSide::Base;
-    // Leg-body inertia in the body frame (aligned with B at home), rotated onto s.
-    Eigen::Matrix3d frame;  // columns: two unit vectors across s, then s
-    frame.col(2) = s;
-    frame.col(0) = jb;
-    frame.col(1) = s.cross(jb);
-    const Matrix3d I_h = frame * (base_driven ? I_housing_base : I_housing_plain) * frame.transpose();
-    const Matrix3d I_r = frame * (base_driven ? I_rod_plain : I_rod_platform) * frame.transpose();
-    const Vector3d c_h = mech.housing.center * s;    // from the base joint [m, B]
-    const Vector3d c_r = (L - mech.rod.center) * s;  // from the base joint, at home [m, B]
-    const auto indent = [](int level) { return std::string(static_cast<std::size_t>(2 * level), ' '); };
-    const double motor_body_share = base_driven ? housing_share : rod_share;
-    const auto rotor_body = [&](int level, const Vector3d& com) {
-      return fmt::format(
-          "{0}<body name=\"rotor{1}\">\n"
-          "{0}  <joint name=\"leg{1}_rotor\" type=\"hinge\" axis=\"{2}\" damping=\"{4}\" frictionloss=\"{5}\"/>\n"
-          "{0}  {3}\n"
-          "{0}</body>\n",
-          indent(level), n, vec(s), inertial(com, motor_body_share, axisymmetric(s, Jm, disc(Jm))),
-          num(rig.servo().viscous_friction), num(rig.servo().coulomb_friction));
-    };
-    const auto end_body = [&](int level) {
-      return fmt::format(
-          "{0}<body name=\"end{1}\">\n"
-          "{0}  <joint name=\"leg{1}_je\" type=\"hinge\" axis=\"{2}\"/>\n"
-          "{0}  <joint name=\"leg{1}_jd\" type=\"hinge\" axis=\"{3}\"/>\n"
-          "{0}  {4}\n"
-          "{0}</body>\n",
-          indent(level), n, vec(je), vec(jd),
-          inertial(load.center_of_mass_P - leg.platform_P, load_share, load_inertia_share));
-    };
-    const std::string rod_geom = fmt::format(
-        "<geom type=\"capsule\" fromto=\"0 0 0 {}\" size=\"0.02\" rgba=\"0.7 0.7 0.75 1\"/>", vec(-0.5 * L * s));
-    const std::string housing_geom = fmt::format(
-        "<geom type=\"capsule\" fromto=\"0 0 0 {}\" size=\"0.04\" rgba=\"0.3 0.3 0.35 1\"/>", vec(0.6 * L * s));
-    t += fmt::format("    <!-- leg {}: {}-driven, {}-hand thread, lead {} m, home length {} m -->\n", n,
-                     base_driven ? "base" : "platform", leg.thread == ThreadSense::Right ? "right" : "left",
-                     num(leg.lead), num(L));
-    t += fmt::format(
-        "    <body name=\"housing{0}\" pos=\"{1}\">\n"
-        "      <joint name=\"leg{0}_ja\" type=\"hinge\" axis=\"{2}\"/>\n"
-        "      <joint name=\"leg{0}_jb\" type=\"hinge\" axis=\"{3}\"/>\n"
-        "      {4}\n"
-        "      {5}\n",
-        n, vec(leg.base_B), vec(ja), vec(jb), inertial(c_h, base_driven ? housing_share : housing_whole, I_h),
-        housing_geom);
-    if (base_driven) {
-      // Motor and screw in the housing, nut in the rod.
-      t += rotor_body(3, c_h);
-      t += fmt::format(
-          "      <body name=\"screw{0}\">\n"
-          "        <joint name=\"leg{0}_screw\" type=\"hinge\" axis=\"{1}\"/>\n"
-          "        {2}\n"
-          "        <body name=\"rod{0}\" pos=\"{3}\">\n"
-          "          <joint name=\"leg{0}_nut\" type=\"hinge\" axis=\"{1}\"/>\n"
-          "          <joint name=\"leg{0}_slide\" type=\"slide\" axis=\"{1}\"/>\n"
-          "          {4}\n"
-          "          {5}\n",
-          n, vec(s), inertial(c_h, housing_share, axisymmetric(s, Js, disc(Js))), vec(L * s),
-          inertial(-mech.rod.center * s, rod_whole, I_r), rod_geom);
-      t += end_body(5);
-      t += "        </body>\n      </body>\n";
-    } else {
-      // Motor and screw in the rod, nut in the housing: the screw turns in the nut and slides
-      // with the rod.
-      t += fmt::format(
-          "      <body name=\"screw{0}\">\n"
-          "        <joint name=\"leg{0}_nut\" type=\"hinge\" axis=\"{1}\"/>\n"
-          "        <joint name=\"leg{0}_slide\" type=\"slide\" axis=\"{1}\"/>\n"
-          "        {2}\n"
-          "        <body name=\"rod{0}\" pos=\"{3}\">\n"
-          "          <joint name=\"leg{0}_screw\" type=\"hinge\" axis=\"{1}\"/>\n"
-          "          {4}\n"
-          "          {5}\n",
-          n, vec(s), inertial(c_r, rod_share, axisymmetric(s, Js, disc(Js))), vec(L * s),
-          inertial(-mech.rod.center * s, rod_share, I_r), rod_geom);
-      t += rotor_body(5, -mech.rod.center * s);
-      t += end_body(5);
-      t += "        </body>\n      </body>\n";
-    }
-    t += "    </body>\n";
-  }
-  // The platform with its payload: P's origin, aligned with B at home.
-  const Vector3d com_P = load.center_of_mass_P;
-  t += fmt::format(
-      "    <body name=\"platform\" pos=\"{}\">\n"
-      "      <freejoint name=\"platform\"/>\n"
-      "      {}\n"
-      "      <geom type=\"cylinder\" pos=\"{}\" size=\"{} 0.03\" rgba=\"0.2 0.45 0.7 0.6\"/>\n"
-      "    </body>\n"
-      "  </worldbody>\n",
-      vec(platform_home_B), inertial(com_P, load_share, load_inertia_share), vec(model.spec().pivot_P),
-      num(model.condition_length()));
-  t += "  <equality>\n";
+      num(kTimestep), num(-rig.load().gravity), num(kTimeConstant));
+  return t;
+}
+
+// The constraints (rod ends welded to the platform, screw-nut pairs, gears) and the motors.
+std::string equalities_and_actuators(const Rig& rig) {
+  const Model& model = rig.model();
+  std::string t = "  <equality>\n";
   for (int i = 0; i < kLegs; ++i) {
     const Leg& leg = model.leg(i);
     const int n = i + 1;
@@ -250,7 +275,7 @@ std::string mjcf_model(const Rig& rig) {
         "    <weld name=\"leg{0}_weld\" body1=\"platform\" body2=\"end{0}\"/>\n"
         "    <joint name=\"leg{0}_helix\" joint1=\"leg{0}_nut\" joint2=\"leg{0}_slide\" polycoef=\"0 {1} 0 0 0\"/>\n"
         "    <joint name=\"leg{0}_gear\" joint1=\"leg{0}_screw\" joint2=\"leg{0}_rotor\" polycoef=\"0 {2} 0 0 0\"/>\n",
-        n, num(1.0 / leg.twist_gain), num(gear_sign / N));
+        n, num(1.0 / leg.twist_gain), num(gear_sign / rig.servo().gear_ratio));
   }
   t += "  </equality>\n  <actuator>\n";
   for (int i = 0; i < kLegs; ++i) {
@@ -259,10 +284,40 @@ std::string mjcf_model(const Rig& rig) {
     t += fmt::format(
         "    <motor name=\"motor{0}\" joint=\"leg{0}_rotor\" gear=\"{1}\" ctrllimited=\"true\" "
         "ctrlrange=\"{2} {3}\" forcelimited=\"true\" forcerange=\"{2} {3}\"/>\n",
-        i + 1, num(gear), num(-servo.torque_limit), num(servo.torque_limit));
+        i + 1, num(gear), num(-rig.servo().torque_limit), num(rig.servo().torque_limit));
   }
-  t += "  </actuator>\n</mujoco>\n";
-  return t;
+  return t + "  </actuator>\n</mujoco>\n";
+}
+
+}  // namespace
+
+std::string mjcf_model(const Rig& rig) {
+  const Model& model = rig.model();
+  for (int i = 0; i < kLegs; ++i) {
+    const Leg& leg = model.leg(i);
+    if (!(leg.lead > 0.0))
+      throw Error(
+          fmt::format("leg {}: the MuJoCo model needs a lead screw on every leg (lead 0 has no screw to "
+                      "couple the motor to the leg)",
+                      i + 1));
+    if (!(leg.axis_base_B.squaredNorm() > 0.0) || !(leg.axis_platform_P.squaredNorm() > 0.0))
+      throw Error(fmt::format("leg {}: the MuJoCo model needs both U-joint axes", i + 1));
+  }
+  const LegBodies bodies(rig);
+  std::string t = preamble(rig);
+  for (int i = 0; i < kLegs; ++i) t += bodies.leg(i);
+  // The platform with its payload: P's origin, aligned with B at home.
+  t += fmt::format(
+      "    <body name=\"platform\" pos=\"{}\">\n"
+      "      <freejoint name=\"platform\"/>\n"
+      "      {}\n"
+      "      <geom type=\"cylinder\" pos=\"{}\" size=\"{} 0.03\" rgba=\"0.2 0.45 0.7 0.6\"/>\n"
+      "    </body>\n"
+      "  </worldbody>\n",
+      vec(Vector3d(0.0, 0.0, model.spec().home_height)),
+      inertial(rig.load().center_of_mass_P, bodies.load_share, bodies.load_inertia_share), vec(model.spec().pivot_P),
+      num(model.condition_length()));
+  return t + equalities_and_actuators(rig);
 }
 
 }  // namespace hexatwist

@@ -115,6 +115,20 @@ Status fk_residual(const Model& model, const Placement& x, const Vector6d& lengt
   return J != nullptr ? length_jacobian(model, legs, kind, *J) : Status::Ok;
 }
 
+std::string_view check_fk_options(const FkOptions& o) noexcept {
+  if (!(o.max_iterations >= 1 && o.max_iterations <= kMaxFkIterations))
+    return "max_iterations: expected 1 to 1000 Newton iterations";
+  if (!(o.tolerance > 0.0 && o.tolerance <= kMaxFkTolerance))
+    return "tolerance: expected a largest length residual > 0 and at most 1e-6 m";
+  if (!(o.singular_ratio > 0.0 && o.singular_ratio <= 1e-3))
+    return "singular_ratio: expected a pivot ratio in (0, 1e-3]";
+  if (!(o.max_step_translation > 0.0 && o.max_step_translation <= 10.0))
+    return "max_step_translation: expected a step cap > 0 and at most 10 m";
+  if (!(o.max_step_rotation > 0.0 && o.max_step_rotation <= kPi))
+    return "max_step_rotation: expected a step cap > 0 and at most pi rad";
+  return {};
+}
+
 Status forward_kinematics(const Model& model, const Vector6d& motor_or_geometric, LengthKind kind,
                           const Placement& guess, FkResult& out, const FkOptions& options) noexcept {
   // Motor-side lengths as the nut's travel (the drives' reference and scale, theory §4): the
@@ -127,6 +141,8 @@ Status forward_kinematics(const Model& model, const Vector6d& motor_or_geometric
   out.det_sign = 0.0;
   if (!detail::all_finite(lengths) || !detail::all_finite(guess.t) || !detail::all_finite(guess.R_BP))
     return Status::NonFiniteInput;
+  // A leg is never shorter than nothing, and the options have documented ranges (check_fk_options).
+  if (!(motor_or_geometric.array() > 0.0).all() || !check_fk_options(options).empty()) return Status::InvalidArgument;
 
   // The state at the iterate and at the trial point live in two buffers that trade places when
   // a step is accepted (copying a LegState is ~90 moves); *legs ends up in out.legs on return.

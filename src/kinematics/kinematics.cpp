@@ -20,6 +20,8 @@ Status inverse_kinematics(const Model& model, const Placement& x, LegState& out)
     detail::store6(out.length.data(), legs.length, k);
     detail::store6(out.s_B, (1.0 / legs.length) * legs.leg, k);
   }
+  // Finite numbers whose lengths overflow (a pose 1e300 m away) are as unusable as NaN.
+  if (!out.length.allFinite()) return Status::NonFiniteInput;
   if (out.length.minCoeff() > 0.0) return Status::Ok;
   for (int i = 0; i < kLegs; ++i)
     if (!(out.length[i] > 0.0)) out.s_B.row(i).setZero();

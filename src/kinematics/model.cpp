@@ -37,7 +37,26 @@ Vector3d unit_axis(const Vector3d& axis, const std::string& what) {
   require_finite(axis, what);
   const double n = axis.norm();
   if (n < kMinAxisNorm) fail(fmt::format("{}: axis is zero; expected a direction", what));
+  if (!std::isfinite(n)) fail(fmt::format("{}: expected a direction of finite length, got one beyond 1e308", what));
   return axis / n;
+}
+
+// The plausible size of a platform (configs/seed.yaml and README's "Platform configuration" list the
+// ranges): every length and coordinate within kMaxLength. Finite nonsense (1e300 m) would overflow
+// the kinematics into inf and NaN downstream; it is refused here, at its field.
+constexpr double kMaxLength = 100.0;  // [m]
+
+void require_point(const Vector3d& v, const std::string& what) {
+  require_finite(v, what);
+  if (v.cwiseAbs().maxCoeff() > kMaxLength)
+    fail(fmt::format("{}: expected coordinates within +-{:g} m, got [{}, {}, {}]", what, kMaxLength, v.x(), v.y(),
+                     v.z()));
+}
+
+void require_length(double v, const std::string& what) {
+  require_finite(v, what);
+  if (!(v > 0.0 && v <= kMaxLength))
+    fail(fmt::format("{}: expected > 0 and at most {:g} m, got {}", what, kMaxLength, v));
 }
 
 }  // namespace
@@ -55,11 +74,9 @@ Model::Model(const ModelSpec& spec) : spec_(spec) {
 void Model::check_limits_spec() {
   const ModelSpec& spec = spec_;
   const LimitSpec& lim = spec.limits;
-  require_finite(spec.home_height, "home_height");
-  if (spec.home_height <= 0.0) fail(fmt::format("home_height: expected > 0 m, got {}", spec.home_height));
-  require_finite(lim.length_min, "limits.length_min");
-  require_finite(lim.length_max, "limits.length_max");
-  if (lim.length_min <= 0.0) fail(fmt::format("limits.length_min: expected > 0 m, got {}", lim.length_min));
+  require_length(spec.home_height, "home_height");
+  require_length(lim.length_min, "limits.length_min");
+  require_length(lim.length_max, "limits.length_max");
   if (lim.length_min >= lim.length_max)
     fail(fmt::format("limits.length_min: expected less than limits.length_max ({} m), got {} m", lim.length_max,
                      lim.length_min));
@@ -71,11 +88,12 @@ void Model::check_limits_spec() {
     fail(fmt::format("limits.singularity_margin: expected an angle in (0, 90) deg, got {:.10g} deg",
                      rad2deg(lim.singularity_margin)));
   require_finite(lim.jacobian_condition_max, "limits.jacobian_condition_max");
+  // A huge limit is no limit (a meaningful choice); at most 1 no pose passes.
   if (!(lim.jacobian_condition_max > 1.0))
     fail(fmt::format("limits.jacobian_condition_max: expected a condition number > 1, got {}",
                      lim.jacobian_condition_max));
-  require_finite(spec.observation_P, "observation_point");
-  require_finite(spec.pivot_P, "pivot");
+  require_point(spec.observation_P, "observation_point");
+  require_point(spec.pivot_P, "pivot");
 
   // The bounds as every limit check compares them, with the tolerance of limits.hpp.
   cos_bend_max_ = std::cos(lim.bend_max) - kLimitTolerance;
@@ -92,8 +110,8 @@ void Model::build_leg(int i) {
   Leg& leg = legs_[static_cast<std::size_t>(i)];
   const std::string who = fmt::format("leg {}", i + 1);
   const double stroke = lim.length_max - lim.length_min;
-  require_finite(ls.base_B, who + ": base");
-  require_finite(ls.platform_P, who + ": platform");
+  require_point(ls.base_B, who + ": base");
+  require_point(ls.platform_P, who + ": platform");
   require_finite(ls.lead, who + ": lead");
   if (ls.lead < 0.0) fail(fmt::format("{}: lead: expected >= 0 m, got {}", who, ls.lead));
   // A screw turns at least once over its stroke: a longer lead (1e30 m) is a typing error.
@@ -138,7 +156,8 @@ void Model::build_leg(int i) {
   if (!std::isnan(ls.drive_lead)) {
     require_finite(ls.drive_lead, who + ": drive_lead");
     if (!(ls.lead > 0.0))
-      fail(fmt::format("{}: drive_lead: a drive scale needs the real lead; lead is {} m", who, ls.lead));
+      fail(fmt::format("{}: drive_lead: a drive scale needs the real lead (screw.lead or the leg's lead); lead is {} m",
+                       who, ls.lead));
     if (!(ls.drive_lead > 0.0)) fail(fmt::format("{}: drive_lead: expected > 0 m, got {} m", who, ls.drive_lead));
     leg.drive_scale = ls.lead / ls.drive_lead;
     if (!(std::abs(leg.drive_scale - 1.0) <= kMaxDriveScaleError))
@@ -157,6 +176,14 @@ void Model::build_leg(int i) {
   }
   has_drive_scale_ = has_drive_scale_ || leg.drive_scale != 1.0;
 
+  build_leg_axes(i);
+}
+
+void Model::build_leg_axes(int i) {
+  const LimitSpec& lim = spec_.limits;
+  const LegSpec& ls = spec_.legs[static_cast<std::size_t>(i)];
+  Leg& leg = legs_[static_cast<std::size_t>(i)];
+  const std::string who = fmt::format("leg {}", i + 1);
   // Axes are needed for the twist (lead > 0). With lead 0 they may be omitted (all zero).
   const bool axes_given = !ls.axis_base_B.isZero(0.0) || !ls.axis_platform_P.isZero(0.0);
   if (ls.lead > 0.0 || axes_given) {
@@ -242,10 +269,15 @@ void Model::check_home_and_reference() {
   double condition = INFINITY;
   if (inverse_kinematics(*this, Placement{}, home) == Status::Ok &&
       jacobian_condition(*this, home, condition) == Status::PlatformSingularity)
-    fail(
-        fmt::format("limits.jacobian_condition_max: the Jacobian's condition number at home is {:.4g}, above the "
-                    "limit {:.4g}",
-                    condition, spec_.limits.jacobian_condition_max));
+    // At fault: the limit if it is tighter than the default and home is within the default (a
+    // platform as well conditioned as the seed's), else the legs, which hold the platform weakly there.
+    fail(condition <= kDefaultJacobianConditionMax
+             ? fmt::format("limits.jacobian_condition_max: the Jacobian's condition number at home is {:.4g}, above "
+                           "the limit {:.4g}",
+                           condition, spec_.limits.jacobian_condition_max)
+             : fmt::format("legs: the Jacobian's condition number at home is {:.4g}, above the limit {:.4g} "
+                           "(limits.jacobian_condition_max): the legs hold the platform weakly at home",
+                           condition, spec_.limits.jacobian_condition_max));
   // The cheap condition proof's reference: the scaled Jacobian's inverse at home (left at zero,
   // with an infinite norm, where home has no regular Jacobian: every proof then fails).
   Matrix6d J_home = Matrix6d::Zero();

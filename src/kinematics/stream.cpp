@@ -92,9 +92,20 @@ std::string_view check_stream_settings(const StreamSettings& s) noexcept {
   if (!(std::isfinite(s.period) && s.period > 0.0)) return "period must be a positive, finite time [s]";
   if (!(s.max_velocity > 0.0)) return "max_velocity must be positive [m/s] (infinite for no limit)";
   if (!(s.max_acceleration > 0.0)) return "max_acceleration must be positive [m/s^2] (infinite for no limit)";
-  if (s.fk.max_iterations < 1) return "fk.max_iterations must be at least 1";
-  if (!(std::isfinite(s.fk.tolerance) && s.fk.tolerance > 0.0)) return "fk.tolerance must be positive and finite [m]";
-  if (!(s.fk.singular_ratio >= 0.0 && s.fk.singular_ratio < 1.0)) return "fk.singular_ratio must lie in [0, 1)";
+  return check_fk_options(s.fk);
+}
+
+std::string_view check_stream_settings(const Model& model, const StreamSettings& s) noexcept {
+  if (const std::string_view why = check_stream_settings(s); !why.empty()) return why;
+  // A limit that lets one input's step cross the whole stroke can never bind: a rate so slow (or a
+  // limit so large) says something else than the user meant.
+  const double stroke = model.spec().limits.length_max - model.spec().limits.length_min;
+  if (std::isfinite(s.max_velocity) && !(s.max_velocity * s.period < stroke))
+    return "max_velocity: one input period at this speed is longer than the whole stroke, so the limit would never "
+           "apply; give a faster input rate or a smaller limit";
+  if (std::isfinite(s.max_acceleration) && !(s.max_acceleration * s.period * s.period < stroke))
+    return "max_acceleration: one input period at this acceleration covers more than the whole stroke, so the limit "
+           "would never apply; give a faster input rate or a smaller limit";
   return {};
 }
 

@@ -15,7 +15,7 @@ namespace hexatwist {
 namespace {
 
 // Largest number of poses a sweep or a resampling may produce (48 bytes each).
-constexpr double kMaxSamples = 1e8;
+constexpr double kMaxSamples = static_cast<double>(kMaxTrajectorySamples);
 
 void check_limit(double value, const char* name) {
   if (!std::isfinite(value)) throw Error(fmt::format("motion limits: {} must be finite, got {}", name, value));
@@ -169,8 +169,10 @@ Trajectory through_waypoints(std::span<const Vector6d> waypoints, const MotionLi
   // Rounded up, but a total that is a whole number of dt up to rounding is not pushed one further.
   const double steps = std::ceil(total / dt - 1e-9);
   if (!(steps + 1.0 <= kMaxSamples))
-    throw Error(fmt::format("the motion takes {:g} s: at a period of {:g} s that is more than {:.0f} samples", total,
-                            dt, kMaxSamples));
+    throw Error(
+        fmt::format("the motion takes {:g} s: at a period of {:g} s that is more than {:.0f} samples (the "
+                    "bound of one trajectory)",
+                    total, dt, kMaxSamples));
   const auto n = static_cast<std::size_t>(std::max(steps, 1.0));
 
   Trajectory traj;
@@ -422,6 +424,16 @@ class Pchip {
 
 }  // namespace
 
+std::string_view check_trajectory_samples(double t0, double dt, std::size_t samples) noexcept {
+  // Beyond 1e9 s (31 years) a start time leaves no sub-microsecond resolution to the samples' times.
+  if (!(std::abs(t0) <= 1e9)) return "t0: expected a start time within +-1e9 s";
+  if (!(dt > 0.0 && std::isfinite(dt))) return "dt: expected a finite sample period > 0 [s]";
+  if (samples < 2) return "poses: expected at least 2 poses";
+  if (samples > kMaxTrajectorySamples)
+    return "poses: more than 1,000,000 samples in one trajectory (kMaxTrajectorySamples)";
+  return {};
+}
+
 Trajectory resample(const TimedPoses& samples, double dt) {
   if (!std::isfinite(dt) || dt <= 0.0) throw Error(fmt::format("dt: expected a finite period > 0 s, got {}", dt));
   const Pchip curve(samples);
@@ -431,7 +443,10 @@ Trajectory resample(const TimedPoses& samples, double dt) {
   // (which holds the last pose) instead of being dropped.
   const double steps = std::ceil(span / dt - 1e-9);
   if (!(steps + 1.0 <= kMaxSamples))
-    throw Error(fmt::format("its {:g} s at a period of {:g} s are more than {:.0f} samples", span, dt, kMaxSamples));
+    throw Error(
+        fmt::format("its {:g} s at a period of {:g} s are more than {:.0f} samples (the bound of one "
+                    "trajectory)",
+                    span, dt, kMaxSamples));
   const auto n = static_cast<std::size_t>(steps);
 
   Trajectory traj;

@@ -48,19 +48,17 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   const bool compensated = twist_in_plant && strategy == Strategy::Compensated;
   std::vector<Vector6d> command(n);
   CommandReport report;
-  InverseDynamics still;
+  Vector6d still;
   const double torque_limit = rig.servo().torque_limit;
   for (std::size_t k = 0; k < n; ++k) {
     if (const Status s = compute_commands(model, trajectory.poses[k], report); s != Status::Ok)
       return fail(issue, s, k, trajectory, report.limit);
     command[k] = compensated ? report.compensated : report.conventional;
-    // Every motor must at least be able to hold the mechanism standing still at every pose
-    // (gravity's share of the inverse dynamics: platform, payload and legs).
-    PlatformMotion rest;
-    rest.placement = placement_from_pose(trajectory.poses[k]);
-    if (const Status s = inverse_dynamics(rig, rest, still); s != Status::Ok) return fail(issue, s, k, trajectory);
+    // Every motor must at least be able to hold the mechanism standing still at every pose.
+    if (const Status s = holding_torque(rig, trajectory.poses[k], still); s != Status::Ok)
+      return fail(issue, s, k, trajectory);
     for (int i = 0; i < kLegs; ++i) {
-      const double hold = std::abs(still.gravity[i]);
+      const double hold = std::abs(still[i]);
       if (hold > accepted_max(torque_limit)) {  // on the limit is inside it (limits.hpp)
         LimitReport limit;
         limit.status = Status::TorqueAboveMax;
@@ -122,6 +120,15 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
 
 }  // namespace
 
+Status holding_torque(const Rig& rig, const Pose& pose, Vector6d& torque) noexcept {
+  PlatformMotion rest;
+  rest.placement = placement_from_pose(pose);
+  InverseDynamics still;
+  const Status s = inverse_dynamics(rig, rest, still);
+  torque = still.gravity;
+  return s;
+}
+
 Status check_trajectory(const Rig& rig, const Trajectory& trajectory, SimulationIssue& issue) {
   issue = SimulationIssue{};
   if (trajectory.poses.empty()) return Status::Ok;
@@ -140,6 +147,7 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
   if (n == 0) return Status::Ok;
   if (std::abs(trajectory.dt - rig.control_period()) > 1e-9 * rig.control_period() && n > 1)
     return fail(issue, Status::NonFiniteInput, 0, trajectory);
+  if (n > kMaxTrajectorySamples) return fail(issue, Status::InvalidArgument, 0, trajectory);
   // make_plan checks every sample of the commands this run sends (limits, stroke, motor speed,
   // holding torque) before the loop starts; check_trajectory adds the other strategy's commands.
   Plan plan;

@@ -1,7 +1,13 @@
 #include "hexatwist/simulation/study.hpp"
 
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <tuple>
+
+#include "hexatwist/error.hpp"
 
 namespace hexatwist {
 
@@ -12,6 +18,52 @@ std::vector<StudyTest> seed_tests(const StudySpec& spec) {
       {"Rz", "rotation about z", 5, spec.angular_amplitude},
       {"Ry", "rotation about y", 4, spec.angular_amplitude},
   };
+}
+
+namespace {
+
+void study_range(double v, double lo, double hi, const char* field, const char* unit, bool lo_closed = false) {
+  if (std::isfinite(v) && (lo_closed ? v >= lo : v > lo) && v <= hi) return;
+  throw Error(
+      fmt::format("{}: expected {} {:g} and at most {:g} {}, got {}", field, lo_closed ? ">=" : ">", lo, hi, unit, v));
+}
+
+}  // namespace
+
+void check_study(const StudySpec& spec, double dt) {
+  study_range(spec.linear_amplitude, 0.0, 100.0, "study.linear_amplitude", "m");
+  study_range(rad2deg(spec.angular_amplitude), 0.0, 180.0, "study.angular_amplitude_deg", "deg");
+  study_range(spec.dwell, 0.0, 3600.0, "study.dwell", "s", true);
+  for (const bool linear : {true, false}) {
+    const MotionLimits& m = linear ? spec.linear : spec.angular;
+    const double scale = linear ? 1.0 : rad2deg(1.0);
+    const char* unit = linear ? "m" : "deg";
+    const std::string block = linear ? "study.linear" : "study.angular_deg";
+    for (const auto& [value, key, per] :
+         {std::tuple{m.velocity, "velocity", "/s"}, std::tuple{m.acceleration, "acceleration", "/s^2"},
+          std::tuple{m.jerk, "jerk", "/s^3"}})
+      study_range(scale * value, 0.0, 1e6, (block + "." + key).c_str(), fmt::format("{}{}", unit, per).c_str());
+    // The sweep home -> +a -> -a -> home with four rests, in samples at the control period.
+    const double amplitude = linear ? spec.linear_amplitude : spec.angular_amplitude;
+    const double duration = 4.0 * spec.dwell + 2.0 * JerkLimitedMove(amplitude, m).duration() +
+                            JerkLimitedMove(2.0 * amplitude, m).duration();
+    if (!(duration / dt + 1.0 <= static_cast<double>(kMaxTrajectorySamples)))
+      throw Error(
+          fmt::format("{}: a test takes {:.6g} s with these limits: more than {} samples at the control period "
+                      "{:g} s; give a larger velocity, acceleration or jerk",
+                      block, duration, kMaxTrajectorySamples, dt));
+  }
+}
+
+StudyTest study_test(const StudySpec& spec, std::string_view name) {
+  for (StudyTest& t : seed_tests(spec))
+    if (t.name == name) return t;
+  std::string shown;
+  for (const char c : name.substr(0, 40)) {
+    const auto u = static_cast<unsigned char>(c);
+    shown += u < 0x20 || u == 0x7f ? fmt::format("\\x{:02x}", u) : std::string(1, c);
+  }
+  throw Error(fmt::format("unknown test '{}'; expected Lz, Lx, Rz or Ry", shown));
 }
 
 Trajectory test_trajectory(const StudySpec& spec, const StudyTest& test, double dt) {
@@ -28,6 +80,19 @@ ErrorStats error_stats(const std::vector<double>& series) noexcept {
   }
   if (!series.empty()) s.rms = std::sqrt(sum2 / static_cast<double>(series.size()));
   return s;
+}
+
+RunMetrics run_metrics(const Rig& rig, const std::vector<SimulationSample>& samples) noexcept {
+  RunMetrics m;
+  for (const SimulationSample& s : samples) {
+    const double torque = s.torque.cwiseAbs().maxCoeff();
+    m.max_torque = std::max(m.max_torque, torque);
+    m.saturated_ticks += torque >= rig.servo().torque_limit ? 1 : 0;
+    m.max_following_error = std::max(m.max_following_error, (s.command - s.motor).cwiseAbs().maxCoeff());
+    const Matrix3d dR = rotation_from_rpy(s.actual.tail<3>()) * rotation_from_rpy(s.desired.tail<3>()).transpose();
+    m.max_orientation_error = std::max(m.max_orientation_error, Eigen::AngleAxisd(dR).angle());
+  }
+  return m;
 }
 
 namespace {

@@ -212,7 +212,7 @@ static void test_tracking(const hexatwist_model* m) {
         "set");
   hexatwist_fk_options options = hexatwist_fk_default_options();
   CHECK(options.max_iterations > 0 && options.tolerance > 0 && options.max_step_translation > 0, "options");
-  options.max_iterations = 0; /* no iteration allowed: the far solve must fail, and say so */
+  options.max_iterations = 1; /* one iteration: the far solve cannot converge, and says so */
   double command[6];
   const double far[6] = {0.2, -0.2, 0.1, 0.1, 0.1, 0.3};
   CHECK(hexatwist_motor_commands(m, far, HEXATWIST_COMPENSATED, command, NULL) == HEXATWIST_OK, "far pose");
@@ -221,6 +221,65 @@ static void test_tracking(const hexatwist_model* m) {
                 HEXATWIST_NO_CONVERGENCE &&
             memcmp(&before, &tracker, sizeof tracker) == 0,
         "a failed tracked solve leaves the tracker as it was");
+}
+
+/* Every call given what a new user tries (#22): NaN, +-inf, 0, -1, 1e300 in each option and
+ * argument. Each answers as the library, the CLI and Python do: HEXATWIST_INVALID_ARGUMENT for an
+ * option outside its documented range or a length <= 0, HEXATWIST_NON_FINITE_INPUT for NaN or inf
+ * in a pose, length or guess; never HEXATWIST_OK with a meaningless result, and a tracker is kept. */
+static void test_invalid_arguments(const hexatwist_model* m) {
+  const double bad[] = {NAN, INFINITY, -INFINITY, 0.0, -1.0, 1e300};
+  double home[6], command[6];
+  hexatwist_model_home_commands(m, home);
+  hexatwist_fk_result fk;
+  hexatwist_fk_tracker tracker;
+  memset(&tracker, 0, sizeof tracker);
+  const double at[6] = {0, 0, 0.05, 0, 0, 10 * kDeg};
+  CHECK(hexatwist_fk_tracker_set(m, &tracker, at, HEXATWIST_MOTOR) == HEXATWIST_OK, "set");
+  const hexatwist_fk_tracker kept = tracker;
+  for (int field = 0; field < 4; ++field)
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+      hexatwist_fk_options o = hexatwist_fk_default_options();
+      const double v = bad[k];
+      if (field == 0) o.max_iterations = v == 1e300 ? 1000000 : (int)(isfinite(v) ? v : -1);
+      if (field == 1) o.tolerance = v;
+      if (field == 2) o.max_step_translation = v;
+      if (field == 3) o.max_step_rotation = v;
+      const hexatwist_status s = hexatwist_forward_kinematics(m, home, HEXATWIST_MOTOR, NULL, &o, &fk);
+      CHECK(s == HEXATWIST_INVALID_ARGUMENT, "option %d = %g: %s", field, v, hexatwist_status_name(s));
+      const hexatwist_status t = hexatwist_forward_kinematics_tracked(m, home, HEXATWIST_MOTOR, &tracker, &o, &fk);
+      CHECK(t == HEXATWIST_INVALID_ARGUMENT && memcmp(&kept, &tracker, sizeof tracker) == 0,
+            "tracked, option %d = %g: %s, tracker kept", field, v, hexatwist_status_name(t));
+    }
+  /* The case: a loose tolerance no longer passes a 0.3 m residual at home. */
+  hexatwist_fk_options loose = hexatwist_fk_default_options();
+  loose.tolerance = 0.5;
+  double off[6];
+  for (int i = 0; i < 6; ++i) off[i] = home[i] + 0.3;
+  CHECK(hexatwist_forward_kinematics(m, off, HEXATWIST_MOTOR, NULL, &loose, &fk) == HEXATWIST_INVALID_ARGUMENT,
+        "tolerance 0.5 m refused");
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k)
+    for (int i = 0; i < 6; ++i) {
+      double lengths[6], pose[6] = {0, 0, 0, 0, 0, 0};
+      memcpy(lengths, home, sizeof lengths);
+      lengths[i] = bad[k];
+      const int finite = isfinite(bad[k]);
+      const hexatwist_status s = hexatwist_forward_kinematics(m, lengths, HEXATWIST_GEOMETRIC, NULL, NULL, &fk);
+      const hexatwist_status expected = !finite ? HEXATWIST_NON_FINITE_INPUT : HEXATWIST_INVALID_ARGUMENT;
+      CHECK(bad[k] > 0 && finite ? s != HEXATWIST_OK : s == expected, "length %d = %g: %s", i + 1, bad[k],
+            hexatwist_status_name(s));
+      pose[i] = bad[k];
+      const hexatwist_status c = hexatwist_motor_commands(m, pose, HEXATWIST_COMPENSATED, command, NULL);
+      CHECK(bad[k] == 0.0 || bad[k] == -1.0 || (c != HEXATWIST_OK && !(c == HEXATWIST_INVALID_ARGUMENT)),
+            "pose %d = %g: %s", i + 1, bad[k], hexatwist_status_name(c));
+    }
+  char error[256];
+  CHECK(hexatwist_model_from_file(HEXATWIST_SOURCE_DIR "/configs", error, sizeof error) == NULL &&
+            strstr(error, "is a directory") != NULL,
+        "a directory: '%s'", error);
+  CHECK(hexatwist_model_from_file("/dev/zero", error, sizeof error) == NULL && strstr(error, "longer than") != NULL,
+        "an endless file: '%s'", error);
+  CHECK(strcmp(hexatwist_status_name(HEXATWIST_INVALID_ARGUMENT), "invalid_argument") == 0, "name");
 }
 
 static void test_no_allocation(const hexatwist_model* m) {
@@ -267,6 +326,7 @@ int main(void) {
   test_commands_and_fk(m);
   test_limits(m);
   test_tracking(m);
+  test_invalid_arguments(m);
   test_no_allocation(m);
   hexatwist_model_free(m);
   printf("%d passed, %d failed\n", passed, failed);

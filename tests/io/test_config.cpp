@@ -1,6 +1,8 @@
 // Config: YAML text to Model. The seed file gives the default model, the `legs` form of the seed
 // gives the same kinematics, per-leg screw settings override the screw block, and every bad
 // input is one line naming "file:line" and the field path.
+#include <yaml-cpp/yaml.h>
+
 #include <fstream>
 #include <initializer_list>
 #include <sstream>
@@ -577,6 +579,117 @@ TEST(Config, RigSectionErrorsNameLineAndField) {
   }
   // The servo needs a screw on every leg.
   EXPECT_NE(config_error(test::replace_line(base, 9, "  lead: 0")).find("needs a lead screw"), std::string::npos);
+}
+
+
+// ---- every numeric field of the schema (#22) -------------------------------------------------
+
+// A number's place in a document: the keys (and list indices) from the top.
+using Path = std::vector<std::string>;
+
+std::string dotted(const Path& path) {
+  std::string s;
+  for (const std::string& k : path) s += k[0] == '[' ? k : (s.empty() ? k : "." + k);
+  return s;
+}
+
+// Every scalar of `node` that reads as a number, with its path.
+void numbers_of(const YAML::Node& node, Path& at, std::vector<Path>& out) {
+  if (node.IsMap()) {
+    for (const auto& kv : node) {
+      at.push_back(kv.first.Scalar());
+      numbers_of(kv.second, at, out);
+      at.pop_back();
+    }
+  } else if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      at.push_back("[" + std::to_string(i) + "]");
+      numbers_of(node[i], at, out);
+      at.pop_back();
+    }
+  } else if (double v = 0.0; node.IsScalar() && YAML::convert<double>::decode(node, v)) {
+    out.push_back(at);
+  }
+}
+
+// `text` with the scalar at `path` replaced by `value` (comments are dropped).
+std::string with_number(const std::string& text, const Path& path, const std::string& value) {
+  YAML::Node root = YAML::Load(text);
+  std::vector<YAML::Node> chain{root};
+  for (const std::string& k : path)
+    chain.push_back(k[0] == '[' ? chain.back()[std::stoul(k.substr(1))] : chain.back()[k]);
+  chain.back() = YAML::Load(value.empty() ? "''" : value);
+  YAML::Emitter e;
+  e << root;
+  return e.c_str();
+}
+
+// The configuration works: the drives' derived numbers are finite, home is commanded and held, and
+// each study test fits its bound.
+std::string not_meaningful(const Config& c) {
+  const Rig& rig = c.rig;
+  for (const Vector6d* v : {&rig.kp(), &rig.ki(), &rig.kd(), &rig.nominal_inertia(), &rig.motor_gain()})
+    if (!v->allFinite() || (v->array() < 0.0).any()) return "a derived gain or inertia is not finite and >= 0";
+  Vector6d hold;
+  if (holding_torque(rig, Pose{}, hold) != Status::Ok || !hold.allFinite()) return "no finite holding torque at home";
+  CommandReport report;
+  if (compute_commands(rig.model(), Pose{}, report) != Status::Ok || !report.compensated.allFinite())
+    return "home cannot be commanded";
+  for (const StudyTest& t : seed_tests(c.study))
+    if (test_trajectory(c.study, t, rig.control_period()).poses.size() > kMaxTrajectorySamples)
+      return "a study test is too long";
+  return {};
+}
+
+TEST(Config, EveryNumericFieldOfTheSchemaLoadsOrIsRefusedNamingItself) {
+  // The seed with every optional key (drive lead, home commands), in both layouts (per-leg screws).
+  const std::string symmetric = std::string(seed_config_yaml()) + "home_commands: [1.7, 2.3, 1.7, 2.3, 1.7, 2.3]\n";
+  std::string legs = test::read_file(std::string(HEXATWIST_SOURCE_DIR) + "/configs/seed-legs.yaml");
+  {
+    YAML::Node root = YAML::Load(legs);
+    root["screw"]["drive_lead"] = 0.0101;
+    root["legs"][0]["lead"] = 0.010;
+    root["legs"][0]["drive_lead"] = 0.0099;
+    YAML::Emitter e;
+    e << root;
+    legs = e.c_str();
+  }
+  ASSERT_NO_THROW(load_config(symmetric, "symmetric.yaml"));
+  ASSERT_NO_THROW(load_config(legs, "legs.yaml"));
+  int fields = 0, loaded = 0, refused = 0;
+  for (const std::string& text : {symmetric, legs}) {
+    std::vector<Path> paths;
+    Path at;
+    numbers_of(YAML::Load(text), at, paths);
+    for (const Path& path : paths) {
+      ++fields;
+      for (const char* value : {".nan", ".inf", "-.inf", "0", "-1", "1e300", ""}) {
+        const std::string field = dotted(path);
+        SCOPED_TRACE(field + " = '" + value + "'");
+        const std::string bad = with_number(text, path, value);
+        try {
+          const Config c = load_config(bad, "t.yaml");
+          const std::string why = not_meaningful(c);
+          EXPECT_EQ(why, "") << "loads, but " << why;
+          ++loaded;
+        } catch (const Error& e) {
+          const std::string msg = e.what();
+          ++refused;
+          EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+          // Named at the field itself, or (an entry of a list, a value of a derived layout) at the
+          // list or block that holds it.
+          std::string named;
+          for (Path p = path; !p.empty() && named.empty(); p.pop_back())
+            if (msg.find(dotted(p)) != std::string::npos) named = dotted(p);
+          EXPECT_FALSE(named.empty()) << msg;
+          // Never at an unrelated field: the top-level key of the message is the field's own.
+          EXPECT_NE(msg.find("field '" + path[0]), std::string::npos) << msg;
+        }
+      }
+    }
+  }
+  std::printf("  %d numeric fields, %d values loaded, %d refused\n", fields, loaded, refused);
+  EXPECT_GT(fields, 100);
 }
 
 }  // namespace

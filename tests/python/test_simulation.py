@@ -121,3 +121,36 @@ def test_point_log_errors_are_one_line():
     with pytest.raises(hexatwist.ConfigError) as e:
         hexatwist.read_point_log("t_s,x_mm,y_mm\n0,1,2\n")
     assert "\n" not in str(e.value)
+
+
+def test_study_metrics_are_the_clis_side_by_side(tmp_path):
+    """Python's study() and `hexatwist study` report the same run with the same library function
+    (run_metrics): the errors, the largest torque, the saturated ticks, the following and orientation
+    errors, number for number, on a motor weak enough to saturate."""
+    import json
+    import subprocess
+
+    from conftest import tool
+
+    config = tmp_path / "weak.yaml"
+    config.write_text(hexatwist.seed_config_yaml().replace("  torque_limit: 28 ", "  torque_limit: 6.5 ")
+                      .replace("  peak_torque_at_max_speed: 16 ", "  peak_torque_at_max_speed: 4 ")
+                      .replace("  continuous_torque: 9.5 ", "  continuous_torque: 5 ")
+                      .replace("  angular_amplitude_deg: 30 ", "  angular_amplitude_deg: 5 "))
+    out = tmp_path / "out"
+    run = subprocess.run([tool("HEXATWIST_CLI"), "study", "--config", str(config), "--tests", "Rz", "--no-figures",
+                          "--no-csv", "--out", str(out)], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    cli = json.loads((out / "summary.json").read_text())["tests"][0]
+    py = hexatwist.study(str(config), test="Rz").summary
+    assert py["status"] == "ok"
+    saturated = 0
+    for strategy in ("conventional", "compensated"):
+        c, p = cli[strategy], py[strategy]
+        for key in ("max_torque", "saturated_ticks", "max_following_error", "max_orientation_error"):
+            assert c[key] == p[key], (strategy, key, c[key], p[key])
+        for error in ("total", "twist_only", "tracking_only"):
+            assert c[f"max_error_{error}"] == p[error]["max"] and c[f"rms_error_{error}"] == p[error]["rms"]
+        saturated += p["saturated_ticks"]
+        assert 0 < p["max_torque"] <= 6.5 and p["max_following_error"] > 0 and p["max_orientation_error"] > 0
+    assert saturated > 0, "the weak motor saturates"

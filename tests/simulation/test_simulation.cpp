@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iomanip>
 
+#include "hexatwist/dynamics/dynamics.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
 #include "hexatwist/io/config.hpp"
 #include "hexatwist/simulation/simulation.hpp"
@@ -196,6 +197,31 @@ TEST(Simulation, AMotorSpeedOrHoldingTorqueOnItsLimitIsInsideAndPastItOutside) {
     const Status s =
         check_trajectory(Rig(seed_rig.model(), weak, LoadSpec{}, SimulationSpec{}), still(Pose{}, 0.01), issue);
     EXPECT_EQ(s, bound == hold * (1.0 - 1e-12) ? Status::TorqueAboveMax : Status::Ok) << std::setprecision(17) << bound;
+  }
+}
+
+TEST(Simulation, TheHoldingTorqueIsWhatTheTrajectoryCheckComparesWithTheLimit) {
+  // The whole mechanism at rest (the inverse dynamics' gravity share), not the load alone: a limit
+  // just above the largest holding torque passes a still trajectory, just below it does not.
+  const Rig& rig = seed().rig;
+  const Pose pose = Pose::from_vector((Vector6d() << 0.05, 0, 0.1, 0, 0.05, 0.2).finished());
+  Vector6d hold;
+  ASSERT_EQ(holding_torque(rig, pose, hold), Status::Ok);
+  LegDynamics load_only;
+  LegState legs;
+  ASSERT_EQ(inverse_kinematics(rig.model(), pose, legs), Status::Ok);
+  ASSERT_EQ(leg_dynamics(rig.model(), rig.load(), legs, LengthKind::Motor, load_only), Status::Ok);
+  const double worst = hold.cwiseAbs().maxCoeff();
+  EXPECT_GT(worst, rig.motor_gain().cwiseProduct(load_only.gravity).cwiseAbs().maxCoeff());  // the legs weigh too
+  SimulationIssue issue;
+  for (const double factor : {1.0 + 1e-9, 1.0 - 1e-9}) {
+    ServoSpec servo = rig.servo();
+    servo.torque_limit = worst * factor;
+    servo.peak_torque_at_max_speed = servo.continuous_torque = 0.5 * servo.torque_limit;
+    const Rig limited(rig.model(), servo, rig.load(), rig.simulation(), rig.mechanism());
+    const Status s = check_trajectory(limited, still(pose, 0.01), issue);
+    EXPECT_EQ(s, factor > 1.0 ? Status::Ok : Status::TorqueAboveMax);
+    if (s == Status::TorqueAboveMax) EXPECT_EQ(issue.limit.value, worst);
   }
 }
 

@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
+#include "hexatwist/error.hpp"
 #include "hexatwist/io/config.hpp"
 #include "hexatwist/simulation/study.hpp"
 
@@ -48,6 +51,51 @@ TEST(Study, KeepAfterDropsTheTicksBeforeAndRecomputesTheStatistics) {
   EXPECT_DOUBLE_EQ(run.compensated.twist_only.rms, std::sqrt((0.04 + 0.09) / 2));
   EXPECT_EQ(run.compensated.tracking_only.max, 4.0);
   EXPECT_DOUBLE_EQ(run.conventional.tracking_only.rms, std::sqrt(8.0));
+}
+
+TEST(Study, StudyTestFindsEachSeedTestByNameAndRefusesOthersInOneLine) {
+  for (const StudyTest& t : seed_tests(StudySpec{}))
+    EXPECT_EQ(study_test(StudySpec{}, t.name).coordinate, t.coordinate);
+  try {
+    (void)study_test(StudySpec{}, "Lq\n");
+    ADD_FAILURE() << "Lq found";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "unknown test 'Lq\\x0a'; expected Lz, Lx, Rz or Ry");
+  }
+}
+
+TEST(Study, RunMetricsAreTheLargestOfTheTicksAndCountTheSaturatedOnes) {
+  // Three hand-made ticks: torques, motor-side targets and real poses whose metrics are known.
+  const Rig& rig = default_config().rig;
+  const double limit = rig.servo().torque_limit;
+  std::vector<SimulationSample> ticks(3);
+  ticks[0].torque << 1, -2, 0, 0, 0, 0;
+  ticks[1].torque << 0, 0, -limit, 3, 0, 0;  // at the limit: saturated
+  ticks[2].torque << 0, 0, 0, 0, 0, 0.5 * limit;
+  ticks[1].command << 0, 0, 0, 0, 0, 2e-3;
+  ticks[2].motor << -3e-3, 0, 0, 0, 0, 0;
+  ticks[2].actual << 0, 0, 0, 0, 0, 0.25;  // yaw 0.25 rad off the commanded 0.1
+  ticks[2].desired << 0, 0, 0, 0, 0, 0.1;
+  const RunMetrics m = run_metrics(rig, ticks);
+  EXPECT_EQ(m.max_torque, limit);
+  EXPECT_EQ(m.saturated_ticks, 1u);
+  EXPECT_EQ(m.max_following_error, 3e-3);
+  EXPECT_NEAR(m.max_orientation_error, 0.15, 1e-12);
+}
+
+TEST(Study, CheckStudyRefusesAMotionTooLongToSampleNamingItsBlock) {
+  StudySpec spec;
+  EXPECT_NO_THROW(check_study(spec, 1e-3));
+  spec.linear.jerk = 1e-12;  // within its range, but a move of days
+  try {
+    check_study(spec, 1e-3);
+    ADD_FAILURE() << "a jerk of 1e-12 m/s^3 passed";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("study.linear: a test takes ", 0), 0u) << e.what();
+  }
+  spec = StudySpec{};
+  spec.angular_amplitude = deg2rad(1e3);
+  EXPECT_THROW(check_study(spec, 1e-3), Error);
 }
 
 // One default test per parameter (the full seed test: about 0.8 s each).

@@ -38,7 +38,8 @@ typedef enum hexatwist_status {
   HEXATWIST_SINGULAR_JACOBIAN = 9,      /**< forward kinematics met a singular Jacobian */
   HEXATWIST_PLATFORM_SINGULARITY = 17,  /**< the pose is too close to a platform (Jacobian) singularity */
   HEXATWIST_ASSEMBLY_MODE_CHANGED = 18, /**< forward kinematics would land on another assembly mode */
-  HEXATWIST_INVALID_ARGUMENT = 100,     /**< a null pointer or an unknown enum value was passed */
+  HEXATWIST_INVALID_ARGUMENT = 100,     /**< a null pointer, an unknown enum value, an option outside its
+                                             documented range (hexatwist_fk_options) or a leg length <= 0 */
   HEXATWIST_STATUS_MAX_ENUM = 0x7FFFFFFF
 } hexatwist_status;
 
@@ -86,12 +87,14 @@ typedef struct hexatwist_command_report {
                                             1 far away, 0 on the limit, negative past it [-] */
 } hexatwist_command_report;
 
-/** Forward-kinematics settings; start from hexatwist_fk_default_options(). */
+/** Forward-kinematics settings; start from hexatwist_fk_default_options(). A value outside its range
+ * (NaN included) makes the call return HEXATWIST_INVALID_ARGUMENT, as the library, the CLI and Python
+ * refuse it. */
 typedef struct hexatwist_fk_options {
-  int max_iterations;          /**< Newton iterations before HEXATWIST_NO_CONVERGENCE */
-  double tolerance;            /**< largest |length residual| accepted [m] */
-  double max_step_translation; /**< largest translation of one Newton step [m] */
-  double max_step_rotation;    /**< largest rotation vector |dw| of one Newton step [rad] */
+  int max_iterations;          /**< Newton iterations before HEXATWIST_NO_CONVERGENCE, 1 to 1000 */
+  double tolerance;            /**< largest |length residual| accepted [m], > 0 and at most 1e-6 */
+  double max_step_translation; /**< largest translation of one Newton step [m], > 0 and at most 10 */
+  double max_step_rotation;    /**< largest rotation vector |dw| of one Newton step [rad], > 0 and at most pi */
 } hexatwist_fk_options;
 
 /** Outcome of forward kinematics. */

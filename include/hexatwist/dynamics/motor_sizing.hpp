@@ -109,8 +109,9 @@ struct MotorSizing {
 /// motor commands' stroke (compute_commands; the motor's speed and torque are the envelope's
 /// checks here, not limits); then inverse_dynamics. Returns Ok, or the first sample's limit or
 /// numerical status (also in out.status, with the sample). The envelope verdict is a result
-/// (out.violation), not a status. A trajectory with fewer than 2 poses or a non-positive dt is
-/// NonFiniteInput at sample 0.
+/// (out.violation), not a status. A trajectory with fewer than 2 poses, a non-positive dt or a
+/// non-finite t0 or dt is NonFiniteInput at sample 0; one longer than kMaxTrajectorySamples
+/// (check_trajectory_samples) InvalidArgument.
 [[nodiscard]] Status size_motors(const Rig& rig, const Trajectory& trajectory, MotorSizing& out);
 
 /// A polyline [speed, torque] in SI units (rad/s, N m).

@@ -135,6 +135,7 @@ class Rig {
 
  private:
   void validate_and_derive();
+  void derive_drives();  // motor gains, inertias and PID gains from the validated specs
 
   Model model_;
   ServoSpec servo_;

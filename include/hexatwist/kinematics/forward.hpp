@@ -2,6 +2,8 @@
 // from geometric lengths or from motor-side lengths with the twist included.
 #pragma once
 
+#include <string_view>
+
 #include "hexatwist/kinematics/kinematics.hpp"
 
 namespace hexatwist {
@@ -26,6 +28,19 @@ struct FkOptions {
   double max_step_translation = 0.5;  ///< longest translation of one step [m]
   double max_step_rotation = 0.5;     ///< largest |dw| of one step (a rotation by 2 atan(|dw|/2) <= |dw|) [rad]
 };
+
+/// Largest FkOptions::max_iterations [-].
+inline constexpr int kMaxFkIterations = 1000;
+/// Largest FkOptions::tolerance: a micrometre of length residual; a looser one would accept poses a
+/// laser tracker tells apart [m].
+inline constexpr double kMaxFkTolerance = 1e-6;
+
+/// Why `options` are outside their documented ranges, as "field: expected ..." (empty if valid):
+/// max_iterations in [1, kMaxFkIterations], tolerance in (0, kMaxFkTolerance] m, singular_ratio in
+/// (0, 1e-3], max_step_translation in (0, 10] m, max_step_rotation in (0, pi] rad. NaN is outside
+/// every range. forward_kinematics and forward_kinematics_tracked return Status::InvalidArgument
+/// for such options (the C API HEXATWIST_INVALID_ARGUMENT; Python and the CLI refuse them with this text).
+[[nodiscard]] std::string_view check_fk_options(const FkOptions& options) noexcept;
 
 /// Result of forward kinematics (caller-owned).
 struct FkResult {

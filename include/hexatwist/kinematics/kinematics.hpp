@@ -19,8 +19,8 @@ struct LegState {
   Vector6d length;             ///< |L_i|, Eq. (4) [m]
 };
 
-/// Inverse kinematics, Eq. (1)-(4). Returns NonFiniteInput for a non-finite pose; a zero-length
-/// leg is reported as StrokeBelowMin. Limits are not checked here (see limits.hpp).
+/// Inverse kinematics, Eq. (1)-(4). Returns NonFiniteInput for a non-finite pose (or one so far that the lengths
+/// overflow); a zero-length leg is reported as StrokeBelowMin. Limits are not checked here (see limits.hpp).
 [[nodiscard]] Status inverse_kinematics(const Model& model, const Placement& x, LegState& out) noexcept;
 
 /// Inverse kinematics for a roll-pitch-yaw pose.

@@ -198,6 +198,7 @@ class Model {
  private:
   void check_limits_spec();
   void build_leg(int i);
+  void build_leg_axes(int i);  // the U-joints' fixed axes and the twist at home (lead > 0)
   void lay_out_geometry();
   void check_home_and_reference();
 

@@ -84,8 +84,13 @@ struct StreamSettings {
 };
 
 /// Empty if the settings are usable, else a one-sentence reason naming the field
-/// ("max_velocity must be positive"). Not real-time (may be called anywhere).
+/// ("max_velocity must be positive"; the FK options as check_fk_options). Not real-time (may be called anywhere).
 std::string_view check_stream_settings(const StreamSettings& settings) noexcept;
+
+/// The same, and that a finite rate limit can bind on `model`: one period's step at max_velocity
+/// (or max_acceleration times the period squared) shorter than the stroke. start_stream and
+/// stream_pose do not check it; the CLI and Python call this before streaming.
+std::string_view check_stream_settings(const Model& model, const StreamSettings& settings) noexcept;
 
 /// State of one stream (caller-owned workspace; one per stream, no sharing between threads).
 struct StreamState {

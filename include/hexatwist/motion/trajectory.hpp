@@ -76,6 +76,13 @@ class JerkLimitedMove {
   std::array<double, 3> p_{}, v_{};
 };
 
+/// Most samples of one trajectory the library makes or runs (sweep_trajectory, waypoint_trajectory,
+/// resample; simulate and size_motors refuse longer ones): 1,000,000, e.g. 1000 s at a 1 kHz control
+/// rate. The bound fits a machine of 2 cores and 24 GB: `hexatwist simulate` on a trajectory this
+/// long holds about 3 GB (three simulations and their CSVs) for about 2 minutes, `dynamics` about
+/// 1.4 GB (measured at 10^5 samples: 300 MB and 11 s, 140 MB and 2 s).
+inline constexpr std::size_t kMaxTrajectorySamples = 1'000'000;
+
 /// A pose trajectory sampled at a fixed period: poses[k] is the pose at time t0 + k*dt.
 struct Trajectory {
   double t0 = 0.0;          ///< time of the first pose [s]
@@ -88,13 +95,19 @@ struct Trajectory {
   double duration() const noexcept;
 };
 
+/// Why a trajectory of `samples` poses from `t0` [s] every `dt` [s] cannot be simulated or sized
+/// (empty if it can), as "t0: ...", "dt: ..." or "poses: ...": |t0| <= 1e9 s (the samples' times
+/// keep sub-microsecond resolution), dt finite and > 0, at least 2 and at most
+/// kMaxTrajectorySamples poses. Checked before the poses take any memory.
+[[nodiscard]] std::string_view check_trajectory_samples(double t0, double dt, std::size_t samples) noexcept;
+
 /// The seed paper's test motion along one pose coordinate (0..5 = x, y, z, roll, pitch, yaw):
 /// at rest for `dwell` [s], home -> +amplitude, dwell, +amplitude -> -amplitude, dwell,
 /// -amplitude -> home, dwell; each move a JerkLimitedMove under `limits` [m or rad per s, s^2, s^3].
 /// `amplitude` [m or rad] > 0. Sampled every `dt` [s] from t0 = 0: the total duration is rounded
 /// up to a whole number of dt (within 1e-9 dt) and the last pose is exactly home. Throws
 /// hexatwist::Error on a bad coordinate index, amplitude <= 0 or non-finite, dwell < 0 or
-/// non-finite, dt <= 0 or non-finite, bad limits, or more than 1e8 samples.
+/// non-finite, dt <= 0 or non-finite, bad limits, or more than kMaxTrajectorySamples samples.
 Trajectory sweep_trajectory(int coordinate, double amplitude, const MotionLimits& limits, double dwell, double dt);
 
 /// Straight-line moves through `waypoints` ([x, y, z, roll, pitch, yaw] relative to home [m, rad],
@@ -144,7 +157,7 @@ std::string format_trajectory_csv(const Trajectory& trajectory, std::size_t ever
 /// time within 1e-9 dt of an input time gives that input pose exactly. Angles are interpolated as
 /// given (no wrapping at ±pi). Throws hexatwist::Error if dt <= 0 or non-finite, fewer than 2
 /// samples, t and poses differ in size, times are not finite and strictly increasing, a pose is
-/// not finite, more than 1e8 samples would result, or the interpolation overflows a double
+/// not finite, more than kMaxTrajectorySamples samples would result, or the interpolation overflows a double
 /// (finite samples whose difference or rate of change is beyond 1e308): it never returns a
 /// non-finite pose.
 Trajectory resample(const TimedPoses& samples, double dt);

@@ -46,6 +46,12 @@ struct SimulationIssue {
   LimitReport limit;           ///< leg, value and bound (limits; motor speed [rad/s]; holding torque [N m])
 };
 
+/// Motor torque that holds the whole mechanism standing still at `pose` [m, rad]: gravity's share of
+/// the inverse dynamics (platform, payload and leg bodies; theory §14) [N m], positive where the
+/// motor pushes the leg longer. What check_trajectory compares with servo.torque_limit, and what
+/// `hexatwist config` shows at home. Returns the status of inverse_dynamics.
+[[nodiscard]] Status holding_torque(const Rig& rig, const Pose& pose, Vector6d& torque) noexcept;
+
 /// Checks the whole trajectory before anything runs: every pose inside the limits, both
 /// commands inside the stroke, no motor faster than servo.max_speed, and no motor that could not
 /// even hold the load standing still (static torque above servo.torque_limit). Returns the first
@@ -57,6 +63,7 @@ struct SimulationIssue {
 /// the first tick, the commands this run will send are checked at every sample as check_trajectory
 /// does (pose limits, stroke, motor speed, holding torque), so nothing runs past a limit; on any
 /// failure `issue` says where, `samples` holds the ticks done so far, and the status is returned.
+/// A trajectory of more than kMaxTrajectorySamples poses is InvalidArgument (nothing is allocated).
 [[nodiscard]] Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOptions& options,
                               std::vector<SimulationSample>& samples, SimulationIssue& issue);
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "hexatwist/simulation/simulation.hpp"
@@ -27,8 +28,20 @@ struct StudyTest {
   double amplitude = 0.0;   ///< [m or rad]
 };
 
+/// Checks the study's numbers against their plausible ranges (configs/seed.yaml lists them):
+/// linear_amplitude in (0, 100] m, angular_amplitude in (0, 180] deg, each velocity, acceleration
+/// and jerk in (0, 1e6] (m or deg per s, s^2, s^3), dwell in [0, 3600] s, and every test at most
+/// kMaxTrajectorySamples samples long at the control period `dt` [s] (a jerk of 1e-12 m/s^3 makes a
+/// move of days). Throws Error "study.<field>: ..." with the configuration's key (study.linear,
+/// study.angular_deg.jerk, ...).
+void check_study(const StudySpec& spec, double dt);
+
 /// The paper's four tests in Table 1's order: Lz, Lx, Rz, Ry. Throws Error for a bad spec.
 std::vector<StudyTest> seed_tests(const StudySpec& spec);
+
+/// The test named `name` ("Lz", "Lx", "Rz" or "Ry") of seed_tests(spec). Throws Error "unknown test
+/// 'NAME'; expected Lz, Lx, Rz or Ry" for another name (the CLI and Python put the argument's name before it).
+StudyTest study_test(const StudySpec& spec, std::string_view name);
 
 /// The test's trajectory: home -> +amplitude -> -amplitude -> home, jerk-limited, sampled every dt.
 Trajectory test_trajectory(const StudySpec& spec, const StudyTest& test, double dt);
@@ -47,6 +60,18 @@ struct StrategyRun {
   ErrorStats twist_only;                  ///< perfect servos, quasi-static: what the twist alone does
   ErrorStats tracking_only;  ///< the same servos with no twist in the plant (the same run for both strategies)
 };
+
+/// What a strategy's run did besides its errors: the study's table, summary.json and Python's study()
+/// report these.
+struct RunMetrics {
+  double max_torque = 0.0;             ///< largest |motor torque| of any leg at any tick [N m]
+  std::size_t saturated_ticks = 0;     ///< ticks with some motor at servo.torque_limit [-]
+  double max_following_error = 0.0;    ///< largest |motor-side target - true motor-side length| of any leg [m]
+  double max_orientation_error = 0.0;  ///< largest angle between the real and the commanded orientation [rad]
+};
+
+/// The metrics of a run's ticks (`rig` gives the torque limit).
+RunMetrics run_metrics(const Rig& rig, const std::vector<SimulationSample>& samples) noexcept;
 
 /// A test's results.
 struct TestRun {

@@ -1,0 +1,105 @@
+// hexatwist ik: the commands of one pose, and the pose errors every command shares.
+#include "cli_support.hpp"
+
+using namespace hexatwist::cli_test;
+
+namespace {
+
+// ---- ik --------------------------------------------------------------------------------------
+
+TEST(Cli, IkJsonReportsEveryLegWithConsistentCommands) {
+  const Outcome r = run({"ik", "--pose=0.05,-0.02,0.1,3,-2,5", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const YAML::Node j = json(r);
+  EXPECT_EQ(j["status"].as<std::string>(), "ok");
+  EXPECT_TRUE(j["limit"].IsNull());
+  ASSERT_TRUE(j["legs"].IsSequence());
+  ASSERT_EQ(j["legs"].size(), 6u);
+  for (std::size_t i = 0; i < 6; ++i) {
+    const YAML::Node leg = j["legs"][i];
+    SCOPED_TRACE("leg " + std::to_string(i + 1));
+    EXPECT_EQ(leg["leg"].as<int>(), static_cast<int>(i) + 1);
+    for (const char* key : {"length", "twist", "length_error", "command_conventional", "command_compensated"})
+      ASSERT_TRUE(leg[key].IsScalar()) << key;
+    const double length = leg["length"].as<double>();
+    EXPECT_GT(length, 1.4);
+    EXPECT_LT(length, 2.45);
+    EXPECT_EQ(leg["command_conventional"].as<double>(), length);
+    // Eq. (12): compensated = length - length_error; the JSON numbers round-trip exactly.
+    EXPECT_NEAR(leg["command_compensated"].as<double>(), length - leg["length_error"].as<double>(), 1e-12);
+    EXPECT_NE(leg["length_error"].as<double>(), 0.0);
+    // Eq. (10) with the seed's +lead/2pi: length_error = 0.01/2pi * twist.
+    EXPECT_NEAR(leg["length_error"].as<double>(), 0.010 / (2 * kPi) * leg["twist"].as<double>(), 1e-15);
+  }
+}
+
+TEST(Cli, IkHeaveTwistsLegsOneAndTwoOppositely) {
+  const Outcome r = run({"ik", "--pose=0,0,0.3,0,0,0", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::vector<double> twist = leg_values(json(r), "twist");
+  ASSERT_EQ(twist.size(), 6u);
+  EXPECT_GT(std::abs(twist[0]), deg2rad(1.0));
+  EXPECT_NEAR(twist[0], -twist[1], 1e-12);
+}
+
+TEST(Cli, IkTextOutputHasOneRowPerLeg) {
+  const Outcome r = run({"ik", "--pose=0,0,0.1,0,0,10"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (int i = 1; i <= 6; ++i) EXPECT_NE(r.out.find("\n  " + std::to_string(i) + "  "), std::string::npos) << i;
+  EXPECT_NE(r.out.find("status: ok"), std::string::npos);
+}
+
+TEST(Cli, NegativeNumbersWorkWithAndWithoutEquals) {
+  const Outcome eq = run({"ik", "--pose=-0.1,0,0,0,0,-5", "--json"});
+  const Outcome space = run({"ik", "--pose", "-0.1,0,0,0,0,-5", "--json"});
+  ASSERT_EQ(eq.code, 0) << eq.err;
+  ASSERT_EQ(space.code, 0) << space.err;
+  EXPECT_EQ(eq.out, space.out);
+  EXPECT_EQ(json(eq)["pose"][0].as<double>(), -0.1);
+  EXPECT_NEAR(json(eq)["pose"][5].as<double>(), deg2rad(-5.0), 1e-15);
+}
+
+// ---- bad input -------------------------------------------------------------------------------
+
+TEST(Cli, PoseWithFiveNumbersIsBadInput) {
+  const Outcome r = run({"ik", "--pose=0,0,0,0,0"});
+  expect_error(r, 2, {"--pose", "6"});
+  EXPECT_EQ(r.out, "");
+}
+
+TEST(Cli, NonNumberInPoseIsBadInput) {
+  expect_error(run({"ik", "--pose=0,0,abc,0,0,0"}), 2, {"--pose", "'abc'", "value 3"});
+  expect_error(run({"ik", "--pose=0,0,0.1.2,0,0,0"}), 2, {"--pose", "'0.1.2'"});
+  expect_error(run({"ik", "--pose=0,0,,0,0,0"}), 2, {"--pose", "value 3"});
+  expect_error(run({"ik", "--pose=+-1,0,0,0,0,0"}), 2, {"--pose", "'+-1'"});
+}
+
+TEST(Cli, NanOrInfInPoseIsBadInput) {
+  for (const char* v : {"nan", "inf", "-inf", "NaN"})
+    expect_error(run({"ik", std::string("--pose=0,") + v + ",0,0,0,0"}), 2, {"--pose", "value 2", "finite"});
+  expect_error(run({"ik", "--pose=1e999,0,0,0,0,0"}), 2, {"--pose", "range"});
+}
+
+TEST(Cli, NewlineInAnArgumentStillGivesOneLine) { expect_error(run({"ik", "--pose=0,0\n,0,0,0,0"}), 2, {"--pose"}); }
+
+TEST(Cli, PoseOutsideALimitExitsThreeAndEmitsNoCommand) {
+  const Outcome r = run({"ik", "--pose=0,0,0.9,0,0,0", "--json"});
+  expect_error(r, 3, {"leg 1", "limits.length_max"});
+  const YAML::Node j = json(r);
+  EXPECT_EQ(j["status"].as<std::string>(), "stroke_above_max");
+  EXPECT_EQ(j["limit"]["leg"].as<int>(), 1);
+  EXPECT_GT(j["limit"]["value"].as<double>(), j["limit"]["bound"].as<double>());
+  ASSERT_EQ(j["legs"].size(), 6u);
+  for (const auto& leg : j["legs"]) {
+    EXPECT_TRUE(leg["command_conventional"].IsNull());
+    EXPECT_TRUE(leg["command_compensated"].IsNull());
+    EXPECT_TRUE(leg["length"].IsScalar());  // the geometry is still reported
+  }
+  // Text output: no command either.
+  const Outcome text = run({"ik", "--pose=0,0,0.9,0,0,0"});
+  expect_error(text, 3, {"leg 1", "limits.length_max"});
+  EXPECT_NE(text.out.find("status: stroke_above_max"), std::string::npos);
+}
+
+}  // namespace

@@ -1,0 +1,233 @@
+// Every option of every command, walked from the CLI's own definitions (add_commands), given the
+// values a new user tries: NaN, +-inf, 0, -1, 1e300, an empty string and a folder. Each run ends
+// as the same command without that value ends (exit 0 for every command but identify, whose small
+// log cannot determine the parameters: exit 5), or with exit 2 and one line naming the option;
+// never exit 1, never a signal; an exit 0 prints no NaN or inf.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <future>
+#include <map>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include "cli_common.hpp"
+#include "cli_support.hpp"
+
+using namespace hexatwist::cli_test;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Options of synth, measure and identify whose checks belong to the calibration subsystem (being
+// rewritten): "command option value" runs that do not end as the table asks yet. Empty this list
+// as they are fixed; the test reports each entry that passes now, so that it is removed.
+// Each of these ends in exit 2 with one line, but names the log's line or window, not the option.
+const std::set<std::string> kKnownFailures = {
+    "measure --time-offset -1",       "measure --time-offset 1e300", "identify --time-offset -1",
+    "identify --time-offset 1e300",   "measure --register-until 0",  "measure --register-until -1",
+    "measure --register-until 1e300",
+};
+
+// A run of the tool in `dir` with standard input empty.
+Outcome run_in(const fs::path& dir, const std::vector<std::string>& args) {
+  Outcome r;
+  const fs::path err_path = dir / "stderr.txt";
+  r.command = "cd " + shell_quote(dir.string()) + " && " + shell_quote(HEXATWIST_CLI);
+  for (const std::string& a : args) (r.command += ' ') += shell_quote(a);
+  FILE* pipe = popen((r.command + " </dev/null 2>" + shell_quote(err_path.string())).c_str(), "r");
+  if (pipe == nullptr) return r;
+  std::array<char, 4096> buf;
+  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) r.out.append(buf.data(), n);
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  r.err = read_file(err_path);
+  return r;
+}
+
+// The inputs the commands run on, small so that each run takes a moment: a short heave, a
+// configuration whose study tests last half a second, and a tracker log of the heave.
+struct Inputs {
+  fs::path dir;
+  std::string config, trajectory, log;
+};
+
+const Inputs& inputs() {
+  static const Inputs in = [] {
+    Inputs i;
+    i.dir = temp_dir() / "option-table";
+    fs::create_directories(i.dir);
+    i.config = (i.dir / "tiny.yaml").string();
+    std::ofstream(i.config) << hexatwist::test::kSymmetricYaml
+                            << "study:\n  linear_amplitude: 0.01\n  angular_amplitude_deg: 1\n  dwell: 0.05\n"
+                               "  linear: {velocity: 0.5, acceleration: 5, jerk: 50}\n"
+                               "  angular_deg: {velocity: 30, acceleration: 300, jerk: 3000}\n";
+    // A smooth 5 mm heave with a 5 deg yaw in 1.5 s, then 1.5 s at rest: the log's points span a
+    // plane (registration) and the motors stay inside their envelope.
+    i.trajectory = (i.dir / "tiny.csv").string();
+    std::ofstream traj(i.trajectory);
+    traj << "t,x,y,z_mm,roll,pitch,yaw_deg\n";
+    for (int k = 0; k <= 300; ++k) {
+      const double t = 0.01 * k, s = t < 1.5 ? 0.5 * (1 - std::cos(kPi * t / 1.5)) : 1.0;
+      traj << t << ",0,0," << 5.0 * s << ",0,0," << 5.0 * s << "\n";
+    }
+    traj.close();
+    i.log = (i.dir / "log.csv").string();
+    const Outcome synth = run_in(i.dir, {"synth", "--trajectory", i.trajectory, "--out", i.log});
+    EXPECT_EQ(synth.code, 0) << synth.err;
+    return i;
+  }();
+  return in;
+}
+
+// The arguments that make each command run on the small inputs (the option under test replaces
+// its own entry).
+std::map<std::string, std::vector<std::string>> base_arguments(const Inputs& in) {
+  const std::string& c = in.config;
+  const std::string& t = in.trajectory;
+  return {
+      {"study", {"--config", c, "--tests", "Rz", "--no-figures", "--no-csv", "--out", "out"}},
+      {"simulate", {"--config", c, "--trajectory", t, "--no-figures", "--no-csv", "--out", "out"}},
+      {"dynamics", {"--config", c, "--trajectory", t, "--no-figures", "--no-csv", "--out", "out"}},
+      {"synth", {"--config", c, "--trajectory", t, "--out", "s.csv"}},
+      {"measure",
+       {"--config", c, "--points", in.log, "--trajectory", t, "--register-first", "150", "--settle", "0",
+        "--no-figures", "--no-csv", "--out", "out"}},
+      {"identify", {"--config", c, "--points", in.log, "--trajectory", t, "--settle", "0", "--out", "id.yaml"}},
+      {"stream", {"--config", c}},
+      {"ik", {"--config", c}},
+      {"fk", {"--config", c, "--lengths=1.9,1.9,1.9,1.9,1.9,1.9"}},
+      {"config", {"--config", c}},
+      {"linuxcnc", {"--config", c}},
+      {"mjcf", {"--config", c}},
+  };
+}
+
+// `base` with the option set to `value` (replacing its entry, or added as --option=value).
+std::vector<std::string> with_value(const std::string& command, std::vector<std::string> base,
+                                    const std::string& option, const std::string& value) {
+  std::vector<std::string> args{command};
+  // The run's other choices that exclude this one leave (a run is given by one of them).
+  std::set<std::string> drop{option};
+  if (option == "--test" || option == "--stations") drop.insert("--trajectory");
+  if (option == "--register-until") drop.insert("--register-first");
+  for (std::size_t k = 0; k < base.size(); ++k) {
+    if (drop.count(base[k]) > 0) {
+      ++k;  // drop its value
+      continue;
+    }
+    if (base[k].starts_with(option + "=")) continue;
+    args.push_back(base[k]);
+  }
+  args.push_back(option + "=" + value);
+  return args;
+}
+
+struct Case {
+  std::string command, option, value;
+  std::vector<std::string> args;
+};
+
+struct Verdict {
+  Case c;
+  Outcome r;
+  std::string problem;  // empty: as the table asks
+};
+
+// What is wrong with run `r` of `c`, whose command ends with `base_code` without the value.
+std::string judge(const Case& c, const Outcome& r, int base_code) {
+  if (r.code == 1) return "exit 1";
+  if (r.code >= 128 || r.code < 0) return "killed by a signal";
+  if (r.code == 2) {
+    if (std::count(r.err.begin(), r.err.end(), '\n') != 1) return "exit 2 but not one line";
+    // CLI11's own messages name the option without its dashes in some forms (\"--opt\" or \"opt\").
+    const std::string bare = c.option.substr(2);
+    if (r.err.find(c.option) == std::string::npos && r.err.find(bare) == std::string::npos)
+      return "exit 2 without naming the option";
+    return {};
+  }
+  if (r.code != base_code)
+    return "exit " + std::to_string(r.code) + ", expected " + std::to_string(base_code) + " or 2";
+  if (r.code == 0)
+    for (const char* word : {"nan", "inf"}) {
+      // The value itself may be echoed (a folder named "nan"): only numbers the run computed count.
+      std::string out = r.out;
+      for (std::size_t at; !c.value.empty() && (at = out.find(c.value)) != std::string::npos;)
+        out.erase(at, c.value.size());
+      std::transform(out.begin(), out.end(), out.begin(), [](unsigned char ch) { return std::tolower(ch); });
+      for (std::size_t at = out.find(word); at != std::string::npos; at = out.find(word, at + 1)) {
+        const bool alone = (at == 0 || !std::isalpha(static_cast<unsigned char>(out[at - 1]))) &&
+                           (at + 3 >= out.size() || !std::isalpha(static_cast<unsigned char>(out[at + 3])));
+        if (alone) return std::string("exit 0 printing ") + word;
+      }
+    }
+  return {};
+}
+
+TEST(CliOptionTable, EveryOptionOfEveryCommandEndsInZeroOrTwoNamingItNeverOne) {
+  const Inputs& in = inputs();
+  const auto base = base_arguments(in);
+  CLI::App app;
+  const std::vector<hexatwist::cli::Command> commands = hexatwist::cli::add_commands(app);
+  const fs::path folder = in.dir / "a-folder";
+  fs::create_directories(folder);
+  const std::vector<std::string> values = {"nan", "inf", "-inf", "0", "-1", "1e300", "", folder.string()};
+
+  // How each command ends without a bad value: the reference every value is judged against.
+  std::map<std::string, int> base_code;
+  std::vector<Case> cases;
+  for (const hexatwist::cli::Command& command : commands) {
+    const std::string name = command.app->get_name();
+    ASSERT_TRUE(base.count(name)) << "no base arguments for the command " << name;
+    const fs::path dir = in.dir / ("base-" + name);
+    fs::create_directories(dir);
+    std::vector<std::string> args{name};
+    args.insert(args.end(), base.at(name).begin(), base.at(name).end());
+    const Outcome r = run_in(dir, args);
+    base_code[name] = r.code;
+    EXPECT_TRUE(r.code == 0 || (name == "identify" && r.code == 5)) << r.command << "\n" << r.err;
+    for (const CLI::Option* opt : command.app->get_options()) {
+      if (opt->get_expected_min() == 0) continue;  // a flag: takes no value
+      for (const std::string& value : values)
+        cases.push_back({name, opt->get_name(), value, with_value(name, base.at(name), opt->get_name(), value)});
+    }
+  }
+  ASSERT_GT(cases.size(), 400u);
+
+  // Every case in its own folder, several at a time (each is a process of its own).
+  std::vector<Verdict> verdicts(cases.size());
+  std::atomic<std::size_t> next{0};
+  const auto work = [&] {
+    for (std::size_t k = next++; k < cases.size(); k = next++) {
+      const fs::path dir = in.dir / ("case-" + std::to_string(k));
+      fs::create_directories(dir);
+      verdicts[k].c = cases[k];
+      verdicts[k].r = run_in(dir, cases[k].args);
+      verdicts[k].problem = judge(cases[k], verdicts[k].r, base_code[cases[k].command]);
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < std::max(4u, std::thread::hardware_concurrency() * 2); ++t) pool.emplace_back(work);
+  for (std::thread& t : pool) t.join();
+
+  int failures = 0;
+  for (const Verdict& v : verdicts) {
+    const std::string key =
+        v.c.command + " " + v.c.option + " " + (v.c.value == folder.string() ? "<folder>" : v.c.value);
+    const bool known = kKnownFailures.count(key) > 0;
+    if (v.problem.empty()) {
+      if (known) ADD_FAILURE() << "now as the table asks, remove it from kKnownFailures: " << key;
+      continue;
+    }
+    if (known) continue;
+    ++failures;
+    ADD_FAILURE() << key << ": " << v.problem << "\n  " << v.r.command << "\n  stderr: " << v.r.err;
+  }
+  std::printf("  %zu runs, %d not as the table asks, %zu known\n", verdicts.size(), failures, kKnownFailures.size());
+}
+
+}  // namespace

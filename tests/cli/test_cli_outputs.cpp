@@ -1,0 +1,227 @@
+// The one writer of every command's files (output_files.hpp): standard output checked, sets of
+// files all or none, outputs compared with inputs as files, reused folders.
+#include <map>
+
+#include "cli_support.hpp"
+
+using namespace hexatwist::cli_test;
+
+namespace {
+
+// ----- no silent failures (#12): every run means what it says or says why not -----
+
+TEST(CliOutputs, EveryCommandWritingToAFullStandardOutputExitsFour) {
+  const std::vector<std::vector<std::string>> commands = {
+      {"ik", "--pose=0,0,0.1,0,0,30"},
+      {"ik", "--pose=0,0,0.1,0,0,30", "--json"},
+      {"fk", "--lengths=1.700685245,2.377495057,1.700685245,2.377495057,1.700685245,2.377495057", "--motor"},
+      {"fk", "--lengths=1.700685245,2.377495057,1.700685245,2.377495057,1.700685245,2.377495057", "--json"},
+      {"config"},
+      {"config", "--json"},
+      {"config", "--yaml"},
+      {"linuxcnc"},
+      {"--help"},
+      {"ik", "--help"},
+      {"--version"}};
+  for (const auto& args : commands) {
+    const Outcome r = run_to_full_disk(args);
+    expect_error(r, 4, {"standard output"});
+  }
+}
+
+TEST(CliOutputs, SynthOutputsThatNameTheSameFileAreRefusedBeforeAnythingIsWritten) {
+  const std::filesystem::path c = temp_dir() / "same.csv";
+  std::filesystem::remove(c);
+  expect_error(run({"synth", "--test", "Lz", "--out", c.string(), "--run-out", c.string()}), 2,
+               {"--out", "--run-out", "same.csv", "nothing was written"});
+  EXPECT_FALSE(std::filesystem::exists(c));
+  const std::string truth = (temp_dir() / "same.truth.json").string();
+  expect_error(run({"synth", "--test", "Lz", "--out", c.string(), "--run-out", truth}), 2, {"--run-out", "truth"});
+  EXPECT_FALSE(std::filesystem::exists(truth));
+}
+
+TEST(CliOutputs, AReportThatCannotBeWrittenWholeLeavesNoFileAndNoTemporary) {
+  const std::string csv = write_file("blocked.csv", heave_csv());
+  const std::filesystem::path out = temp_dir() / "blocked-out";
+  std::filesystem::remove_all(out);
+  std::filesystem::create_directories(out / "summary.json");  // a folder where the summary goes
+  expect_error(run({"simulate", "--trajectory", csv, "--out", out.string()}), 4, {"summary.json"});
+  EXPECT_EQ(folder_entries(out), std::vector<std::string>{"summary.json"});
+}
+
+TEST(CliOutputs, AReusedFolderSaysSoAndItsSummaryListsOnlyThisRunsFiles) {
+  const std::string csv = write_file("reused.csv", heave_csv());
+  const std::filesystem::path out = temp_dir() / "reused-out";
+  std::filesystem::remove_all(out);
+  const Outcome first = run({"simulate", "--trajectory", csv, "--out", out.string(), "--no-figures"});
+  ASSERT_EQ(first.code, 0) << first.err;
+  EXPECT_EQ(first.err, "");
+  EXPECT_TRUE(std::filesystem::exists(out / "reused_compensated.csv"));
+  write_file("reused-out/notes.txt", "mine\n");
+  const Outcome second = run({"simulate", "--trajectory", csv, "--out", out.string(), "--no-figures", "--no-csv"});
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_NE(second.err.find("was not empty: 2 files replaced, 2 of an earlier run removed; 1 other files left"),
+            std::string::npos)
+      << second.err;
+  EXPECT_NE(second.err.find("notes.txt"), std::string::npos);
+  EXPECT_EQ(folder_entries(out), (std::vector<std::string>{"notes.txt", "summary.json", "summary.md"}));
+  const YAML::Node s = YAML::LoadFile((out / "summary.json").string());
+  EXPECT_EQ(s["files"].size(), 0u);
+  EXPECT_EQ(read_file(out / "summary.md").find("_compensated.csv"), std::string::npos);
+}
+
+TEST(CliOutputs, AReportWhoseStandardOutputFailsLeavesNoFiles) {
+  const std::string csv = write_file("fullout.csv", heave_csv());
+  const std::filesystem::path out = temp_dir() / "fullout-out";
+  std::filesystem::remove_all(out);
+  expect_error(run_to_full_disk({"simulate", "--trajectory", csv, "--out", out.string(), "--no-figures"}), 4,
+               {"standard output"});
+  // The folder this run made is gone with its files (a failed run leaves nothing it made).
+  EXPECT_TRUE(!std::filesystem::exists(out) || folder_entries(out).empty());
+  const std::string log = (temp_dir() / "fullout-log.csv").string();
+  expect_error(run_to_full_disk({"synth", "--test", "Lz", "--out", log}), 4, {"standard output"});
+  EXPECT_FALSE(std::filesystem::exists(log));
+  EXPECT_FALSE(std::filesystem::exists(temp_dir() / "fullout-log.truth.json"));
+}
+
+// ----- nothing lost (#22): a failed run changes nothing that was there before it -----
+
+namespace fs = std::filesystem;
+
+// Every file under `dir` with its bytes (names relative to `dir`).
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) files[fs::relative(e.path(), dir).string()] = read_file(e.path());
+  return files;
+}
+
+// A short heave and a configuration whose study tests last half a second: quick reports.
+std::string quick_config() {
+  return write_file("quick.yaml", hexatwist::test::kSymmetricYaml +
+                                      "study:\n  linear_amplitude: 0.01\n  angular_amplitude_deg: 1\n  dwell: 0.05\n"
+                                      "  linear: {velocity: 0.5, acceleration: 5, jerk: 50}\n"
+                                      "  angular_deg: {velocity: 30, acceleration: 300, jerk: 3000}\n");
+}
+
+TEST(CliOutputs, AFailedRunLeavesEveryEarlierFileByteForByte) {
+  const std::string config = quick_config();
+  const std::string csv = write_file("keep.csv", heave_csv());
+  // Stations 20 mm along x, y and z (the tracker frame registers on them), then a yaw and back.
+  const std::string stations = write_file("keep-stations.csv",
+                                          "t,x_mm,y_mm,z_mm,roll,pitch,yaw\n0,0,0,0,0,0,0\n0.5,0,0,0,0,0,0\n"
+                                          "1,20,0,0,0,0,0\n1.5,20,0,0,0,0,0\n2,0,20,0,0,0,0\n2.5,0,20,0,0,0,0\n"
+                                          "3,0,0,20,0,0,0\n3.5,0,0,20,0,0,0\n4,0,0,0,0,0,0\n5,0,0,0,0,0,3\n"
+                                          "6,0,0,0,0,0,0\n");
+  const std::string log = (temp_dir() / "keep-log.csv").string();
+  ASSERT_EQ(run({"synth", "--trajectory", stations, "--out", log}).code, 0);
+  const std::vector<std::vector<std::string>> runs = {
+      {"study", "--config", config, "--tests", "Lz,Rz", "--no-csv"},
+      {"simulate", "--trajectory", csv},
+      {"dynamics", "--trajectory", csv},
+      {"measure", "--points", log, "--trajectory", stations, "--register-until", "4", "--no-figures"},
+  };
+  for (const std::vector<std::string>& command : runs) {
+    const fs::path out = temp_dir() / ("keep-" + command[0]);
+    std::vector<std::string> args = command;
+    args.insert(args.end(), {"--out", out.string()});
+    const Outcome first = run(args);
+    ASSERT_EQ(first.code, 0) << first.command << "\n" << first.err;
+    write_file("keep-" + command[0] + "/notes.txt", "my notes\n");
+    const auto before = snapshot(out);
+    ASSERT_GT(before.size(), 2u);
+    // The same run again, and one with other files, each failing at its very end.
+    std::vector<std::string> other = args;
+    if (command[0] == "study") other[std::find(other.begin(), other.end(), "Lz,Rz") - other.begin()] = "Rz";
+    for (const auto& again : {args, other}) {
+      expect_error(run_to_full_disk(again), 4, {"standard output"});
+      EXPECT_EQ(snapshot(out), before) << command[0] << ": the earlier report changed";
+    }
+  }
+  // Files named by the user: synth's log and truth, identify's configuration, beside an input.
+  const std::string truth = (temp_dir() / "keep-log.truth.json").string();
+  const std::string log_before = read_file(log), truth_before = read_file(truth);
+  expect_error(run_to_full_disk({"synth", "--trajectory", stations, "--out", log, "--seed", "7"}), 4,
+               {"standard output"});
+  EXPECT_EQ(read_file(log), log_before);
+  EXPECT_EQ(read_file(truth), truth_before);
+}
+
+TEST(CliOutputs, AFailedIdentifyLeavesAHandMadeConfigurationAsItWas) {
+  const std::string log = (temp_dir() / "keep-stations.csv").string();
+  ASSERT_EQ(run({"synth", "--stations", "12", "--station-seed", "3", "--out", log}).code, 0);
+  const std::string keep = write_file("keep.yaml", "# my own configuration\n" + hexatwist::test::kSymmetricYaml);
+  const Outcome ok = run({"identify", "--points", log, "--stations", "12", "--station-seed", "3", "--out", keep});
+  if (ok.code != 0) GTEST_SKIP() << "this log does not identify: " << ok.err;  // the run must reach its write
+  std::ofstream(keep) << "# my own configuration\n" << hexatwist::test::kSymmetricYaml;
+  expect_error(
+      run_to_full_disk({"identify", "--points", log, "--stations", "12", "--station-seed", "3", "--out", keep}), 4,
+      {"standard output"});
+  EXPECT_EQ(read_file(keep), "# my own configuration\n" + hexatwist::test::kSymmetricYaml);
+}
+
+TEST(CliOutputs, AnOutputThatIsAnInputAsAFileIsRefusedAndTheInputKept) {
+  const fs::path dir = temp_dir() / "same-files";
+  fs::create_directories(dir);
+  const std::string csv = (dir / "run.csv").string();
+  std::ofstream(csv) << heave_csv();
+  const std::string yaml = (dir / "x.yaml").string();
+  std::ofstream(yaml) << hexatwist::test::kSymmetricYaml;
+  fs::create_symlink(yaml, dir / "link.yaml");
+  fs::create_hard_link(csv, dir / "hard.csv");
+  const std::string relative = fs::relative(yaml).string();  // from the test's working folder
+  const struct {
+    std::vector<std::string> args;
+    const char* input;
+  } cases[] = {
+      {{"synth", "--trajectory", csv, "--out", csv}, "--trajectory"},
+      {{"synth", "--trajectory", csv, "--out", (dir / "hard.csv").string()}, "--trajectory"},
+      {{"synth", "--trajectory", csv, "--out", (dir / "x.csv").string(), "--run-out", csv}, "--trajectory"},
+      {{"linuxcnc", "--config", yaml, "--out", yaml}, "--config"},
+      {{"linuxcnc", "--config", relative, "--out", yaml}, "--config"},
+      {{"mjcf", "--config", yaml, "--out", (dir / "link.yaml").string()}, "--config"},
+      {{"mjcf", "--config", (dir / "link.yaml").string(), "--out", (dir / "." / "x.yaml").string()}, "--config"},
+      {{"identify", "--points", csv, "--trajectory", (dir / "t.csv").string(), "--out", csv}, "--points"},
+      {{"identify", "--config", yaml, "--points", (dir / "p.csv").string(), "--test", "Lz", "--out", yaml}, "--config"},
+      {{"dynamics", "--trajectory", csv, "--out", csv}, "--trajectory"},
+  };
+  const auto before = snapshot(dir);
+  for (const auto& c : cases) {
+    expect_error(run(c.args), 2, {c.input, "an output never replaces an input"});
+    EXPECT_EQ(snapshot(dir), before);
+  }
+}
+
+TEST(CliOutputs, TwoOutputsNamingOneFileAreRefusedHoweverTheyAreSpelled) {
+  const fs::path dir = temp_dir() / "two-outputs";
+  fs::create_directories(dir);
+  // In an empty folder, the second name is the first one absolute: one file, refused before
+  // anything runs.
+  const Outcome r = run({"synth", "--test", "Lz", "--out", (dir / "c.csv").string(), "--run-out",
+                         (dir / "sub" / ".." / "c.csv").string()});
+  expect_error(r, 2, {"--out", "--run-out", "c.csv", "nothing was written"});
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(CliOutputs, AFolderGivenAsAFileOutputIsRefusedNamingTheOption) {
+  expect_error(run({"mjcf", "--out", temp_dir().string()}), 2, {"--out", "is a folder"});
+  expect_error(run({"linuxcnc", "--out", temp_dir().string()}), 2, {"--out", "is a folder"});
+  expect_error(run({"simulate", "--trajectory", write_file("f.csv", heave_csv()), "--out", ""}), 2, {"--out"});
+}
+
+TEST(CliOutputs, AFolderReusedByAnotherCommandHoldsOnlyThatRunsFilesAndSaysSo) {
+  const std::string csv = write_file("h2.csv", heave_csv());
+  const fs::path out = temp_dir() / "H2";
+  ASSERT_EQ(run({"simulate", "--trajectory", csv, "--out", out.string(), "--no-figures"}).code, 0);
+  EXPECT_TRUE(fs::exists(out / "summary.md"));
+  EXPECT_TRUE(fs::exists(out / "h2_compensated.csv"));
+  const Outcome r = run({"dynamics", "--trajectory", csv, "--out", out.string(), "--no-figures"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("the earlier run was simulate"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("1 files replaced, 3 of an earlier run removed"), std::string::npos) << r.err;
+  EXPECT_EQ(folder_entries(out), (std::vector<std::string>{"h2_dynamics.csv", "summary.json"}));
+  const YAML::Node s = YAML::LoadFile((out / "summary.json").string());
+  EXPECT_EQ(s["command"].as<std::string>(), "dynamics");
+}
+
+}  // namespace

@@ -1,0 +1,68 @@
+// The one reader of configuration and data files (text_file.hpp): the whole file, a bound on its
+// size checked while reading (an endless device stops there), and one line naming the path.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "hexatwist/error.hpp"
+#include "hexatwist/io/text_file.hpp"
+
+namespace hexatwist {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh folder for this run's files, removed at exit.
+const fs::path& scratch() {
+  struct Dir {
+    fs::path path;
+    Dir() {
+      std::string tmpl = (fs::temp_directory_path() / "hexatwist_text_file_XXXXXX").string();
+      if (mkdtemp(tmpl.data()) == nullptr) std::abort();
+      path = tmpl;
+    }
+    ~Dir() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
+}
+
+std::string error_of(const std::string& path, std::size_t max) {
+  try {
+    (void)read_text_file(path, "test file", max);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(TextFile, ReadsTheWholeFileUpToItsBoundAndRefusesOneByteMore) {
+  const std::string path = (scratch() / "bytes.bin").string();
+  std::string bytes;
+  for (int k = 0; k < 70000; ++k) bytes += static_cast<char>(k * 7 % 256);  // more than one read's buffer
+  std::ofstream(path, std::ios::binary) << bytes;
+  EXPECT_EQ(read_text_file(path, "test file", bytes.size()), bytes);
+  const std::string msg = error_of(path, bytes.size() - 1);
+  EXPECT_NE(msg.find(path + ": longer than a test file may be, 69999 bytes"), std::string::npos) << msg;
+}
+
+TEST(TextFile, AFolderAMissingFileAndAnEndlessDeviceAreOneLineEach) {
+  std::ofstream((scratch() / "empty").string());
+  EXPECT_EQ(read_text_file((scratch() / "empty").string(), "test file", 10), "");
+  const std::string folder = error_of(scratch().string(), kMaxConfigBytes);
+  EXPECT_NE(folder.find(": is a directory, not a test file"), std::string::npos) << folder;
+  const std::string missing = error_of((scratch() / "none" / "x.yaml").string(), kMaxConfigBytes);
+  EXPECT_NE(missing.find(": cannot read the test file: No such file or directory"), std::string::npos) << missing;
+  const std::string endless = error_of("/dev/zero", kMaxConfigBytes);
+  EXPECT_NE(endless.find("/dev/zero: longer than a test file may be, 1048576 bytes"), std::string::npos) << endless;
+  for (const std::string& m : {folder, missing, endless}) EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+}
+
+}  // namespace
+}  // namespace hexatwist
