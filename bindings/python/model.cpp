@@ -106,82 +106,19 @@ ModelPtr from_arrays(const py::object& base, const py::object& platform, const p
   return std::make_shared<Model>(spec);
 }
 
-// Shortest text that reads back to the same double.
-std::string num(double x) {
-  char buf[32];
-  auto r = std::to_chars(buf, buf + sizeof buf, x);
-  return std::string(buf, r.ptr);
-}
-// Shortest decimal text of an angle in degrees that load_model turns back into exactly `rad`
-// (deg2rad of it == rad): rad2deg's nearest double does not always do that (1.5 deg -> rad -> deg
-// -> rad moves by one ulp). Every angle loaded from degrees has such a text; an angle given in
-// radians that no double in degrees maps to gets the nearest one.
-std::string degrees(double rad) {
-  const double d = rad2deg(rad);
-  if (!std::isfinite(d)) return num(d);
-  for (int precision = 1; precision <= 17; ++precision) {
-    for (double c : {d, std::nextafter(d, -INFINITY), std::nextafter(d, INFINITY)}) {
-      char buf[40];
-      auto r = std::to_chars(buf, buf + sizeof buf, c, std::chars_format::general, precision);
-      double back = 0.0;
-      std::from_chars(buf, r.ptr, back);
-      if (deg2rad(back) == rad) return num(back);
-    }
-  }
-  // Further neighbours (a few ulps away), shortest form.
-  double lo = d, hi = d;
-  for (int k = 0; k < 8; ++k) {
-    lo = std::nextafter(lo, -INFINITY);
-    hi = std::nextafter(hi, INFINITY);
-    if (deg2rad(lo) == rad) return num(lo);
-    if (deg2rad(hi) == rad) return num(hi);
-  }
-  return num(d);
-}
-std::string list3(const Vector3d& v) { return "[" + num(v[0]) + ", " + num(v[1]) + ", " + num(v[2]) + "]"; }
-
-std::string to_yaml(const Model& model) {
-  const ModelSpec& s = model.spec();
-  std::ostringstream o;
-  std::string name = s.name;
-  for (char& c : name)
-    if (c == '\n' || c == '"' || c == '\\') c = ' ';
-  const LegSpec& l0 = s.legs[0];
-  auto thread = [](ThreadSense t) { return t == ThreadSense::Right ? "right" : "left"; };
-  auto driven = [](DrivenSide d) { return d == DrivenSide::Base ? "base" : "platform"; };
-  o << "name: \"" << name << "\"\n";
-  o << "home_height: " << num(s.home_height) << "   # [m]\n";
-  o << "screw:\n  lead: " << num(l0.lead) << "\n  thread: " << thread(l0.thread)
-    << "\n  driven_side: " << driven(l0.driven) << "\n";
-  o << "legs:   # base [m, B], platform [m, P], fixed U-joint axes base_axis [B], platform_axis [P]\n";
-  for (const LegSpec& l : s.legs) {
-    o << "  - base: " << list3(l.base_B) << "\n    platform: " << list3(l.platform_P) << "\n";
-    if (l.axis_base_B != Vector3d::Zero()) o << "    base_axis: " << list3(l.axis_base_B) << "\n";
-    if (l.axis_platform_P != Vector3d::Zero()) o << "    platform_axis: " << list3(l.axis_platform_P) << "\n";
-    o << "    lead: " << num(l.lead) << "\n    thread: " << thread(l.thread)
-      << "\n    driven_side: " << driven(l.driven) << "\n";
-  }
-  o << "length_offsets: [";
-  for (int i = 0; i < kLegs; ++i) o << (i ? ", " : "") << num(s.legs[static_cast<std::size_t>(i)].length_offset);
-  o << "]\n";
-  o << "limits:\n  length_min: " << num(s.limits.length_min) << "\n  length_max: " << num(s.limits.length_max)
-    << "\n  bend_max_deg: " << degrees(s.limits.bend_max)
-    << "\n  singularity_margin_deg: " << degrees(s.limits.singularity_margin)
-    << "\n  jacobian_condition_max: " << num(s.limits.jacobian_condition_max) << "\n";
-  o << "observation_point: " << list3(s.observation_P) << "\npivot: " << list3(s.pivot_P) << "\n";
-  return o.str();
-}
+// The model as a configuration in the legs form (the library's writer: every double exact).
+std::string to_yaml(const Model& model) { return model_yaml(model.spec()); }
 
 // Pickle state: every number of the spec, exactly.
 py::tuple state_of(const Model& m) {
   const ModelSpec& s = m.spec();
   py::list legs;
   for (const LegSpec& l : s.legs)
-    legs.append(py::make_tuple(0, l.base_B[0], l.base_B[1], l.base_B[2], l.platform_P[0], l.platform_P[1],
-                               l.platform_P[2], l.axis_base_B[0], l.axis_base_B[1], l.axis_base_B[2],
-                               l.axis_platform_P[0], l.axis_platform_P[1], l.axis_platform_P[2], l.lead,
-                               static_cast<int>(l.thread), static_cast<int>(l.driven), l.length_offset));
-  return py::make_tuple(1, s.name, legs, s.home_height,
+    legs.append(py::make_tuple(
+        0, l.base_B[0], l.base_B[1], l.base_B[2], l.platform_P[0], l.platform_P[1], l.platform_P[2], l.axis_base_B[0],
+        l.axis_base_B[1], l.axis_base_B[2], l.axis_platform_P[0], l.axis_platform_P[1], l.axis_platform_P[2], l.lead,
+        static_cast<int>(l.thread), static_cast<int>(l.driven), l.length_offset, l.drive_lead, l.home_command));
+  return py::make_tuple(2, s.name, legs, s.home_height,
                         py::make_tuple(s.limits.length_min, s.limits.length_max, s.limits.bend_max,
                                        s.limits.singularity_margin, s.limits.jacobian_condition_max),
                         py::make_tuple(s.observation_P[0], s.observation_P[1], s.observation_P[2]),
@@ -189,7 +126,7 @@ py::tuple state_of(const Model& m) {
 }
 
 ModelPtr from_state(const py::tuple& t) {
-  if (t.size() != 7 || t[0].cast<int>() != 1) raise_input("Model pickle: unknown state");
+  if (t.size() != 7 || t[0].cast<int>() != 2) raise_input("Model pickle: unknown state");
   ModelSpec s;
   s.name = t[1].cast<std::string>();
   py::list legs = t[2];
@@ -205,6 +142,8 @@ ModelPtr from_state(const py::tuple& t) {
     g.thread = static_cast<ThreadSense>(l[14].cast<int>());
     g.driven = static_cast<DrivenSide>(l[15].cast<int>());
     g.length_offset = d(16);
+    g.drive_lead = d(17);
+    g.home_command = d(18);
   }
   s.home_height = t[3].cast<double>();
   py::tuple lim = t[4];

@@ -177,12 +177,15 @@ def study(config=None, test: str | None = None, poses=None) -> Result:
     return r
 
 
-def read_point_log(path_or_text, time_column: str = "t", length_unit: float = 0.0, indexed: bool = False) -> Result:
-    """A laser tracker's point log (CSV with a header; measurement.hpp): ``stamps`` (K,) [s] (or sample
-    indices), ``points`` (K, 3) [m, tracker frame T], ``lines`` (K,) source lines. Units come from the
-    column suffixes (``x_mm``, ``t_s``) or ``length_unit`` [m per unit]. Raises ConfigError with the
-    library's "source:line:column: ..." message."""
-    return Result(_core._read_point_log(path_or_text, time_column, length_unit, indexed))
+def read_point_log(path_or_text, time_column: str = "t", length_unit: float = 0.0, indexed: bool = False,
+                   target_column: str = "") -> Result:
+    """A laser tracker's point log (CSV with a header; point_log.hpp): ``stamps`` (K,) [s] (or sample
+    indices), ``points`` (K, 3) [m, tracker frame T], ``targets`` (K,) int (an index into
+    ``target_names``; 0 is the observation point), ``lines`` (K,) source lines. Units come from the
+    column suffixes (``x_mm``, ``t_s``) or ``length_unit`` [m per unit]; a ``target`` column (or
+    ``target_column``) names each row's target. Raises ConfigError with the library's
+    "source:line:column: ..." message."""
+    return Result(_core._read_point_log(path_or_text, time_column, length_unit, indexed, target_column))
 
 
 def measured_test(config=None, test: str = "Rz") -> Result:
@@ -191,28 +194,59 @@ def measured_test(config=None, test: str = "Rz") -> Result:
     return Result(_core._measured_test(config, test))
 
 
-def observations_at_rest(model: Model, t, poses, stamps, points, time_offset: float = 0.0,
+def stations_run(config=None, count: int = 40, seed: int = 1, strategy: str = "compensated",
+                 translation: float = 0.25, rotation: float = float(np.radians(15.0)), stations=None) -> Result:
+    """A calibration run (stations.hpp): home, ``count`` random stations within +-``translation`` [m] and
+    +-``rotation`` [rad] inside every limit (the same seed gives the CLI's ``--stations N --station-seed S``
+    run), or the given ``stations`` (N, 6) [m, rad], home; 1 s at each. ``t`` (T,) [s], ``poses`` (T, 6)
+    [m, rad] at the control rate, ``stations`` (N, 6)."""
+    return Result(_core._stations_run(config, count, seed, strategy, translation, rotation, stations))
+
+
+def observations_at_rest(model: Model, t, poses, stamps, points, targets=None, time_offset: float = 0.0,
                          strategy: str = "compensated", settle: float = 0.25) -> Result:
     """The log points taken while the commanded pose had been still for ``settle`` [s], each with the
     motor-side lengths the model commands there: ``motor`` (K, 6) [m], ``points`` (K, 3) [m, T],
-    ``index`` (log rows), ``poses`` (distinct poses). ``time_offset``: log time at trajectory t = 0 [s]."""
+    ``targets`` (K,), ``index`` (log rows), ``poses`` (stations). ``time_offset``: log time at trajectory
+    t = 0 [s]."""
     return Result(_core._observations_at_rest(model, np.asarray(t, dtype=np.float64), poses,
-                                              np.asarray(stamps, dtype=np.float64), points, time_offset,
+                                              np.asarray(stamps, dtype=np.float64), points, targets, time_offset,
                                               strategy, settle))
 
 
-def identify(model: Model, motor, points, lead_effect: str = "twist") -> Result:
-    """Identifies lead, twist sign, length offsets, observation point and the tracker placement X_BT
-    (identification.hpp) from observations ``motor`` (K, 6) [m] and ``points`` (K, 3) [m, T].
+def identify(model: Model, motor, points, targets=None, *, calibration: str = "geometry",
+             lead_effect: str = "travel", axes: str = "auto", tracker_noise=None, folds: int = 5,
+             accuracy_poses: int = 1000) -> Result:
+    """Calibrates the platform (identification.hpp, theory §13) from observations ``motor`` (K, 6) [m],
+    ``points`` (K, 3) [m, T] and their ``targets`` (K,) int (None: all the observation point), with the
+    library's decisions: the same status and estimate as ``hexatwist identify`` (whose defaults these are).
 
-    Returns ``status`` (name) and ``reason``; ``estimate`` (dict: lead [m], twist_sign, length_offsets
-    (6,) [m], observation_point (3,) [m, P], R_BT (3, 3), t_BT (3,) [m, B]); ``sd`` (16,) standard
-    deviations in the order of ``parameter_names`` [m; rad for the rotation]; ``covariance`` (16, 16);
-    ``sigma``, ``rms_before``, ``rms_after``, ``max_after`` [m]; ``residuals`` (K, 3) [m, B];
-    ``corrected_model`` (a Model, when ok).
+    ``calibration``: "geometry" (the twelve U-joint centres, leads, thread sense, offsets, targets,
+    tracker frame) or "basic" (the joints as configured); ``lead_effect`` "travel" | "twist"; ``axes``
+    "auto" | "none" | "all"; ``tracker_noise`` [m] (None: the scatter at rest); ``folds`` of the
+    cross-validation (0: none).
+
+    Returns ``status`` ("ok", "not_identifiable", "model_mismatch", "sign_undecided", ...), ``reason``
+    and ``hint``; ``parameter_names``, ``nominal``, ``estimate``, ``sd``, ``covariance`` (SI, the tracker
+    rotation as dw about ``R_BT``); ``twist_sign``; ``R_BT``, ``t_BT`` [m, B]; ``corrected`` (dict of the
+    corrected platform: base_joints, platform_joints (6, 3) [m], axes, leads, threads, length_offsets,
+    home_commands, drive_leads [m], observation_point) and ``corrected_model`` (a Model when ok);
+    ``base_shift``/``platform_shift`` and their ``_sd`` (6, 3) [m]; ``axis_sd`` (12,) [rad] and
+    ``axes_fitted``; ``targets`` [m, P]; the fit: ``sigma``, ``tracker_noise``, ``scatter``,
+    ``fit_statistic``, ``fit_dof``, ``fit_z``, ``worst`` stations, ``rms_before``, ``rms_after``,
+    ``max_after`` [m], ``residuals`` (K, 3) [m, B]; ``fits`` (both senses), ``cost_ratio``,
+    ``sign_separation``, ``condition``, ``undetermined``; ``cross_validation`` and ``accuracy`` (dicts,
+    [m]).
     """
-    return Result(_core._identify(model, np.ascontiguousarray(motor, dtype=np.float64),
-                                  np.ascontiguousarray(points, dtype=np.float64), lead_effect))
+    return Result(_core._identify(model, motor, points, targets, calibration, lead_effect, axes, tracker_noise,
+                                  folds, accuracy_poses))
+
+
+def corrected_config(config, corrected: Model, header: str = "") -> str:
+    """The configuration ``config`` (YAML text, a path, or None for the seed) with its platform replaced by
+    ``corrected`` (an identification's ``corrected_model``) in the legs form, the drives' reference
+    recorded, every other key kept (platform_yaml.hpp): what ``hexatwist identify`` writes."""
+    return _core._corrected_config(config, corrected, header)
 
 
 def platform_motion(poses, pose_rates, pose_accelerations) -> Result:

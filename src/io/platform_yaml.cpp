@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <charconv>
 #include <cmath>
 #include <initializer_list>
 #include <set>
@@ -16,6 +17,33 @@ namespace {
 
 // Shortest text that reads back to the same double.
 YAML::Node number(double v) { return YAML::Node(fmt::format("{}", v)); }
+
+// The shortest degrees text that load_config turns back into exactly `rad` (deg2rad of it == rad):
+// rad2deg's nearest double does not always do that (1.5 deg -> rad -> deg -> rad moves by one
+// ulp). Every angle loaded from degrees has such a text; an angle given in radians that no double
+// in degrees maps to gets the nearest one.
+YAML::Node degrees(double rad) {
+  const double d = rad2deg(rad);
+  if (!std::isfinite(d)) return number(d);
+  for (int precision = 1; precision <= 17; ++precision) {
+    for (const double c : {d, std::nextafter(d, -INFINITY), std::nextafter(d, INFINITY)}) {
+      char buf[40];
+      const auto r = std::to_chars(buf, buf + sizeof buf, c, std::chars_format::general, precision);
+      double back = 0.0;
+      std::from_chars(buf, r.ptr, back);
+      if (deg2rad(back) == rad) return number(back);
+    }
+  }
+  // Further neighbours (a few ulps away).
+  double lo = d, hi = d;
+  for (int k = 0; k < 8; ++k) {
+    lo = std::nextafter(lo, -INFINITY);
+    hi = std::nextafter(hi, INFINITY);
+    if (deg2rad(lo) == rad) return number(lo);
+    if (deg2rad(hi) == rad) return number(hi);
+  }
+  return number(d);
+}
 
 YAML::Node flow(std::initializer_list<double> values) {
   YAML::Node list(YAML::NodeType::Sequence);
@@ -59,12 +87,8 @@ YAML::Node legs_node(const ModelSpec& platform) {
   return legs;
 }
 
-}  // namespace
-
-std::string platform_config_yaml(std::string_view yaml_text, std::string_view source, const ModelSpec& platform,
-                                 std::string_view header, bool write_home_commands) {
-  (void)load_config(yaml_text, source);  // located errors for text that does not load
-  const Model model(platform);           // and a platform that is no model
+// The platform block, in the order the legs form reads.
+YAML::Node platform_block(const ModelSpec& platform, const Model& model, bool write_home_commands) {
   const LegSpec& first = platform.legs[0];
   // The platform block, in the order the legs form reads.
   YAML::Node block(YAML::NodeType::Map);
@@ -88,6 +112,42 @@ std::string platform_config_yaml(std::string_view yaml_text, std::string_view so
   block["length_offsets"] = flow(offsets);
   if (write_home_commands || homes_differ) block["home_commands"] = flow(homes);
   block["observation_point"] = flow(platform.observation_P);
+  return block;
+}
+
+std::string with_header(std::string_view header, const YAML::Node& root) {
+  std::string text;
+  for (std::size_t begin = 0; begin < header.size();) {
+    const std::size_t end = std::min(header.find('\n', begin), header.size());
+    text += "# " + std::string(header.substr(begin, end - begin)) + "\n";
+    begin = end + 1;
+  }
+  YAML::Emitter out;
+  out << root;
+  return text + out.c_str() + "\n";
+}
+
+}  // namespace
+
+std::string model_yaml(const ModelSpec& spec) {
+  const Model model(spec);
+  YAML::Node root = platform_block(spec, model, false);
+  YAML::Node limits(YAML::NodeType::Map);
+  limits["length_min"] = number(spec.limits.length_min);
+  limits["length_max"] = number(spec.limits.length_max);
+  limits["bend_max_deg"] = degrees(spec.limits.bend_max);
+  limits["singularity_margin_deg"] = degrees(spec.limits.singularity_margin);
+  limits["jacobian_condition_max"] = number(spec.limits.jacobian_condition_max);
+  root["limits"] = limits;
+  root["pivot"] = flow(spec.pivot_P);
+  return with_header({}, root);
+}
+
+std::string platform_config_yaml(std::string_view yaml_text, std::string_view source, const ModelSpec& platform,
+                                 std::string_view header, bool write_home_commands) {
+  (void)load_config(yaml_text, source);  // located errors for text that does not load
+  const Model model(platform);           // and a platform that is no model
+  const YAML::Node block = platform_block(platform, model, write_home_commands);
   // The user's keys in their order, the platform block where its first key stood.
   const YAML::Node original = YAML::Load(std::string(yaml_text));
   YAML::Node root(YAML::NodeType::Map);
@@ -105,15 +165,7 @@ std::string platform_config_yaml(std::string_view yaml_text, std::string_view so
   if (!placed)
     for (const auto& b : block) root[b.first.as<std::string>()] = b.second;
 
-  std::string text;
-  for (std::size_t begin = 0; begin < header.size();) {
-    const std::size_t end = std::min(header.find('\n', begin), header.size());
-    text += "# " + std::string(header.substr(begin, end - begin)) + "\n";
-    begin = end + 1;
-  }
-  YAML::Emitter out;
-  out << root;
-  text += std::string(out.c_str()) + "\n";
+  const std::string text = with_header(header, root);
   (void)load_config(text, source);  // what is written loads (a bug here must not reach a file)
   return text;
 }

@@ -23,4 +23,9 @@ namespace hexatwist {
 std::string platform_config_yaml(std::string_view yaml_text, std::string_view source, const ModelSpec& platform,
                                  std::string_view header, bool write_home_commands);
 
+/// The model `spec` alone as a configuration in the legs form: the platform block as above, its
+/// limits (angles in degrees, as the file takes them) and pivot, nothing else. Loads back to the
+/// same model, every double exactly. Throws hexatwist::Error if `spec` is no model.
+std::string model_yaml(const ModelSpec& spec);
+
 }  // namespace hexatwist
