@@ -2,17 +2,24 @@
 
     PYTHONPATH=build/python /usr/bin/python3 bench/python/bench_python.py [--reps 15]
 
-Measures 10^6 compensated commands from an (N, 6) array (targets: <= 0.1 s on two cores), one pose
-through motor_command (target: <= 2 us of overhead over the library's own call), and 10^6 motor-side
-forward kinematics, warm-started along a path.
+Measures, in one run: 10^6 compensated commands from an (N, 6) array on two threads and on one
+(the poses across the SIMD lanes, batch.hpp; target: <= 25 ms on two cores), the same computation in
+plain numpy (bench/python/numpy_commands.py, checked against the library first), inverse kinematics
+in full and lengths only, one pose through motor_command (target: <= 2 us of overhead over the
+library's own call), and 10^6 motor-side forward kinematics, warm-started along a path.
 """
 import argparse
+import os
 import statistics
+import sys
 import time
 
 import numpy as np
 
 import hexatwist
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import numpy_commands  # noqa: E402
 
 
 def timed(f, reps):
@@ -25,6 +32,10 @@ def timed(f, reps):
     return statistics.median(times), max(times)
 
 
+def ms(t):
+    return f"median {t[0] * 1e3:.1f} ms, worst {t[1] * 1e3:.1f} ms"
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--reps", type=int, default=15)
@@ -33,10 +44,30 @@ def main():
     m = hexatwist.default_model()
     rng = np.random.default_rng(1)
     q = rng.uniform(-1, 1, (a.n, 6)) * [0.2, 0.2, 0.2, 0.15, 0.15, 0.15]
-    ok = hexatwist.commands(m, q).ok.mean()
-    med, worst = timed(lambda: hexatwist.commands(m, q, strategy="compensated"), a.reps)
-    print(f"commands, {a.n} poses ({100 * ok:.1f}% inside limits): median {med * 1e3:.1f} ms, worst {worst * 1e3:.1f} ms"
-          f" ({med / a.n * 1e9:.0f} ns/pose)")
+    r = hexatwist.commands(m, q)
+    print(f"{a.n} poses, {100 * r.ok.mean():.2f}% inside every limit; load average {os.getloadavg()[0]:.1f} "
+          f"on {os.cpu_count()} CPUs")
+    # The numpy version decides and computes alike: checked before it is timed.
+    nm = numpy_commands.NumpyModel(m)
+    c, accepted = numpy_commands.compensated_commands_chunked(nm, q)
+    agree = (accepted == r.ok).mean()
+    diff = np.abs(c[accepted & r.ok] - r.commands[accepted & r.ok]).max()
+    print(f"numpy version: the same accept/refuse for {100 * agree:.4f}% of the poses, commands within {diff:.1e} m")
+    results = {}
+    for threads in (2, 1):
+        hexatwist.set_num_threads(threads)
+        results[threads] = timed(lambda: hexatwist.commands(m, q, strategy="compensated"), a.reps)
+        print(f"commands (compensated), {threads} thread(s): {ms(results[threads])} "
+              f"({results[threads][0] / a.n * 1e9:.1f} ns/pose)")
+    hexatwist.set_num_threads(2)
+    print(f"  second thread: {results[1][0] / results[2][0]:.2f}x")
+    t_np = timed(lambda: numpy_commands.compensated_commands_chunked(nm, q), max(3, a.reps // 5))
+    print(f"plain numpy, the same computation (blocks of 4096 poses), 1 thread: {ms(t_np)}: "
+          f"{t_np[0] / results[2][0]:.0f}x the library on 2 threads")
+    ik = timed(lambda: hexatwist.inverse_kinematics(m, q), max(3, a.reps // 3))
+    ik_l = timed(lambda: hexatwist.inverse_kinematics(m, q, lengths_only=True), a.reps)
+    print(f"inverse_kinematics, 2 threads: full (axes, bends) {ms(ik)}; lengths_only {ms(ik_l)}: "
+          f"{ik_l[0] / results[2][0]:.2f}x commands")
     pose = [0.1, -0.05, 0.1, 0.05, -0.02, 0.1]
     arr = np.array(pose)
     k = 20000

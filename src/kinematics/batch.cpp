@@ -27,12 +27,27 @@ struct PosePacket {
   lane_v q[6];
 };
 
+// Lane p = r[6 p] (a column of the rows), built in registers: through a buffer, scalar stores
+// followed by a vector load stall on store forwarding.
+inline lane_v column(const double* r) noexcept {
+#if HEXATWIST_LANE_WIDTH == 8
+  return lane_v{r[0], r[6], r[12], r[18], r[24], r[30], r[36], r[42]};
+#elif HEXATWIST_LANE_WIDTH == 4
+  return lane_v{r[0], r[6], r[12], r[18]};
+#else
+  return lane_v{r[0], r[6]};
+#endif
+}
+
 PosePacket load_poses(const double* rows, int n) noexcept {
-  alignas(64) double t[6][kPoses] = {};
-  for (int p = 0; p < n; ++p)
-    for (int c = 0; c < 6; ++c) t[c][p] = rows[6 * p + c];
   PosePacket out;
-  std::memcpy(out.q, t, sizeof t);
+  if (n == kPoses) {
+    for (int c = 0; c < 6; ++c) out.q[c] = column(rows + c);
+    return out;
+  }
+  double padded[6 * kPoses] = {};  // the batch's last poses, then home
+  std::memcpy(padded, rows, sizeof(double) * 6 * static_cast<std::size_t>(n));
+  for (int c = 0; c < 6; ++c) out.q[c] = column(padded + c);
   return out;
 }
 
@@ -63,7 +78,7 @@ lane_m computable(const PosePacket& p) noexcept {
 
 // Eq. (3) per lane. For |angle| <= 0.78 the full sin_cos reduces with k = 0 exactly, which is what
 // the single pose's shortcut (sin_cos_reduced) computes.
-LaneRotation<lane_v> rotation_of(const PosePacket& p) noexcept {
+[[gnu::always_inline]] inline LaneRotation<lane_v> rotation_of(const PosePacket& p) noexcept {
   lane_v s[3], c[3];
   for (int k = 0; k < 3; ++k) sin_cos(p.q[3 + k], s[k], c[k]);
   return rotation_rzyx(s[0], c[0], s[1], c[1], s[2], c[2]);
