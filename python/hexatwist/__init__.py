@@ -230,8 +230,10 @@ def inverse_dynamics(config, poses, pose_rates, pose_accelerations) -> Result:
     (positive lengthens the leg), motor ``angle`` from home [rad], ``speed`` [rad/s], ``acceleration``
     [rad/s^2], ``power`` = torque * speed [W] (negative: the load drives the motor); the torque's parts, which
     add up to it (to rounding), ``gravity``, ``platform_inertia``, ``velocity_product``, ``legs``, ``drives``,
-    ``friction`` [N m]; ``screw_force`` axial force in the nut, tension positive [N]; and ``status`` (N,) int8
-    (NaN rows unless ok; limits are not checked). Batch like :func:`commands`: GIL released, threads.
+    ``friction`` [N m]; ``screw_force`` axial force in the nut, tension positive [N]; ``thread_speed`` the nut's
+    sliding along the screw as a motor speed, real length rate / motor gain [rad/s], and ``thread_dissipation``
+    the power the screw's efficiency loses in the thread (>= 0) [W]; and ``status`` (N,) int8 (NaN rows unless
+    ok; limits are not checked). Batch like :func:`commands`: GIL released, threads.
     """
     return Result(_core._inverse_dynamics(config, poses, pose_rates, pose_accelerations))
 
