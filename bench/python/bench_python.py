@@ -50,10 +50,11 @@ m = hexatwist.default_model()
 q = np.random.default_rng(1).uniform(-1, 1, (n, 6)) * [0.2, 0.2, 0.2, 0.15, 0.15, 0.15]
 def timed(f, reps):
     f()
-    t = []
+    t, c = [], []
     for _ in range(reps):
-        t0 = time.perf_counter(); f(); t.append(time.perf_counter() - t0)
-    return statistics.median(t), max(t)
+        t0, c0 = time.perf_counter(), time.process_time(); f()
+        t.append(time.perf_counter() - t0); c.append(time.process_time() - c0)
+    return statistics.median(t), max(t), statistics.median(c)
 for threads in (2, 1):
     hexatwist.set_num_threads(threads)
     print("commands", threads, *timed(lambda: hexatwist.commands(m, q), reps))
@@ -65,7 +66,7 @@ def baseline(path, n, reps):
     env = dict(os.environ, PYTHONPATH=path)
     out = subprocess.run([sys.executable, "-c", BASELINE, str(n), str(reps)], env=env, check=True,
                          capture_output=True, text=True).stdout
-    return {(f, int(t)): (float(a), float(b)) for f, t, a, b in (line.split() for line in out.splitlines())}
+    return {(f, int(t)): (float(a), float(b), float(c)) for f, t, a, b, c in (line.split() for line in out.splitlines())}
 
 
 def main():
@@ -108,21 +109,21 @@ def main():
         b = baseline(a.baseline, a.n, a.reps)
         for threads in (2, 1):
             c, i = b[("commands", threads)], b[("inverse_kinematics", threads)]
-            print(f"baseline {a.baseline}, {threads} thread(s): commands median {c[0] * 1e3:.1f} ms "
-                  f"(worst {c[1] * 1e3:.1f}): {c[0] / results[threads][0]:.2f}x this build's; "
-                  f"inverse_kinematics median {i[0] * 1e3:.1f} ms: {i[0] / c[0]:.1f}x its commands")
+            print(f"baseline {a.baseline}, {threads} thread(s): commands {ms(c)}: {c[0] / results[threads][0]:.2f}x "
+                  f"this build's (cpu {c[2] / results[threads][2]:.2f}x); inverse_kinematics {ms(i)}: "
+                  f"{i[0] / c[0]:.1f}x its commands")
     pose = [0.1, -0.05, 0.1, 0.05, -0.02, 0.1]
     arr = np.array(pose)
     k = 20000
     for name, p in (("list", pose), ("array", arr)):
-        med, worst = timed(lambda: [hexatwist.motor_command(m, p) for _ in range(k)], max(5, a.reps // 3))
+        med, worst, _ = timed(lambda: [hexatwist.motor_command(m, p) for _ in range(k)], max(5, a.reps // 3))
         print(f"motor_command, one pose ({name}): median {med / k * 1e6:.2f} us per call, worst {worst / k * 1e6:.2f} us")
     one = arr.reshape(1, 6)
-    med, _ = timed(lambda: [hexatwist.commands(m, one) for _ in range(k)], max(5, a.reps // 3))
+    med, _, _ = timed(lambda: [hexatwist.commands(m, one) for _ in range(k)], max(5, a.reps // 3))
     print(f"commands, a (1, 6) batch: median {med / k * 1e6:.2f} us per call")
     path = np.linspace(0, 1, a.n)[:, None] * np.array([0.2, -0.1, 0.25, 0.1, -0.15, 0.3])
     lengths = hexatwist.commands(m, path).commands
-    med, worst = timed(lambda: hexatwist.forward(m, lengths), max(3, a.reps // 5))
+    med, worst, _ = timed(lambda: hexatwist.forward(m, lengths), max(3, a.reps // 5))
     print(f"forward (motor, warm-started), {a.n} poses: median {med * 1e3:.0f} ms, worst {worst * 1e3:.0f} ms")
 
 
