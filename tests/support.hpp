@@ -80,6 +80,16 @@ inline Pose random_valid_pose(const Model& model, std::mt19937_64& rng, double d
   }
 }
 
+/// The seed platform with stroke and bend limits wide enough for a pure yaw to 90 deg: only the
+/// platform-singularity limit stops it (the condition proof and the exact number decide there).
+inline Model seed_with_wide_limits() {
+  ModelSpec spec = seed_model().spec();
+  spec.limits.length_min = 0.5;
+  spec.limits.length_max = 4.0;
+  spec.limits.bend_max = deg2rad(89);
+  return Model(spec);
+}
+
 /// The seed platform with zero errors (length offsets) drawn uniformly in [-max_offset, max_offset] [m].
 inline Model seed_with_offsets(std::mt19937_64& rng, double max_offset) {
   ModelSpec spec = seed_model().spec();

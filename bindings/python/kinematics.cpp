@@ -5,8 +5,33 @@
 namespace hexatwist::python {
 namespace {
 
-py::dict ik_batch(const Model& model, const py::object& poses_in) {
+// Leg lengths only, the poses across the lanes (batch.hpp).
+py::dict lengths_batch(const Model& model, const Rows6& poses) {
+  const std::size_t n = poses.rows;
+  auto lengths = new_rows(n, 6, poses.single);
+  auto status = new_column<std::int8_t>(n, poses.single);
+  double* pl = lengths.mutable_data();
+  std::int8_t* ps = status.mutable_data();
+  const double* q = poses.data;
+  parallel_blocks(n, [&](std::size_t begin, std::size_t end) {
+    constexpr std::size_t kChunk = 256;
+    Status st[kChunk];
+    for (std::size_t first = begin; first < end; first += kChunk) {
+      const std::size_t m = std::min(kChunk, end - first);
+      (void)leg_lengths_batch(model, {q + 6 * first, 6 * m}, {pl + 6 * first, 6 * m}, {st, m});  // consistent spans
+      for (std::size_t i = 0; i < m; ++i) ps[first + i] = static_cast<std::int8_t>(st[i]);
+    }
+  });
+  raise_non_finite(ps, n, "poses");
+  py::dict d;
+  d["lengths"] = lengths;
+  d["status"] = status;
+  return d;
+}
+
+py::dict ik_batch(const Model& model, const py::object& poses_in, bool lengths_only) {
   const Rows6 poses = rows6(poses_in, "poses");
+  if (lengths_only) return lengths_batch(model, poses);
   const std::size_t n = poses.rows;
   auto lengths = new_rows(n, 6, poses.single);
   py::array_t<double> axes = poses.single
@@ -85,7 +110,7 @@ py::dict twist_batch(const Model& model, const py::object& poses_in) {
 }  // namespace
 
 void expose_kinematics(py::module_& m) {
-  m.def("_ik", &ik_batch, py::arg("model"), py::arg("poses"));
+  m.def("_ik", &ik_batch, py::arg("model"), py::arg("poses"), py::arg("lengths_only") = false);
   m.def("_twist", &twist_batch, py::arg("model"), py::arg("poses"));
 }
 

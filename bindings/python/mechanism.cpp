@@ -32,9 +32,9 @@ Rows6 matching(const py::object& obj, const char* name, const Rows6& poses) {
   return r;
 }
 
-constexpr std::array<const char*, 12> kParts{
-    "torque",           "angle", "speed",  "acceleration", "power",      "gravity", "platform_inertia",
-    "velocity_product", "legs",  "drives", "friction",     "screw_force"};
+constexpr std::array<const char*, 14> kParts{
+    "torque",           "angle", "speed",  "acceleration", "power",       "gravity",      "platform_inertia",
+    "velocity_product", "legs",  "drives", "friction",     "screw_force", "thread_speed", "thread_dissipation"};
 
 py::dict inverse_dynamics_batch(const py::object& config, const py::object& poses_in, const py::object& rates_in,
                                 const py::object& accelerations_in) {
@@ -74,7 +74,9 @@ py::dict inverse_dynamics_batch(const py::object& config, const py::object& pose
                                                          &id.legs,
                                                          &id.drives,
                                                          &id.friction,
-                                                         &id.screw_force};
+                                                         &id.screw_force,
+                                                         &id.thread_speed,
+                                                         &id.thread_dissipation};
       for (std::size_t j = 0; j < kParts.size(); ++j)
         for (int k = 0; k < 6; ++k) p[j][6 * i + k] = s == Status::Ok ? (*v[j])[k] : NAN;
     }

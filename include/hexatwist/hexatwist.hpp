@@ -5,6 +5,7 @@
 #include "hexatwist/status.hpp"
 #include "hexatwist/types.hpp"
 
+#include "hexatwist/kinematics/batch.hpp"
 #include "hexatwist/kinematics/compensation.hpp"
 #include "hexatwist/kinematics/forward.hpp"
 #include "hexatwist/kinematics/kinematics.hpp"

@@ -89,14 +89,16 @@ class Result(dict):
         return self["status"] == 0
 
 
-def inverse_kinematics(model: Model, poses) -> Result:
+def inverse_kinematics(model: Model, poses, lengths_only: bool = False) -> Result:
     """Inverse kinematics, paper Eq. (1)-(4), of (N, 6) poses [m, rad].
 
     Returns ``lengths`` (N, 6) joint-to-joint leg lengths [m], ``axes`` (N, 6, 3) unit leg axes base to
     platform [-, B], ``bend_base`` and ``bend_platform`` (N, 6) U-joint bends from home [rad], and
     ``status`` (N,) int8 (ok, or stroke_below_min for a zero-length leg; limits are not checked here).
+    ``lengths_only=True`` returns ``lengths`` and ``status`` alone, the same numbers bit for bit, with
+    the poses across the SIMD lanes (the library's leg_lengths_batch): a fraction of the time.
     """
-    return Result(_core._ik(model, poses))
+    return Result(_core._ik(model, poses, lengths_only))
 
 
 def twist(model: Model, poses) -> Result:
@@ -268,8 +270,10 @@ def inverse_dynamics(config, poses, pose_rates, pose_accelerations) -> Result:
     (positive lengthens the leg), motor ``angle`` from home [rad], ``speed`` [rad/s], ``acceleration``
     [rad/s^2], ``power`` = torque * speed [W] (negative: the load drives the motor); the torque's parts, which
     add up to it (to rounding), ``gravity``, ``platform_inertia``, ``velocity_product``, ``legs``, ``drives``,
-    ``friction`` [N m]; ``screw_force`` axial force in the nut, tension positive [N]; and ``status`` (N,) int8
-    (NaN rows unless ok; limits are not checked). Batch like :func:`commands`: GIL released, threads.
+    ``friction`` [N m]; ``screw_force`` axial force in the nut, tension positive [N]; ``thread_speed`` the nut's
+    sliding along the screw as a motor speed, real length rate / motor gain [rad/s], and ``thread_dissipation``
+    the power the screw's efficiency loses in the thread (>= 0) [W]; and ``status`` (N,) int8 (NaN rows unless
+    ok; limits are not checked). Batch like :func:`commands`: GIL released, threads.
     """
     return Result(_core._inverse_dynamics(config, poses, pose_rates, pose_accelerations))
 

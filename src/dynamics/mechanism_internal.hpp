@@ -13,6 +13,8 @@ struct DriveLoad {
                              ///< included) [1/(kg m^2)]
   Vector6d load;             ///< L = -J_phi^-T bias + A J_phi' x': gravity and velocity products at the motors [N m]
   Vector6d screw_torque;     ///< torque the screws pass to the load at the motor acceleration given [N m]
+  Vector6d thread_loss;      ///< the threads' efficiency losses as torques at the motors (thread_loss, theory §14)
+                             ///< at the motor speeds and acceleration given [N m]
   Vector6d velocity;         ///< the platform velocity [v; w] for the motor speeds given
 };
 
@@ -20,8 +22,5 @@ struct DriveLoad {
 /// `twist` false for a plant whose legs do not twist (real length = motor-side length).
 [[nodiscard]] Status drive_load(const Rig& rig, const LegState& legs, const Vector6d& speed,
                                 const Vector6d& motor_acceleration, bool twist, DriveLoad& out) noexcept;
-
-/// The screw efficiency's share of drive_friction [N m].
-Vector6d efficiency_loss(const Rig& rig, const Vector6d& speed, const Vector6d& screw_torque) noexcept;
 
 }  // namespace hexatwist::detail

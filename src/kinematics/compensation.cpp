@@ -1,5 +1,6 @@
 #include "hexatwist/kinematics/compensation.hpp"
 
+#include "kinematics/compensation_internal.hpp"
 #include "kinematics/lanes.hpp"
 #include "kinematics/twist_internal.hpp"
 
@@ -116,6 +117,11 @@ Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, V
     return Status::Ok;
   }
   // Some test failed: the same computation through a LegState, which names the leg and limit.
+  return detail::commands_through_state(model, pose, compensated, command, report);
+}
+
+Status detail::commands_through_state(const Model& model, const Pose& pose, bool compensated, Vector6d& command,
+                                      LimitReport& report) noexcept {
   LegState legs;
   // The Placement overload: the Pose one would test finiteness a second time.
   if (const Status s = inverse_kinematics(model, placement_from_pose(pose), legs); s != Status::Ok)

@@ -129,9 +129,10 @@ template <class V>
 inline vec3<V> operator-(const vec3<V>& a, const vec3<V>& b) noexcept {
   return {a.x - b.x, a.y - b.y, a.z - b.z};
 }
-/// R times each lane's vector.
-template <class V>
-inline vec3<V> rotate(const Matrix3d& R, const vec3<V>& v) noexcept {
+/// R times each lane's vector: R a Matrix3d (one rotation for every lane) or a LaneRotation (one
+/// per lane).
+template <class M, class V>
+inline vec3<V> rotate(const M& R, const vec3<V>& v) noexcept {
   return {R(0, 0) * v.x + R(0, 1) * v.y + R(0, 2) * v.z, R(1, 0) * v.x + R(1, 1) * v.y + R(1, 2) * v.z,
           R(2, 0) * v.x + R(2, 1) * v.y + R(2, 2) * v.z};
 }
@@ -255,16 +256,30 @@ inline void sin_cos(const Vector3d& a, Vector3d& s, Vector3d& c) noexcept {
 #endif
 }
 
+/// A rotation matrix per lane (lane p: pose p of a batch), entries m[row][column].
+template <class V>
+struct LaneRotation {
+  V m[3][3];
+  const V& operator()(int row, int column) const noexcept { return m[row][column]; }
+};
+
+/// Eq. (3): R = Rz(q6) Ry(q5) Rx(q4) from the sines and cosines of roll (4), pitch (5) and yaw (6),
+/// written out to avoid three matrix products; T a double or a vector of lanes. One expression
+/// for both, so that a batch's lanes round as the single pose does.
+template <class T>
+inline LaneRotation<T> rotation_rzyx(T s4, T c4, T s5, T c5, T s6, T c6) noexcept {
+  return {{{c5 * c6, s4 * s5 * c6 - c4 * s6, c4 * s5 * c6 + s4 * s6},
+           {c5 * s6, s4 * s5 * s6 + c4 * c6, c4 * s5 * s6 - s4 * c6},
+           {-s5, s4 * c5, c4 * c5}}};
+}
+
 /// Eq. (3), inlined into the real-time kernels (hexatwist::rotation_from_rpy calls it).
 inline Matrix3d rotation_from_rpy(const Vector3d& rpy) noexcept {
-  // Eq. (3): R = Rz(q6) Ry(q5) Rx(q4), written out to avoid three matrix products.
   Vector3d sn, cs;
   sin_cos(rpy, sn, cs);
-  const double c4 = cs[0], s4 = sn[0], c5 = cs[1], s5 = sn[1], c6 = cs[2], s6 = sn[2];
+  const LaneRotation<double> r = rotation_rzyx(sn[0], cs[0], sn[1], cs[1], sn[2], cs[2]);
   Matrix3d R;
-  R << c5 * c6, s4 * s5 * c6 - c4 * s6, c4 * s5 * c6 + s4 * s6,  //
-      c5 * s6, s4 * s5 * s6 + c4 * c6, c4 * s5 * s6 - s4 * c6,   //
-      -s5, s4 * c5, c4 * c5;
+  R << r.m[0][0], r.m[0][1], r.m[0][2], r.m[1][0], r.m[1][1], r.m[1][2], r.m[2][0], r.m[2][1], r.m[2][2];
   return R;
 }
 

@@ -109,19 +109,28 @@ struct LegsAt {
   lane_v length;         ///< |L_i| [m]
 };
 
-inline LegsAt legs_at(const Model& model, const Matrix3d& R_BP, const Vector3d& t, int k) noexcept {
-  const LegLanes& g = model.geometry().lanes;
+/// The same from the legs' constants as vectors (one leg per lane, or one leg in every lane for a
+/// batch of poses, batch.cpp) and the platform's origin pivot_home + t [m, B]; R_BP a Matrix3d or
+/// a LaneRotation.
+template <class M>
+inline LegsAt legs_at(const M& R_BP, const lanes3& origin_B, const lanes3& arm_P, const lanes3& axis_platform_P,
+                      const lanes3& base_B) noexcept {
   LegsAt out;
-  out.arm = rotate(R_BP, load_lanes(g.arm_P, k));
-  out.axis_platform = rotate(R_BP, load_lanes(g.axis_platform_P, k));
-  const Vector3d origin_B = model.pivot_home_B() + t;
-  const lanes3 base = load_lanes(g.base_B, k);
+  out.arm = rotate(R_BP, arm_P);
+  out.axis_platform = rotate(R_BP, axis_platform_P);
   // L_i = (pivot_home + t) + R_BP * arm_P,i - base_B,i.
-  out.leg = {(out.arm.x - base.x) + origin_B.x(), (out.arm.y - base.y) + origin_B.y(),
-             (out.arm.z - base.z) + origin_B.z()};
+  out.leg = {(out.arm.x - base_B.x) + origin_B.x, (out.arm.y - base_B.y) + origin_B.y,
+             (out.arm.z - base_B.z) + origin_B.z};
   out.length2 = dot(out.leg, out.leg);
   out.length = vsqrt(out.length2);
   return out;
+}
+
+inline LegsAt legs_at(const Model& model, const Matrix3d& R_BP, const Vector3d& t, int k) noexcept {
+  const LegLanes& g = model.geometry().lanes;
+  const Vector3d origin_B = model.pivot_home_B() + t;
+  const lanes3 origin = {splat<lane_v>(origin_B.x()), splat<lane_v>(origin_B.y()), splat<lane_v>(origin_B.z())};
+  return legs_at(R_BP, origin, load_lanes(g.arm_P, k), load_lanes(g.axis_platform_P, k), load_lanes(g.base_B, k));
 }
 
 /// What the pose limits test, per leg, for leg directions u = scale * s (u = s, scale = 1, or
@@ -137,10 +146,16 @@ struct LimitTerms {
   lane_v dot_d;         ///< u . jd (0 for legs without axes)
 };
 
+/// The same for home directions `home` [-, B] as vectors, R_BP a Matrix3d or a LaneRotation.
+template <class M>
+inline LimitTerms limit_terms(const M& R_BP, const lanes3& u, lane_v scale, lane_v length, lane_v dot_a, lane_v dot_d,
+                              const lanes3& home) noexcept {
+  return {length, scale, dot(u, home), dot(u, rotate(R_BP, home)), dot_a, dot_d};
+}
+
 inline LimitTerms limit_terms(const Model& model, const Matrix3d& R_BP, const lanes3& u, lane_v scale, lane_v length,
                               lane_v dot_a, lane_v dot_d, int k) noexcept {
-  const lanes3 home = load_lanes(model.geometry().lanes.s_home_B, k);
-  return {length, scale, dot(u, home), dot(u, rotate(R_BP, home)), dot_a, dot_d};
+  return limit_terms(R_BP, u, scale, length, dot_a, dot_d, load_lanes(model.geometry().lanes.s_home_B, k));
 }
 
 /// Lanes within every pose limit, bounds included with the tolerance of limits.hpp (the Model's
@@ -183,17 +198,25 @@ inline constexpr double kSingularSin2 = 1e-24;
 
 /// Lanes away from a U-joint singularity or without axes, for (x, y) scaled by sqrt(unit2)
 /// (1 for unit vectors). NaN fails.
+/// `has_axes` 1 for legs with axes, else 0.
+inline lane_m twist_regular(lane_v x, lane_v y, lane_v unit2, lane_v has_axes) noexcept {
+  return (x * x + y * y) + (1.0 - has_axes) * unit2 >= kSingularSin2 * unit2;
+}
 inline lane_m twist_regular(const Model& model, lane_v x, lane_v y, lane_v unit2, int k) noexcept {
-  return (x * x + y * y) + (1.0 - load_lanes(model.geometry().lanes.has_axes, k)) * unit2 >= kSingularSin2 * unit2;
+  return twist_regular(x, y, unit2, load_lanes(model.geometry().lanes.has_axes, k));
 }
 
 /// The twist theta - theta_home (relative) or theta (absolute) in one atan2: (x, y) rotated by
 /// -theta_home. Zero for legs without axes.
+/// With cos and sin of theta_home (c0, s0) and has_axes as vectors: theta - theta_home.
+inline lane_v twist_angle(lane_v x, lane_v y, lane_v c0, lane_v s0, lane_v has_axes) noexcept {
+  return atan2(y * c0 - x * s0, x * c0 + y * s0) * has_axes;
+}
 inline lane_v twist_angle(const Model& model, lane_v x, lane_v y, bool relative, int k) noexcept {
   const LegLanes& g = model.geometry().lanes;
   const lane_v c0 = relative ? load_lanes(g.cos_theta_home, k) : splat<lane_v>(1.0);
   const lane_v s0 = relative ? load_lanes(g.sin_theta_home, k) : splat<lane_v>(0.0);
-  return atan2(y * c0 - x * s0, x * c0 + y * s0) * load_lanes(g.has_axes, k);
+  return twist_angle(x, y, c0, s0, load_lanes(g.has_axes, k));
 }
 
 /// The rows of packet k of the twist Jacobian (motor = false) or of the motor-side length
@@ -236,16 +259,24 @@ inline void jacobian_columns(const Model& model, const lanes3& s, lane_v inv_len
 /// |L|, both then scaled by |L|^2), L.ja, L.jd, |L|, |L|^2 and 1/|L|; the triangle inequality on
 /// jacobian_columns' terms, without forming them. Near a U-joint singularity it grows like
 /// 1/(x^2 + y^2); NaN stays NaN. Lanes 6 and 7 give 0.
+/// `has_axes`, `arm_ratio` and `gain_bound` are LegLanes' has_axes, arm_ratio and twist_gain_bound
+/// as vectors.
 inline lane_v twist_share_bound(const Model& model, lane_v x, lane_v y, lane_v dot_a, lane_v dot_d, lane_v length,
-                                lane_v length2, lane_v inv_length, int k) noexcept {
-  const LegLanes& g = model.geometry().lanes;
+                                lane_v length2, lane_v inv_length, lane_v has_axes, lane_v arm_ratio,
+                                lane_v gain_bound) noexcept {
   const lane_v ax = vabs(x), ay = vabs(y);
   // With w = 1/(x^2 + y^2) (legs without axes: 1, and a zero gain): |a| <= |L| w (|x| + |y| (|ja.s| +
   // |jd.s|)) for the translation part a, |g_jd| <= |L|^2 w (|x| + |y|), |b| <= |arm| |a| + |g_jd|.
-  const lane_v w = 1.0 / ((x * x + y * y) + (1.0 - load_lanes(g.has_axes, k)));
+  const lane_v w = 1.0 / ((x * x + y * y) + (1.0 - has_axes));
   const lane_v a = length * w * (ax + ay * ((vabs(dot_a) + vabs(dot_d)) * inv_length));
-  const lane_v b_scaled = load_lanes(g.arm_ratio, k) * a + (length2 * w * (ax + ay)) * (1.0 / model.condition_length());
-  return load_lanes(g.twist_gain_bound, k) * (a > b_scaled ? a : b_scaled);
+  const lane_v b_scaled = arm_ratio * a + (length2 * w * (ax + ay)) * (1.0 / model.condition_length());
+  return gain_bound * (a > b_scaled ? a : b_scaled);
+}
+inline lane_v twist_share_bound(const Model& model, lane_v x, lane_v y, lane_v dot_a, lane_v dot_d, lane_v length,
+                                lane_v length2, lane_v inv_length, int k) noexcept {
+  const LegLanes& g = model.geometry().lanes;
+  return twist_share_bound(model, x, y, dot_a, dot_d, length, length2, inv_length, load_lanes(g.has_axes, k),
+                           load_lanes(g.arm_ratio, k), load_lanes(g.twist_gain_bound, k));
 }
 
 /// The sum of the lanes.

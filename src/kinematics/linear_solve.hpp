@@ -263,6 +263,68 @@ inline bool condition_below(const PaddedRows& a, const ConditionReference& ref, 
   return proven(norm_y1, residual_norm(y1, norm_y1));
 }
 
+/// The largest of six columns per lane, inf where one is NaN (max_lane, lane by lane).
+inline lane_v column_max(const lane_v (&v)[6]) noexcept {
+  lane_v m = v[0];
+  for (int c = 1; c < 6; ++c) m = m > v[c] ? m : v[c];
+  const lane_v inf = splat<lane_v>(INFINITY);
+  for (int c = 0; c < 6; ++c) m = v[c] == v[c] ? m : inf;
+  return m;
+}
+
+/// condition_below for a 6x6 matrix per lane (lane p: the matrix of pose p of a batch, a[row][column])
+/// with a perturbation per lane: the same operations in the same order on each lane's numbers, so
+/// that each lane's verdict is condition_below's for that matrix. Lanes outside `todo` come out
+/// false.
+inline mask_of<lane_v> condition_below_lanes(const lane_v (&a)[6][6], const ConditionReference& ref, double bound,
+                                             lane_v perturbation, mask_of<lane_v> todo) noexcept {
+  using lane_m = mask_of<lane_v>;
+  constexpr int kW = sizeof(lane_v) / sizeof(double);
+  todo &= perturbation < INFINITY;  // also NaN
+  lane_v sum_a[6];
+  for (int c = 0; c < 6; ++c)
+    sum_a[c] = (vabs(a[0][c]) + vabs(a[1][c])) + (vabs(a[2][c]) + vabs(a[3][c])) + (vabs(a[4][c]) + vabs(a[5][c]));
+  const lane_v norm_a = column_max(sum_a) + perturbation;
+  lane_v g[6][6];
+  const auto residual_norm = [&](const auto& y, auto norm_y) {
+    lane_v sum_g[6];
+    for (int i = 0; i < 6; ++i) {
+      for (int c = 0; c < 6; ++c) {
+        lane_v r0 = splat<lane_v>(i == c ? 1.0 : 0.0), r1 = {};
+        for (int k = 0; k < 3; ++k) r0 -= y(i, k) * a[k][c];
+        for (int k = 3; k < 6; ++k) r1 -= y(i, k) * a[k][c];
+        g[i][c] = r0 + r1;
+      }
+    }
+    for (int c = 0; c < 6; ++c)
+      sum_g[c] = (vabs(g[0][c]) + vabs(g[1][c])) + (vabs(g[2][c]) + vabs(g[3][c])) + (vabs(g[4][c]) + vabs(g[5][c]));
+    return column_max(sum_g) + norm_y * perturbation + 1e-13 * norm_y * norm_a;
+  };
+  const double target = bound * (1.0 - 1e-9);
+  const auto proven = [&](auto norm_y, lane_v norm_g) {
+    return (norm_g < 1.0) & (norm_a * norm_y * (1.0 + 1e-12) <= target * (1.0 - norm_g));
+  };
+  const lane_v norm_g = residual_norm([&](int i, int k) { return ref.inverse[i][k]; }, ref.norm);
+  lane_m result = todo & proven(ref.norm, norm_g);
+  const lane_m step = todo & ~result & (norm_g < 2.0);
+  bool any_step = false;
+  for (int p = 0; p < kW; ++p) any_step |= step[p] != 0;
+  if (!any_step) return result;
+  // One Newton-Schulz step, Y1 = (I + G) Y0.
+  lane_v y1[6][6], sum_y[6] = {};
+  for (int i = 0; i < 6; ++i) {
+    for (int c = 0; c < 6; ++c) {
+      lane_v r = splat<lane_v>(ref.inverse[i][c]);
+      for (int k = 0; k < 6; ++k) r += g[i][k] * ref.inverse[k][c];
+      y1[i][c] = r;
+      sum_y[c] += vabs(r);
+    }
+  }
+  const lane_v norm_y1 = column_max(sum_y);
+  const lane_v norm_g1 = residual_norm([&](int i, int k) { return y1[i][k]; }, norm_y1);
+  return result | (step & proven(norm_y1, norm_g1));
+}
+
 /// condition_below for A = J diag(1, 1, 1, 1/length x 3), J in its column-major storage.
 inline bool scaled_condition_below(const Matrix6d& J, double length, const ConditionReference& ref, double bound,
                                    double perturbation = 0.0) noexcept {

@@ -178,8 +178,7 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
       s != Status::Ok)
     return fail(issue, s, 0, trajectory);
   // Holding torque: the motor balances the load (and the viscous friction at its speed).
-  const Vector6d holding = rig.servo().viscous_friction * drives.speed - load.load +
-                           detail::efficiency_loss(rig, drives.speed, load.screw_torque);
+  const Vector6d holding = rig.servo().viscous_friction * drives.speed - load.load + load.thread_loss;
   Vector6d measured;
   read_encoder(rig, drives.angle, measured);
   ControllerState controller;
@@ -211,16 +210,15 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
     if (options.progress && (k % kProgressEvery == 0 || k + 1 == n)) options.progress(k + 1, n);
     if (k + 1 == n) break;
 
-    // The load at the current state, held over the control period; the efficiency loss from the
-    // screw torque at the last period's motor acceleration.
+    // The load at the current state, held over the control period; the thread's efficiency loss
+    // from the screw torque at the last period's motor acceleration.
     if (k > 0)
       if (const Status s =
               detail::drive_load(rig, fk.legs, drives.speed, motor_acceleration, options.twist_in_plant, load);
           s != Status::Ok)
         return fail(issue, s, k, trajectory);
     const Vector6d speed_before = drives.speed;
-    integrate_drives(rig, load.inverse_inertia,
-                     load.load - detail::efficiency_loss(rig, drives.speed, load.screw_torque), torque, drives);
+    integrate_drives(rig, load.inverse_inertia, load.load - load.thread_loss, torque, drives);
     motor_acceleration = (drives.speed - speed_before) / rig.control_period();
     motor = model.length_home() + gain.cwiseProduct(drives.angle);
     const Placement previous = fk.placement;  // warm start from the last tick

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "dynamics/mechanism_internal.hpp"
 #include "hexatwist/dynamics/dynamics.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
 #include "hexatwist/io/config.hpp"
@@ -301,10 +302,11 @@ TEST(Mechanism, ForwardDynamicsInvertsInverseDynamics) {
 }
 
 TEST(Mechanism, ShareOfGravityIsTheHoldingTorqueAndFrictionVanishesWithoutIt) {
-  // The seed rig (with friction): at rest the torque is gravity's share plus friction at zero
-  // speed (the efficiency blend at half); gravity's share equals the frictionless holding torque.
+  // The seed rig (with friction): the torque is the frictionless rig's plus friction; gravity's
+  // share equals the frictionless holding torque.
   const Rig with(seed_rig_spec()), without(frictionless_spec());
   std::mt19937_64 rng(kSeed + 8);
+  int checked = 0;
   for (int trial = 0; trial < 10; ++trial) {
     PlatformMotion motion;
     motion.placement = placement_from_pose(random_valid_pose(with.model(), rng, 0.3, deg2rad(20)));
@@ -314,20 +316,146 @@ TEST(Mechanism, ShareOfGravityIsTheHoldingTorqueAndFrictionVanishesWithoutIt) {
     ASSERT_EQ(inverse_dynamics(with, motion, a), Status::Ok);
     ASSERT_EQ(inverse_dynamics(without, motion, b), Status::Ok);
     EXPECT_LT((b.friction).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT(b.thread_dissipation.cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT((a.torque - a.friction - b.torque).cwiseAbs().maxCoeff(), 1e-9 * b.torque.cwiseAbs().maxCoeff());
-    // Efficiency: where the motor drives the load (torque and speed of one sign, far from the
-    // speed where dry friction changes sign), the screw's share is the ideal one over eta.
+    // Efficiency: where the nut slides fast (the smoothing spent), the thread's loss is the ideal
+    // torque times 1/eta - 1 where the power through the thread is positive (the screw drives the
+    // load), times 1 - eta' where it is negative. The ideal torque is the frictionless rig's less its
+    // drives' share; the loss pair is the thread's dissipation over its speed.
     for (int i = 0; i < kLegs; ++i) {
       const double screw = b.torque[i] - b.drives[i];
-      const double speed = a.speed[i];
-      if (std::abs(speed) < 20.0 * with.servo().friction_speed) continue;
-      const double expected_loss =
-          (screw * speed > 0.0 ? 1.0 / with.mechanism().efficiency - 1.0 : with.mechanism().back_efficiency - 1.0) *
-              screw +
-          with.servo().viscous_friction * speed + with.servo().coulomb_friction * (speed > 0 ? 1.0 : -1.0);
-      EXPECT_NEAR(a.friction[i], expected_loss, 1e-6 * std::abs(screw) + 1e-9) << "leg " << i + 1;
+      const double w = a.thread_speed[i];
+      if (std::abs(w) < 20.0 * with.servo().friction_speed) continue;
+      const double pair = a.thread_dissipation[i] / w;
+      const double expected =
+          (screw * w > 0.0 ? 1.0 / with.mechanism().efficiency - 1.0 : with.mechanism().back_efficiency - 1.0) * screw;
+      EXPECT_NEAR(pair, expected, 1e-9 * std::abs(screw)) << "leg " << i + 1;
+      ++checked;
     }
   }
+  EXPECT_GT(checked, 20);
+}
+
+// The energy rate along a motion through pose p0 with constant pose acceleration, by a five-point
+// central difference of kinetic plus potential energy.
+double energy_rate(const Rig& rig, const Pose& p0, const Vector6d& rate, const Vector6d& acc) {
+  const auto energy = [&](double t) {
+    const Vector6d q = p0.to_vector() + t * rate + 0.5 * t * t * acc;
+    const PlatformMotion m = platform_motion(Pose::from_vector(q), rate + t * acc, acc);
+    return kinetic(rig, m.placement, m.velocity) + potential(rig, m.placement);
+  };
+  const double h = 1e-3;
+  return (-energy(2 * h) + 8 * energy(h) - 8 * energy(-h) + energy(-2 * h)) / (12 * h);
+}
+
+TEST(Mechanism, MotorPowerIsTheEnergyRatePlusEveryLossAtEveryInstant) {
+  // On random motions of the seed rig and of a rig with an off-axis load and heavier rods (both
+  // with friction and screw efficiencies), slow ones near a motor's reversal included: the motors'
+  // power sum_i tau_i phi'_i is the rate of kinetic plus potential energy (finite differences of
+  // the energies, independent of the Newton-Euler projection) plus what the bearings dissipate
+  // (drive_friction * speed) plus what the threads dissipate, and no thread ever gives energy back.
+  RigSpec rich = rich_spec();
+  const RigSpec seed = seed_rig_spec();
+  rich.servo = seed.servo;
+  rich.mechanism.efficiency = seed.mechanism.efficiency;
+  rich.mechanism.back_efficiency = seed.mechanism.back_efficiency;
+  const Rig rigs[] = {Rig(seed), Rig(rich)};
+  std::mt19937_64 rng(kSeed + 12);
+  double worst = 0.0, dissipated = 0.0;
+  for (const Rig& rig : rigs) {
+    for (int trial = 0; trial < 60; ++trial) {
+      const Pose p0 = random_valid_pose(rig.model(), rng, 0.3, deg2rad(20));
+      const double scale = trial % 3 == 0 ? 1e-3 : 1.0;  // every third: slow, around the reversals
+      const Vector6d rate = scale * random_vector(rng, 0.5, 0.8), acc = random_vector(rng, 3.0, 5.0);
+      InverseDynamics id;
+      ASSERT_EQ(inverse_dynamics(rig, platform_motion(p0, rate, acc), id), Status::Ok);
+      const double motors = id.power.sum();
+      const double bearings = drive_friction(rig, id.speed).dot(id.speed);
+      const double threads = id.thread_dissipation.sum();
+      const double rate_of_energy = energy_rate(rig, p0, rate, acc);
+      const double size = std::abs(motors) + std::abs(rate_of_energy) + bearings + threads;
+      worst = std::max(worst, std::abs(motors - (rate_of_energy + bearings + threads)) / size);
+      EXPECT_GE(id.thread_dissipation.minCoeff(), 0.0) << str(p0);
+      dissipated = std::max(dissipated, threads / size);
+    }
+  }
+  // The residual is the finite difference's rounding: 1e-15 of the energy (kJ) over its step.
+  report("power balance, relative to the powers' sizes", worst);
+  EXPECT_LT(worst, 3e-8);
+  EXPECT_GT(dissipated, 0.01);  // the threads' share is far above the tolerance
+}
+
+TEST(Mechanism, TheThreadsLossFollowsTheNutNotTheMotor) {
+  // Issue 23's example: the seed at home, yawing at 0.5 rad/s with the heave that stops motor 1.
+  // Its nut still slides (the leg twists) at 1.32 mm/s under 3.3 kN of compression: the screw
+  // drives the load, so the thread loses 1/eta - 1 of the power through it, and motor 1 holds
+  // 6.17 N m, where a loss decided by the motor's speed alone gave 5.40.
+  const Rig rig(seed_rig_spec()), ideal(frictionless_spec());
+  const auto motion = [](double heave) {
+    Vector6d rate = Vector6d::Zero();
+    rate[2] = heave;
+    rate[5] = 0.5;
+    return platform_motion(Pose{}, rate, Vector6d::Zero());
+  };
+  InverseDynamics a, b;
+  ASSERT_EQ(inverse_dynamics(rig, motion(0.0), a), Status::Ok);
+  ASSERT_EQ(inverse_dynamics(rig, motion(1.0), b), Status::Ok);
+  const double heave = -a.speed[0] / (b.speed[0] - a.speed[0]);  // the speeds are linear in the heave
+  EXPECT_NEAR(heave, 0.4586, 1e-4);
+  InverseDynamics id, free;
+  ASSERT_EQ(inverse_dynamics(rig, motion(heave), id), Status::Ok);
+  ASSERT_EQ(inverse_dynamics(ideal, motion(heave), free), Status::Ok);
+  EXPECT_LT(std::abs(id.speed[0]), 1e-12);
+  // The nut's speed from the length's own rate (a central difference of inverse kinematics).
+  const auto length = [&](double t) {
+    LegState legs;
+    Pose p;
+    p.position.z() = heave * t;
+    p.rpy.z() = 0.5 * t;
+    EXPECT_EQ(inverse_kinematics(rig.model(), p, legs), Status::Ok);
+    return legs.length[0];
+  };
+  const double length_rate = (length(1e-6) - length(-1e-6)) / 2e-6;
+  EXPECT_NEAR(length_rate, 1.316e-3, 1e-6);
+  EXPECT_NEAR(id.thread_speed[0], length_rate / rig.motor_gain()[0], 1e-6);
+  EXPECT_NEAR(id.screw_force[0], -3308.0, 1.0);
+  // Motor 1 does no work; its thread dissipates 1/eta - 1 of the power through it (smoothed).
+  const double screw = free.torque[0] - free.drives[0];
+  const double w = id.thread_speed[0];
+  const double expected =
+      (1.0 / rig.mechanism().efficiency - 1.0) * screw * w * std::tanh(w / rig.servo().friction_speed);
+  EXPECT_NEAR(id.thread_dissipation[0], expected, 1e-9);
+  std::printf("  motor 1: %.4f N m (frictionless %.4f); thread at %.3f mm/s dissipates %.3f W\n", id.torque[0],
+              free.torque[0], 1e3 * length_rate, id.thread_dissipation[0]);
+  EXPECT_NEAR(id.torque[0], 6.17, 0.005);
+}
+
+TEST(Mechanism, TheClosedLoopsDriveEquationGivesTheInverseDynamicsTorque) {
+  // The closed-loop simulation integrates A phi'' = tau - drive_friction - thread_loss + L
+  // (detail::drive_load, theory §14): at the state, speeds and acceleration of an inverse-dynamics
+  // motion, solving it for tau gives the inverse dynamics' torque, the threads' losses included,
+  // and its thread loss is the inverse dynamics' friction less the bearings'.
+  const Rig rig(seed_rig_spec());
+  std::mt19937_64 rng(kSeed + 13);
+  double worst = 0.0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const Pose p0 = random_valid_pose(rig.model(), rng, 0.3, deg2rad(20));
+    const double scale = trial % 2 == 0 ? 1e-3 : 1.0;
+    const PlatformMotion motion =
+        platform_motion(p0, scale * random_vector(rng, 0.5, 0.8), random_vector(rng, 3.0, 5.0));
+    InverseDynamics id;
+    ASSERT_EQ(inverse_dynamics(rig, motion, id), Status::Ok);
+    detail::DriveLoad load;
+    ASSERT_EQ(detail::drive_load(rig, id.legs_state, id.speed, id.acceleration, true, load), Status::Ok);
+    const Vector6d tau =
+        load.inverse_inertia.inverse() * id.acceleration + drive_friction(rig, id.speed) + load.thread_loss - load.load;
+    const double size = id.torque.cwiseAbs().maxCoeff();
+    worst = std::max(worst, (tau - id.torque).cwiseAbs().maxCoeff() / size);
+    worst = std::max(worst,
+                     (load.thread_loss - (id.friction - drive_friction(rig, id.speed))).cwiseAbs().maxCoeff() / size);
+  }
+  report("relative difference of the drive equation's torque and thread loss", worst);
+  EXPECT_LT(worst, 1e-12);
 }
 
 // The platform state for integration: placement and velocity.

@@ -335,16 +335,6 @@ TEST(Forward, StepCapHoldsWhereTheNewtonStepIsHuge) {
   EXPECT_GT(step.position + step.rotation, 0.0);
 }
 
-// The seed platform with stroke and bend limits wide enough for a pure yaw to 90 deg: only the
-// platform-singularity limit stops it.
-Model seed_with_wide_limits() {
-  ModelSpec spec = seed_model().spec();
-  spec.limits.length_min = 0.5;
-  spec.limits.length_max = 4.0;
-  spec.limits.bend_max = deg2rad(89);
-  return Model(spec);
-}
-
 TEST(Forward, TrackedYawSweepStaysOnItsAssemblyModeUpToTheSingularityLimit) {
   // Pure yaw 0 -> 93 deg at 1 kHz and 20 deg/s; the seed is singular at 90 deg. Ok while
   // check_limits passes; past the limit, and past the singularity, never Ok, and a failure

@@ -318,6 +318,76 @@ TEST(LinearSolve, CheapConditionProofWithAPerturbationHoldsForEveryMatrixWithinI
   EXPECT_GT(proven, 10000);
 }
 
+TEST(LinearSolve, ConditionProofPerLaneGivesEachMatrixTheVerdictOfTheSingleMatrix) {
+  // condition_below_lanes (a batch's poses, one matrix per lane) says for every lane what
+  // condition_below says for that lane's matrix: at perturbations within a few ulp of where the
+  // verdict turns (found by bisection per matrix), from references near and far (so that the
+  // Newton-Schulz step decides some), with a lane left out, NaN and inf.
+  std::mt19937_64 rng(777);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), scale(-2.0, 0.0), far(-6.0, -0.3);
+  constexpr int kW = sizeof(lane_v) / sizeof(double);
+  long compared = 0, proven = 0;
+  for (int n = 0; n < 3000; ++n) {
+    Matrix6d J;
+    for (int i = 0; i < 36; ++i) J(i) = u(rng);
+    const Vector6d v = Vector6d::NullaryExpr([&] { return u(rng); }).normalized();
+    J -= (1.0 - std::pow(10.0, scale(rng))) * (J * v) * v.transpose();
+    Matrix6d E;
+    for (int i = 0; i < 36; ++i) E(i) = u(rng);
+    const Matrix6d Y = (J + std::pow(10.0, far(rng)) * E).inverse();
+    ConditionReference ref;
+    for (int i = 0; i < 6; ++i)
+      for (int c = 0; c < 6; ++c) ref.inverse[i][c] = Y(i, c);
+    ref.norm = Y.cwiseAbs().colwise().sum().maxCoeff();
+    double sign;
+    const double bound = 1.5 * scaled_condition(J, 1.0, sign);
+    if (!std::isfinite(bound)) continue;
+    // Each lane: J with a small change of its own, and a perturbation at that matrix's edge.
+    Matrix6d A[kW];
+    double p[kW];
+    for (int l = 0; l < kW; ++l) {
+      Matrix6d D;
+      for (int i = 0; i < 36; ++i) D(i) = u(rng);
+      A[l] = J + 1e-6 * D;
+      PaddedRows rows;
+      padded_rows(A[l], rows);
+      double lo = 0.0, hi = A[l].cwiseAbs().colwise().sum().maxCoeff();
+      if (!condition_below(rows, ref, bound, lo)) {
+        p[l] = l % 2 == 0 ? 0.0 : 1e-9;  // not proven at all: still compared
+        continue;
+      }
+      for (int it = 0; it < 200 && std::nextafter(lo, hi) < hi; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (condition_below(rows, ref, bound, mid) ? lo : hi) = mid;
+      }
+      p[l] = lo;
+      for (int k = 0; k < l % 5; ++k) p[l] = std::nextafter(p[l], INFINITY);  // 0-4 ulp past the last yes
+    }
+    if (n % 100 == 7) p[1] = std::nan("");
+    if (n % 100 == 8) p[2] = INFINITY;
+    lane_v a[6][6], perturbation;
+    for (int l = 0; l < kW; ++l) {
+      perturbation[l] = p[l];
+      for (int r = 0; r < 6; ++r)
+        for (int c = 0; c < 6; ++c) a[r][c][l] = A[l](r, c);
+    }
+    mask_of<lane_v> todo = all_set();
+    if (n % 10 == 5) todo[0] = 0;
+    const mask_of<lane_v> lanes = condition_below_lanes(a, ref, bound, perturbation, todo);
+    for (int l = 0; l < kW; ++l) {
+      PaddedRows rows;
+      padded_rows(A[l], rows);
+      const bool single = condition_below(rows, ref, bound, p[l]);
+      ASSERT_EQ(lanes[l] != 0, single && todo[l] != 0) << "matrix " << n << " lane " << l << " p " << p[l];
+      ++compared;
+      proven += single;
+    }
+  }
+  std::printf("  %ld lanes compared, %ld proven\n", compared, proven);
+  EXPECT_GT(proven, compared / 8);
+  EXPECT_LT(proven, compared * 3 / 4);
+}
+
 TEST(Lanes, TwistShareBoundCoversTheMotorSideJacobiansTwistRows) {
   // twist_share_bound summed over the legs bounds ||A_m - A_g||_1, the twist's share of the scaled
   // motor-side Jacobian, on the seed platform, on random asymmetric ones (either thread hand and

@@ -63,7 +63,7 @@ TEST(RealTime, CountingAllocatorSeesAllocations) {
   EXPECT_GE(g_allocations.load() - before, 2);
 }
 
-TEST(RealTime, CommandsTwistLimitsConditionAndFkDoNotAllocate) {
+TEST(RealTime, CommandsTwistLimitsConditionFkAndBatchesDoNotAllocate) {
   const Model& model = seed_model();
   std::mt19937_64 rng(kSeed + 60);
   std::vector<Pose> poses;
@@ -80,7 +80,18 @@ TEST(RealTime, CommandsTwistLimitsConditionAndFkDoNotAllocate) {
   FkTracker tracker;
   double condition;
 
+  std::vector<double> rows, batch(6 * poses.size());
+  for (const Pose& p : poses) {
+    const Vector6d q = p.to_vector();
+    rows.insert(rows.end(), q.data(), q.data() + 6);
+  }
+  std::vector<LimitReport> reports(poses.size());
+  std::vector<Status> statuses(poses.size());
+
   const long before = g_allocations.load();
+  for (const Strategy strategy : {Strategy::Compensated, Strategy::Conventional})
+    EXPECT_EQ(motor_commands_batch(model, rows, strategy, batch, reports), Status::Ok);
+  EXPECT_EQ(leg_lengths_batch(model, rows, batch, statuses), Status::Ok);
   int ok = 0;
   for (const Pose& p : poses) {
     (void)inverse_kinematics(model, p, st);

@@ -49,6 +49,21 @@ def test_ik_and_twist_equal_the_library_bit_for_bit(model, poses, tmp_path):
     np.testing.assert_allclose(np.linalg.norm(ik.axes, axis=2), 1.0, atol=1e-15)
 
 
+def test_lengths_only_are_the_full_inverse_kinematics_lengths(model, poses):
+    # The poses across the SIMD lanes (leg_lengths_batch): the same lengths and statuses, bit for bit.
+    full = hexatwist.inverse_kinematics(model, poses)
+    only = hexatwist.inverse_kinematics(model, poses, lengths_only=True)
+    assert set(only) == {"lengths", "status"}
+    assert np.array_equal(only.status, full.status)
+    assert same_bits(only.lengths, full.lengths)
+    one = hexatwist.inverse_kinematics(model, poses[3], lengths_only=True)
+    assert one.lengths.shape == (6,) and np.array_equal(one.lengths, full.lengths[3])
+    bad = poses[:5].copy()
+    bad[2, 1] = np.nan
+    with pytest.raises(hexatwist.InputError, match="row 2"):
+        hexatwist.inverse_kinematics(model, bad, lengths_only=True)
+
+
 def test_batch_equals_the_single_pose_path(model, poses):
     r = hexatwist.commands(model, poses)
     for i in range(len(poses)):

@@ -38,11 +38,14 @@ struct InverseDynamics {
   Vector6d velocity_product;  ///< share of the velocity-product (Coriolis, centripetal, gyroscopic) terms of the
                               ///< platform and the leg bodies [N m]
   Vector6d legs;              ///< share of the leg bodies' inertia, linear in the acceleration [N m]
-  Vector6d drives;       ///< share of rotor, gear and screw inertia: all of it, velocity-product part of the motor's
-                         ///< acceleration included [N m]
-  Vector6d friction;     ///< viscous and dry friction and the screw's efficiency losses [N m]
-  Vector6d screw_force;  ///< axial force the nut carries, tension positive [N]
-  LegState legs_state;   ///< inverse kinematics at the pose
+  Vector6d drives;        ///< share of rotor, gear and screw inertia: all of it, velocity-product part of the motor's
+                          ///< acceleration included [N m]
+  Vector6d friction;      ///< viscous and dry friction and the screw's efficiency losses [N m]
+  Vector6d screw_force;   ///< axial force the nut carries, tension positive [N]
+  Vector6d thread_speed;  ///< the nut's sliding along the screw as a motor speed: real length rate / motor gain,
+                          ///< the motor speed plus (twist gain / motor gain) * twist rate [rad/s]
+  Vector6d thread_dissipation;  ///< power the screw's efficiency loss dissipates in the thread, >= 0 [W]
+  LegState legs_state;          ///< inverse kinematics at the pose
 };
 
 /// Motor torques for `motion` (Newton-Euler on every body, projected by virtual power;
@@ -65,10 +68,18 @@ struct InverseDynamics {
 /// Motor angles relative to home for a placement (inverse kinematics and the twist) [rad].
 [[nodiscard]] Status motor_angles(const Rig& rig, const Placement& placement, Vector6d& angle) noexcept;
 
-/// Friction torque at each motor shaft for motor speeds `speed` and the torque the screw
-/// transmits to the load `screw_torque` (docs/theory.md §14): viscous + smoothed dry friction +
-/// the efficiency loss [N m].
-Vector6d drive_friction(const Rig& rig, const Vector6d& speed, const Vector6d& screw_torque) noexcept;
+/// Friction torque at each motor shaft for motor speeds `speed` [rad/s]: viscous and smoothed dry
+/// friction, b speed + tau_c tanh(speed / w_f) [N m] (docs/theory/dynamics.md §14).
+Vector6d drive_friction(const Rig& rig, const Vector6d& speed) noexcept;
+
+/// The screw's efficiency loss in each thread, a torque pair on screw and nut [N m, at the motor
+/// shaft], for the nut's sliding `thread_speed` (InverseDynamics::thread_speed) [rad/s] and the
+/// torque the screw passes to the load `screw_torque` [N m]: |tau_s| tanh(w_t / w_f) times
+/// 1/eta - 1 where the power through the thread tau_s w_t is positive (the screw drives) and
+/// 1 - eta' where it is negative (driven back), so that loss * thread_speed >= 0 is the power the
+/// thread dissipates (theory §14). Its share of the motor torques is J_phi^-T of the pair's
+/// generalised force, sum_i loss_i / c_i [s_i; a_i x s_i].
+Vector6d thread_loss(const Rig& rig, const Vector6d& thread_speed, const Vector6d& screw_torque) noexcept;
 
 /// Platform acceleration for motor torques `torque` (at the shaft, friction not included: pass
 /// the net torque), from M x'' = J_phi^T torque - bias.
