@@ -450,6 +450,18 @@ double gaussian_norm_mixture_quantile(const std::vector<Matrix3d>& covariances, 
   return std::exp(0.5 * (a + b));
 }
 
+void linear_quantiles(const ToleranceLinear& linear, ToleranceSummary& s, int threads) {
+  const auto quantiles = [&](const std::vector<Matrix3d>& cov) {
+    ErrorQuantiles q;
+    q.median = gaussian_norm_mixture_quantile(cov, 0.5, threads);
+    q.p95 = gaussian_norm_mixture_quantile(cov, 0.95, threads);
+    return q;
+  };
+  s.point_linear = quantiles(linear.point_covariance);
+  s.position_linear = quantiles(linear.position_covariance);
+  s.orientation_linear = quantiles(linear.orientation_covariance);
+}
+
 ToleranceSummary summarize_tolerance(const ToleranceChunk& c, std::size_t poses, const ToleranceLinear* linear,
                                      int threads) {
   ToleranceSummary s;
@@ -470,17 +482,7 @@ ToleranceSummary summarize_tolerance(const ToleranceChunk& c, std::size_t poses,
   s.worst_point_linear = sample_quantiles(c.max_point_linear);
   s.worst_position = sample_quantiles(c.max_position);
   s.worst_orientation = sample_quantiles(c.max_orientation);
-  if (linear != nullptr) {
-    const auto lin = [&](const std::vector<Matrix3d>& cov) {
-      ErrorQuantiles q;
-      q.median = gaussian_norm_mixture_quantile(cov, 0.5, threads);
-      q.p95 = gaussian_norm_mixture_quantile(cov, 0.95, threads);
-      return q;
-    };
-    s.point_linear = lin(linear->point_covariance);
-    s.position_linear = lin(linear->position_covariance);
-    s.orientation_linear = lin(linear->orientation_covariance);
-  }
+  if (linear != nullptr) linear_quantiles(*linear, s, threads);
   return s;
 }
 

@@ -91,3 +91,55 @@ def test_sixteen_simulations_equal_the_local_run(client):
         assert a.summary == b.summary
         for key in ("time", "actual", "command", "motor", "error", "twist"):
             assert np.array_equal(a[key], b[key]), key
+
+
+def test_hexatwist_threads_follow_the_workers_and_its_functions_pickle(client):
+    # A compiled function shipped to every worker: it pickles, and each --nthreads 1 worker runs one thread.
+    assert set(client.run(hexatwist.get_num_threads).values()) == {1}
+    assert client.submit(hexatwist.get_num_threads, pure=False).result() == 1
+
+
+def test_per_row_keyword_arrays_are_cut_with_the_rows(client, model):
+    q = random_poses(20_000, seed=8)
+    r = hexatwist.commands(model, q)
+    m = r.commands[r.ok]
+    guess = q[r.ok]  # each row starts at its own pose
+    local = hexatwist.forward(model, m, guess=guess)
+    remote = hexatwist.map_batch("forward", model, m, client=client, chunk=4096, guess=guess)
+    for key in local:
+        assert np.array_equal(local[key], remote[key], equal_nan=True), key
+    # A single guess for every row stays whole.
+    one = hexatwist.map_batch("forward", model, m[:5000], client=client, chunk=4096, guess=guess[0])
+    assert np.array_equal(one.poses, hexatwist.forward(model, m[:5000], guess=guess[0]).poses, equal_nan=True)
+
+
+def same(a, b):
+    """Equal numbers, NaN equal to NaN, through nested dicts."""
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
+    return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True)
+
+
+def test_a_tolerance_study_on_two_workers_equals_the_local_run_bit_for_bit(client, model):
+    settings = dict(platforms=120, seed=4, random=150, test_samples=11, sigmas=dict(base_joint=80e-6, lead=1e-4))
+    local = hexatwist.tolerance(model, **settings)
+    remote = hexatwist.tolerance(model, client=client, chunk=17, **settings)
+    for key in local:
+        if isinstance(local[key], np.ndarray):
+            assert np.array_equal(local[key], remote[key], equal_nan=True), key
+    assert same(local.summary, remote.summary)
+    assert same(local.linear, remote.linear)
+    assert len(local.max_point) == 120 and local.summary["failures"] == 0
+
+
+def test_a_workspace_map_and_volume_on_two_workers_equal_the_local_run_bit_for_bit(client, model):
+    orientation = (0.05, -0.1, 0.2)
+    local = hexatwist.workspace_map(model, orientation, spacing=0.04)
+    remote = hexatwist.workspace_map(model, orientation, spacing=0.04, client=client, chunk=3)
+    for key in local:
+        if isinstance(local[key], np.ndarray):
+            assert np.array_equal(local[key], remote[key], equal_nan=True), key
+    assert local.grid == remote.grid
+    v_local = hexatwist.workspace_volume(model, orientation, cell=0.05)
+    v_remote = hexatwist.workspace_volume(model, orientation, cell=0.05, client=client, chunk=50)
+    assert (v_local.volume, v_local.error, v_local.coarse_volume) == (v_remote.volume, v_remote.error, v_remote.coarse_volume)

@@ -145,8 +145,12 @@ struct ToleranceSummary {
   ErrorQuantiles worst_position, worst_orientation;
 };
 
-/// The summary of a whole study (`chunk` from platform 0) and its linear model (may be null: no
-/// linear quantiles).
+/// The covariance answer's quantiles (point_linear, position_linear, orientation_linear: median
+/// and 95th percentile of the pooled mixtures, gaussian_norm_mixture_quantile) into `summary`.
+void linear_quantiles(const ToleranceLinear& linear, ToleranceSummary& summary, int threads = 1);
+
+/// The summary of a whole study (`chunk` from platform 0) and its linear model (may be null: the
+/// linear quantiles stay NaN; linear_quantiles fills them).
 ToleranceSummary summarize_tolerance(const ToleranceChunk& chunk, std::size_t poses, const ToleranceLinear* linear,
                                      int threads = 1);
 
