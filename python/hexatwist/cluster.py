@@ -46,11 +46,11 @@ def main(argv=None) -> int:
         out.write(f"workers 1 {workers}\n")
         config = request.get("config")
         if request["job"] == "tolerance":
-            chunk, linear = tolerance_on(client, config, None, request["workspace"], request["sigmas"],
-                                         request["seed"], request["platforms"], request.get("calibration", "none"),
-                                         True, request.get("chunk"))
+            poses = np.asarray(request["poses"], dtype=np.float64) if "poses" in request else None
+            chunk, _ = tolerance_on(client, config, poses, request["workspace"], request["sigmas"], request["seed"],
+                                    request["platforms"], request.get("calibration", "none"), True,
+                                    request.get("chunk"), linear=False)
             _write_arrays(out, "", chunk)
-            _write_arrays(out, "linear.", {k: v for k, v in linear.items() if k != "poses"})
         elif request["job"] == "workspace":
             model = hexatwist.Rig(config).model
             volume = workspace_volume_on(client, model, request["orientation"], request["cell"], request["refine"],

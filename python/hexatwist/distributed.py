@@ -200,16 +200,18 @@ def merge_tolerance_chunks(parts):
     return out
 
 
-def tolerance_on(client, config, poses, workspace, sigmas, seed, platforms, calibration, linear_worst, chunk):
+def tolerance_on(client, config, poses, workspace, sigmas, seed, platforms, calibration, linear_worst, chunk,
+                 linear=True):
     """hexatwist.tolerance on the workers: ``chunk`` platforms a task (default: about 64 tasks), each
     sampling its platforms from (seed, index) and generating the poses from ``workspace`` (``poses``,
-    when given, are scattered once); one task for the covariance answer. Returns (chunk, linear)."""
+    when given, are scattered once); one task for the covariance answer (``linear``). Returns (chunk,
+    linear or None)."""
     chunk = int(chunk) if chunk else max(1, math.ceil(platforms / 64))
     config_future = client.scatter(config, broadcast=True) if config is not None else None
     poses_future = client.scatter(np.ascontiguousarray(poses, dtype=np.float64), broadcast=True) \
         if poses is not None else None
-    linear = client.submit(_linear_task, config_future, poses_future, workspace, sigmas, pure=False)
+    linear = client.submit(_linear_task, config_future, poses_future, workspace, sigmas, pure=False) if linear else None
     futures = [client.submit(_tolerance_task, config_future, poses_future, workspace, sigmas, seed, first, count,
                              calibration, linear_worst, pure=False)
                for first, count in _ranges(platforms, chunk)]
-    return merge_tolerance_chunks(client.gather(futures)), linear.result()
+    return merge_tolerance_chunks(client.gather(futures)), linear.result() if linear is not None else None

@@ -44,8 +44,10 @@ double strip_centre(double lo, double hi, long k, long n) {
 
 }  // namespace
 
-Status workspace_slice(const Model& model, const Vector3d& rpy, const SliceSpec& spec, const WorkspaceOptions& options,
-                       WorkspaceSlice& out) {
+Status workspace_slice(const Model& model, const Vector3d& rpy_in, const SliceSpec& spec_in,
+                       const WorkspaceOptions& options, WorkspaceSlice& out) {
+  const Vector3d rpy = rpy_in;  // copies: the caller may pass out.rpy and out.spec
+  const SliceSpec spec = spec_in;
   out = WorkspaceSlice{};
   out.spec = spec;
   out.rpy = rpy;
@@ -99,8 +101,9 @@ Matrix3d tilt_torsion_rotation(double azimuth, double tilt, double torsion) noex
       .toRotationMatrix();
 }
 
-Status orientation_workspace(const Model& model, const OrientationSpec& spec, Strategy strategy,
+Status orientation_workspace(const Model& model, const OrientationSpec& spec_in, Strategy strategy,
                              OrientationWorkspace& out) {
+  const OrientationSpec spec = spec_in;  // a copy: the caller may pass out.spec
   out = OrientationWorkspace{};
   out.spec = spec;
   if (spec.directions < 1 || !(spec.step > 0.0) || !std::isfinite(spec.step) || !(spec.tolerance > 0.0) ||

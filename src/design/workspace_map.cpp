@@ -67,8 +67,10 @@ void workspace_map_rows(const Model& model, const Vector3d& rpy, const MapGrid& 
     }
 }
 
-Status workspace_map(const Model& model, const Vector3d& rpy, const MapGrid& grid, Strategy strategy, WorkspaceMap& out,
-                     int threads) {
+Status workspace_map(const Model& model, const Vector3d& rpy_in, const MapGrid& grid_in, Strategy strategy,
+                     WorkspaceMap& out, int threads) {
+  const MapGrid grid = grid_in;  // copies: the caller may pass out.grid and out.rpy
+  const Vector3d rpy = rpy_in;
   out = WorkspaceMap{};
   out.grid = grid;
   out.rpy = rpy;

@@ -51,7 +51,8 @@ Status line_intervals(const Model& model, const Vector3d& rpy, const Vector3d& o
   return Status::Ok;
 }
 
-Status volume_grid(const Model& model, const Vector3d& rpy, const VolumeOptions& options, VolumeGrid& grid) {
+Status volume_grid(const Model& model, const Vector3d& rpy_in, const VolumeOptions& options, VolumeGrid& grid) {
+  const Vector3d rpy = rpy_in;  // a copy: the caller may pass grid.rpy
   grid = VolumeGrid{};
   if (!detail::search_options_valid(options.search) || !(options.cell >= 0.0) || !std::isfinite(options.cell) ||
       options.refine < 0 || options.refine > 8)
@@ -152,7 +153,9 @@ WorkspaceVolume volume_from_cells(const VolumeGrid& grid, const std::vector<doub
   return v;
 }
 
-Status workspace_volume(const Model& model, const Vector3d& rpy, const VolumeOptions& options, WorkspaceVolume& out) {
+Status workspace_volume(const Model& model, const Vector3d& rpy_in, const VolumeOptions& options,
+                        WorkspaceVolume& out) {
+  const Vector3d rpy = rpy_in;  // a copy: the caller may pass out.grid.rpy
   out = WorkspaceVolume{};
   VolumeGrid grid;
   if (const Status s = volume_grid(model, rpy, options, grid); s != Status::Ok) return s;

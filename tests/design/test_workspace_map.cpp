@@ -83,6 +83,16 @@ TEST(WorkspaceMap, RowsComputedApartEqualTheWholeMap) {
       EXPECT_EQ(rows[k].margin, whole.points[k].margin);
     }
   }
+  // Its own grid and orientation passed back in: the same map.
+  WorkspaceMap again = whole;
+  ASSERT_EQ(workspace_map(model, again.rpy, again.grid, Strategy::Compensated, again), Status::Ok);
+  ASSERT_EQ(again.points.size(), whole.points.size());
+  for (std::size_t k = 0; k < again.points.size(); ++k) {
+    EXPECT_EQ(again.points[k].status, whole.points[k].status);
+    if (whole.points[k].status == Status::Ok) {
+      EXPECT_EQ(again.points[k].margin, whole.points[k].margin);
+    }
+  }
   grid.nu = 1;
   EXPECT_EQ(workspace_map(model, Vector3d::Zero(), grid, Strategy::Compensated, whole), Status::NonFiniteInput);
 }

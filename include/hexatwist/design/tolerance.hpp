@@ -74,6 +74,9 @@ struct ErrorHistogram {
   std::uint64_t total() const noexcept;
   /// The q-quantile (0 < q < 1), interpolated geometrically inside its bin; NaN when empty.
   double quantile(double q) const noexcept;
+  /// The share of the values counted that are at most `value`, interpolated as quantile() (its
+  /// inverse); NaN when empty.
+  double cdf(double value) const noexcept;
 };
 
 /// What a study returns for a range of sampled platforms: per platform its worst and RMS errors
@@ -133,6 +136,11 @@ double gaussian_norm_cdf(const Matrix3d& C, double r) noexcept;
 /// The q-quantile of |z| for z drawn from an equal mixture of N(0, C_k) (a pose drawn uniformly,
 /// then the errors): the linearised study's answer [m or rad].
 double gaussian_norm_mixture_quantile(const std::vector<Matrix3d>& covariances, double q, int threads = 1);
+
+/// The linearised study's cumulative distribution of |z| (the equal mixture of N(0, C_k)) at each
+/// of `values` [m or rad].
+std::vector<double> gaussian_norm_mixture_cdf(const std::vector<Matrix3d>& covariances,
+                                              const std::vector<double>& values, int threads = 1);
 
 /// A study's summary.
 struct ToleranceSummary {
