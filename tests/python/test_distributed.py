@@ -117,6 +117,8 @@ def same(a, b):
     """Equal numbers, NaN equal to NaN, through nested dicts."""
     if isinstance(a, dict):
         return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
+    if a is None or b is None:  # JSON's null for a number without a value
+        return a is None and b is None
     return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True)
 
 
@@ -143,3 +145,33 @@ def test_a_workspace_map_and_volume_on_two_workers_equal_the_local_run_bit_for_b
     v_local = hexatwist.workspace_volume(model, orientation, cell=0.05)
     v_remote = hexatwist.workspace_volume(model, orientation, cell=0.05, client=client, chunk=50)
     assert (v_local.volume, v_local.error, v_local.coarse_volume) == (v_remote.volume, v_remote.error, v_remote.coarse_volume)
+
+
+@pytest.mark.skipif(not os.environ.get("HEXATWIST_CLI"), reason="the command-line tool is not built")
+def test_the_command_line_on_the_cluster_equals_its_local_run(client, tmp_path):
+    # hexatwist tolerance / workspace --scheduler: the samples on the workers, the report the same.
+    import json
+
+    cli = os.environ["HEXATWIST_CLI"]
+    scheduler = client.scheduler.address
+    env = dict(os.environ, HEXATWIST_PYTHON=sys.executable,
+               PYTHONPATH=os.pathsep.join(p for p in [os.path.dirname(os.path.dirname(hexatwist.__file__)),
+                                                      os.environ.get("PYTHONPATH", "")] if p))
+
+    def run(*args):
+        r = subprocess.run([cli, *args], env=env, capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0, r.stderr
+        return json.loads(r.stdout)
+
+    common = ["--platforms", "60", "--workspace", "random=80,samples=5", "--json", "--no-figures"]
+    local = run("tolerance", *common, "--out", str(tmp_path / "tl"))
+    remote = run("tolerance", *common, "--out", str(tmp_path / "tr"), "--scheduler", scheduler)
+    assert remote["cluster"]["workers"] == 2
+    for key in ("monte_carlo", "linearised", "worst_per_platform", "failures"):
+        assert same(local[key], remote[key]), key
+    assert (tmp_path / "tl" / "platforms.csv").read_text() == (tmp_path / "tr" / "platforms.csv").read_text()
+    common = ["--heights", "0", "--spacing", "0.05", "--map-spacing", "0.05", "--yaws", "0", "--json", "--no-figures"]
+    local = run("workspace", *common, "--out", str(tmp_path / "wl"))
+    remote = run("workspace", *common, "--out", str(tmp_path / "wr"), "--scheduler", scheduler)
+    assert (local["volume"], local["volume_error"]) == (remote["volume"], remote["volume_error"])
+    assert (tmp_path / "wl" / "map.csv").read_text() == (tmp_path / "wr" / "map.csv").read_text()
