@@ -138,23 +138,23 @@ std::string report_text(const Model& model, const DesignCommandOptions& o, const
                                                      : "lead sensitivity",
                      o.symmetry == "symmetric" ? "symmetric (odd legs turn +a, even legs -a)" : o.symmetry,
                      o.tilt ? ", tilts searched" : "", o.max_volume_loss_pct);
-  out += fmt::format("\n{:<28}{:>44}{:>44}\n", "", "before", "after");
-  out += fmt::format("{:<28}{:>44}{:>44}\n", "largest |twist|",
+  out += fmt::format("\n{:<28}{:>40}{:>40}\n", "", "before", "after");
+  out += fmt::format("{:<28}{:>40}{:>40}\n", "largest |twist|",
                      fmt::format("{:.2f} deg (leg {})", rad2deg(b.max_twist), b.twist_leg + 1),
                      fmt::format("{:.2f} deg (leg {})", rad2deg(a.max_twist), a.twist_leg + 1));
   out +=
-      fmt::format("{:<28}{:>44}{:>44}\n", "largest |length error|", fmt::format("{:.4f} mm", 1e3 * b.max_length_error),
+      fmt::format("{:<28}{:>40}{:>40}\n", "largest |length error|", fmt::format("{:.4f} mm", 1e3 * b.max_length_error),
                   fmt::format("{:.4f} mm", 1e3 * a.max_length_error));
-  out += fmt::format("{:<28}{:>44}{:>44}\n", "lead sensitivity (point A)",
+  out += fmt::format("{:<28}{:>40}{:>40}\n", "lead sensitivity (point A)",
                      fmt::format("{:.4f} mm per 1 % lead", 10.0 * b.max_lead_sensitivity),
                      fmt::format("{:.4f} mm per 1 % lead", 10.0 * a.max_lead_sensitivity));
-  out += fmt::format("{:<28}{:>44}{:>44}\n", "required poses reached (+ home)",
-                     fmt::format("{} of {}", b.reached, b.poses), fmt::format("{} of {}", a.reached, a.poses));
+  out += fmt::format("{:<28}{:>40}{:>40}\n", "poses reached (with home)", fmt::format("{} of {}", b.reached, b.poses),
+                     fmt::format("{} of {}", a.reached, a.poses));
   out += "margin: share of range left\n";
   for (int k = 0; k < kMarginKinds; ++k)
-    out += fmt::format("  {:<26}{:>44}{:>44}\n", kMarginLabels[k], margin_text(b.margins[static_cast<std::size_t>(k)]),
+    out += fmt::format("  {:<26}{:>40}{:>40}\n", kMarginLabels[k], margin_text(b.margins[static_cast<std::size_t>(k)]),
                        margin_text(a.margins[static_cast<std::size_t>(k)]));
-  out += fmt::format("{:<28}{:>44}{:>44}\n",
+  out += fmt::format("{:<28}{:>40}{:>40}\n",
                      fmt::format("volume at {:g},{:g},{:g} deg", rad2deg(d.volume_rpy[0]), rad2deg(d.volume_rpy[1]),
                                  rad2deg(d.volume_rpy[2])),
                      fmt::format("{:.4f} m^3 (+-{:.4f})", b.volume, b.volume_error),

@@ -256,7 +256,7 @@ std::string report_text(const Model& model, const ToleranceCommandOptions& o, co
       "axis; U-joint axes {:g} deg; lead {:g} ppm; zero offsets {:g} um\n",
       1e6 * s.base_joint, 1e6 * s.platform_joint, rad2deg(s.base_axis), 1e6 * s.lead, 1e6 * s.offset);
   out +=
-      fmt::format("{} platforms (seed {}) x {} poses, driven by {} compensated commands{}: {:.1f} s\n", sm.platforms,
+      fmt::format("{} platforms (seed {}) x {} poses, driven by {} compensated commands{} in {:.1f} s\n", sm.platforms,
                   o.seed, sm.poses, o.calibration == "perfect" ? "a perfectly calibrated controller's" : "the nominal",
                   workers > 0 ? fmt::format(" on {} Dask workers ({})", workers, printable(o.scheduler)) : "", seconds);
   if (sm.failures > 0)

@@ -371,9 +371,10 @@ std::string orientation_label(const Vector3d& rpy) {
   return fmt::format("roll {:g}, pitch {:g}, yaw {:g} deg", rad2deg(rpy[0]), rad2deg(rpy[1]), rad2deg(rpy[2]));
 }
 
-std::vector<Figure> figures(const Results& r, const fs::path& dir) {
+std::vector<Figure> figures(const Results& r, const fs::path& dir, const std::string& source) {
   std::vector<Figure> out;
-  const std::string at = orientation_label(r.rpy);
+  // The platform named by its source (a file name, or the seed), short enough for a title.
+  const std::string at = orientation_label(r.rpy) + ", " + source;
   // One panel per x-y slice, the plane drawn to scale.
   Figure xy{(dir / "slices_xy").string(), fmt::format("Constant-orientation workspace at {}: x-y slices", at), {}};
   for (std::size_t k = 0; k < r.xy_slices; ++k) {
@@ -531,7 +532,7 @@ int run_workspace(const WorkspaceCommandOptions& o) {
   std::vector<Figure> figs;
   if (!o.no_csv) names.insert(names.end(), {"slices.csv", "orientation.csv", "map.csv"});
   if (!o.no_figures) {
-    figs = figures(r, dir);
+    figs = figures(r, dir, model_source(o.model));
     for (const Figure& f : figs)
       for (const char* ext : {".png", ".svg"}) names.push_back(fs::path(f.stem).filename().string() + ext);
   }

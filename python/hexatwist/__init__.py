@@ -79,7 +79,8 @@ def _worker_threads():
         worker = distributed.get_worker()
     except (ValueError, AttributeError):
         return None
-    return getattr(worker, "nthreads", None)
+    state = getattr(worker, "state", None)  # distributed >= 2022.10 keeps it there
+    return getattr(state, "nthreads", None) if state is not None else getattr(worker, "nthreads", None)
 
 
 def _follow_worker():
