@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
 #include <memory>
 
 #include "cli_common.hpp"
@@ -134,32 +135,22 @@ std::string summary_json(const Model& model, const ToleranceCommandOptions& o, c
   j.field("seed", o.seed);
   j.field("calibration", o.calibration);
   j.field("failures", sm.failures);
-  j.key("monte_carlo").begin_object();
-  j.key("point");
-  quantiles_json(j, sm.point);
-  j.key("position");
-  quantiles_json(j, sm.position);
-  j.key("orientation");
-  quantiles_json(j, sm.orientation);
-  j.end_object();
-  j.key("linearised").begin_object();
-  j.key("point");
-  quantiles_json(j, sm.point_linear);
-  j.key("position");
-  quantiles_json(j, sm.position_linear);
-  j.key("orientation");
-  quantiles_json(j, sm.orientation_linear);
-  j.end_object();
-  j.key("worst_per_platform").begin_object();
-  j.key("point");
-  quantiles_json(j, sm.worst_point);
-  j.key("point_linear_model");
-  quantiles_json(j, sm.worst_point_linear);
-  j.key("position");
-  quantiles_json(j, sm.worst_position);
-  j.key("orientation");
-  quantiles_json(j, sm.worst_orientation);
-  j.end_object();
+  // Each group of quantiles an object of its errors.
+  const auto group = [&](const char* name, std::initializer_list<std::pair<const char*, const ErrorQuantiles*>> items) {
+    j.key(name).begin_object();
+    for (const auto& [key, q] : items) {
+      j.key(key);
+      quantiles_json(j, *q);
+    }
+    j.end_object();
+  };
+  group("monte_carlo", {{"point", &sm.point}, {"position", &sm.position}, {"orientation", &sm.orientation}});
+  group("linearised",
+        {{"point", &sm.point_linear}, {"position", &sm.position_linear}, {"orientation", &sm.orientation_linear}});
+  group("worst_per_platform", {{"point", &sm.worst_point},
+                               {"point_linear_model", &sm.worst_point_linear},
+                               {"position", &sm.worst_position},
+                               {"orientation", &sm.worst_orientation}});
   j.field("definitions",
           "pooled over every (platform, pose): the point A, pivot position and orientation (rotation angle) errors of "
           "the sampled platform driven by its controller's compensated commands; linearised: the same from the "

@@ -113,6 +113,13 @@ PlatformSource platform_of(const py::handle& src);
 /// A (3,) float64 vector argument (lists accepted); InputError naming it otherwise, or for NaN/inf.
 Vector3d vector3(const py::handle& obj, const char* name);
 
+/// The workspace searches' settings from Python arguments (InputError for an unknown strategy).
+WorkspaceOptions search_options(double step, double tolerance, const std::string& strategy);
+/// The slice `plane` ("xy", "xz", "yz") at `offset` [m] of `model` at `orientation` [rad], searched
+/// `spacing` [m] apart; InputError / StatusError beginning with `what` when it cannot be searched.
+WorkspaceSlice slice_of(const Model& model, const py::object& orientation, const std::string& plane, double offset,
+                        double spacing, double step, double tolerance, const std::string& strategy, const char* what);
+
 /// A limit report as a dict: status (name), leg (0-based), value, bound.
 py::dict limit_dict(const LimitReport& r);
 

@@ -166,16 +166,17 @@ py::dict summary_py(const py::dict& chunk, std::size_t poses, const py::object& 
   d["platforms"] = s.platforms;
   d["poses"] = s.poses;
   d["failures"] = s.failures;
-  d["point"] = quantiles_dict(s.point);
-  d["position"] = quantiles_dict(s.position);
-  d["orientation"] = quantiles_dict(s.orientation);
-  d["point_linear"] = quantiles_dict(s.point_linear);
-  d["position_linear"] = quantiles_dict(s.position_linear);
-  d["orientation_linear"] = quantiles_dict(s.orientation_linear);
-  d["worst_point"] = quantiles_dict(s.worst_point);
-  d["worst_point_linear"] = quantiles_dict(s.worst_point_linear);
-  d["worst_position"] = quantiles_dict(s.worst_position);
-  d["worst_orientation"] = quantiles_dict(s.worst_orientation);
+  const std::pair<const char*, const ErrorQuantiles*> quantiles[] = {{"point", &s.point},
+                                                                     {"position", &s.position},
+                                                                     {"orientation", &s.orientation},
+                                                                     {"point_linear", &s.point_linear},
+                                                                     {"position_linear", &s.position_linear},
+                                                                     {"orientation_linear", &s.orientation_linear},
+                                                                     {"worst_point", &s.worst_point},
+                                                                     {"worst_point_linear", &s.worst_point_linear},
+                                                                     {"worst_position", &s.worst_position},
+                                                                     {"worst_orientation", &s.worst_orientation}};
+  for (const auto& [key, q] : quantiles) d[key] = quantiles_dict(*q);
   return d;
 }
 

@@ -13,18 +13,21 @@ SlicePlane plane_from(const std::string& name) {
   raise_input("plane: expected 'xy', 'xz' or 'yz', got '" + name + "'");
 }
 
-namespace {
-
-py::dict slice_py(const Model& model, const py::object& orientation, const std::string& plane, double offset,
-                  double spacing, double step, double tolerance, const std::string& strategy) {
-  SliceSpec spec;
-  spec.plane = plane_from(plane);
-  spec.offset = offset;
-  spec.spacing = spacing;
+WorkspaceOptions search_options(double step, double tolerance, const std::string& strategy) {
   WorkspaceOptions o;
   o.step = step;
   o.tolerance = tolerance;
   o.strategy = strategy_from(strategy);
+  return o;
+}
+
+WorkspaceSlice slice_of(const Model& model, const py::object& orientation, const std::string& plane, double offset,
+                        double spacing, double step, double tolerance, const std::string& strategy, const char* what) {
+  SliceSpec spec;
+  spec.plane = plane_from(plane);
+  spec.offset = offset;
+  spec.spacing = spacing;
+  const WorkspaceOptions o = search_options(step, tolerance, strategy);
   const Vector3d rpy = vector3(orientation, "orientation");
   WorkspaceSlice s;
   Status st;
@@ -33,8 +36,17 @@ py::dict slice_py(const Model& model, const py::object& orientation, const std::
     st = workspace_slice(model, rpy, spec, o, s);
   }
   if (st == Status::NonFiniteInput)
-    raise_input("workspace_slice: offset, spacing, step and tolerance must be finite, > 0");
-  if (st != Status::Ok) raise_status(st, "workspace_slice: the legs' bounds do not meet");
+    raise_input(std::string(what) + ": offset, spacing, step and tolerance must be finite, > 0");
+  if (st != Status::Ok) raise_status(st, std::string(what) + ": the legs' bounds do not meet");
+  return s;
+}
+
+namespace {
+
+py::dict slice_py(const Model& model, const py::object& orientation, const std::string& plane, double offset,
+                  double spacing, double step, double tolerance, const std::string& strategy) {
+  const WorkspaceSlice s =
+      slice_of(model, orientation, plane, offset, spacing, step, tolerance, strategy, "workspace_slice");
   const std::size_t n = s.boundary.size();
   py::array_t<double> u(n), v(n), value(n), bound(n);
   py::array_t<double> inside({n, std::size_t{3}}), outside({n, std::size_t{3}});

@@ -30,25 +30,8 @@ MapGrid grid_of(const py::dict& d) {
 
 py::dict map_grid_py(const Model& model, const py::object& orientation, const std::string& plane, double offset,
                      double spacing, double step, double tolerance, const std::string& strategy) {
-  SliceSpec spec;
-  spec.plane = plane_from(plane);
-  spec.offset = offset;
-  spec.spacing = spacing;
-  WorkspaceOptions o;
-  o.step = step;
-  o.tolerance = tolerance;
-  o.strategy = strategy_from(strategy);
-  if (!(spacing > 0.0) || !std::isfinite(spacing)) raise_input("workspace_map: spacing must be finite and > 0");
-  const Vector3d rpy = vector3(orientation, "orientation");
-  WorkspaceSlice s;
-  Status st;
-  {
-    py::gil_scoped_release release;
-    st = workspace_slice(model, rpy, spec, o, s);
-  }
-  if (st == Status::NonFiniteInput) raise_input("workspace_map: offset, step and tolerance must be finite, > 0");
-  if (st != Status::Ok) raise_status(st, "workspace_map: the legs' bounds do not meet");
-  return grid_dict(map_grid_around(s, spacing));
+  return grid_dict(map_grid_around(
+      slice_of(model, orientation, plane, offset, spacing, step, tolerance, strategy, "workspace_map"), spacing));
 }
 
 // Rows [first, first + count) of the map as arrays (count, nu).

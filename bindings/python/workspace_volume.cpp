@@ -5,14 +5,6 @@
 namespace hexatwist::python {
 namespace {
 
-WorkspaceOptions search_options(double step, double tolerance, const std::string& strategy) {
-  WorkspaceOptions o;
-  o.step = step;
-  o.tolerance = tolerance;
-  o.strategy = strategy_from(strategy);
-  return o;
-}
-
 VolumeOptions volume_options(double cell, int refine, double step, double tolerance, const std::string& strategy,
                              int threads) {
   VolumeOptions o;
