@@ -92,3 +92,14 @@ def test_tolerance_does_not_depend_on_threads_and_a_perfect_calibration_leaves_n
         hexatwist.tolerance(sigmas=dict(joint=1e-5), **settings)
     with pytest.raises(hexatwist.InputError, match="workspace"):
         hexatwist.tolerance(platforms=2, randoms=5)
+
+
+def test_every_public_function_pickles_by_reference():
+    # Dask ships functions pickled (client.run(hexatwist.get_num_threads)): a pybind11 function does not pickle.
+    import pickle
+
+    functions = [getattr(hexatwist, n) for n in hexatwist.__all__
+                 if callable(getattr(hexatwist, n)) and not isinstance(getattr(hexatwist, n), type)]
+    assert len(functions) > 40
+    for f in functions:
+        assert pickle.loads(pickle.dumps(f)) is f, f.__name__
