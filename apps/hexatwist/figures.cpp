@@ -50,6 +50,9 @@ constexpr double kMaxKeyWidth = 340;     // a wider key goes under the plot
 constexpr double kKeyGap = 12;           // between the plot area and a key right of it
 constexpr double kKeyLineHeight = 19.5;  // of a key entry
 constexpr double kKeyBelowGap = 8;       // under a key below the plot
+constexpr double kColorBoxSpace = 150;   // right of a plot with a colour map: the bar, its ticks and its label
+constexpr double kColorBoxGap = 14;
+constexpr double kColorBoxWidth = 18;
 constexpr const char* kFont = "sans,11";
 constexpr const char* kTitleFont = "sans,13";
 constexpr double kLineWidth = 1.5;
@@ -180,7 +183,7 @@ struct Ticks {
   std::size_t last = 0;    // characters of the label at the upper end
 };
 
-Ticks ticks_for(char axis, Range r, double target_count) {
+Ticks ticks_for(char axis, Range r, double target_count, bool exact = false) {
   Ticks t;
   if (r.empty()) {
     // No finite point: gnuplot cannot autoscale, so an empty frame without tick labels.
@@ -227,10 +230,14 @@ Ticks ticks_for(char axis, Range r, double target_count) {
                  : fmt::format("{:.{}f}e{}", v / scale, mantissa_decimals, exponent);
   };
 
-  t.commands = fmt::format("set {}range [{:.17g}:{:.17g}]\nset {}tics (", axis, first * step, last * step, axis);
-  for (double k = first; k <= last + 0.5; k += 1.0) {
+  // An exact range (equal axes) keeps its ends and takes the ticks inside them.
+  const double lo_tick = exact ? std::ceil(r.lo / step - 1e-9) : first,
+               hi_tick = exact ? std::floor(r.hi / step + 1e-9) : last;
+  t.commands = fmt::format("set {}range [{:.17g}:{:.17g}]\nset {}tics (", axis, exact ? r.lo : first * step,
+                           exact ? r.hi : last * step, axis);
+  for (double k = lo_tick; k <= hi_tick + 0.5; k += 1.0) {
     const std::string text = label(k * step);
-    t.commands += fmt::format("{}'{}' {:.17g}", k == first ? "" : ", ", text, k * step);
+    t.commands += fmt::format("{}'{}' {:.17g}", k == lo_tick ? "" : ", ", text, k * step);
     t.widest = std::max(t.widest, text.size());
     t.last = text.size();
   }
@@ -262,12 +269,85 @@ struct FigureCommands {
   int height = 0;
 };
 
+std::string map_block_name(std::size_t f, std::size_t p) { return fmt::format("$f{}p{}map", f, p); }
+
+// Writes a heat map as a datablock (one scan line of u per v, blank lines between) and widens the
+// ranges by its cells.
+void append_map_block(std::string& out, const std::string& name, const HeatMap& m, Range& xr, Range& yr) {
+  out += name + " << EOD\n";
+  const std::size_t nu = m.u.size(), nv = m.v.size();
+  for (std::size_t j = 0; j < nv; ++j) {
+    for (std::size_t i = 0; i < nu; ++i) {
+      append_number(out, m.u[i]);
+      out += ' ';
+      append_number(out, m.v[j]);
+      out += ' ';
+      const double value = m.values[j * nu + i];
+      if (std::isfinite(value))
+        append_number(out, value);
+      else
+        out += "NaN";
+      out += '\n';
+    }
+    out += '\n';
+  }
+  out += "EOD\n";
+  // The cells reach half a step beyond the outer centres.
+  const double du = nu > 1 ? 0.5 * (m.u[nu - 1] - m.u[0]) / static_cast<double>(nu - 1) : 0.5;
+  const double dv = nv > 1 ? 0.5 * (m.v[nv - 1] - m.v[0]) / static_cast<double>(nv - 1) : 0.5;
+  if (nu > 0 && nv > 0) {
+    xr.add(m.u.front() - du), xr.add(m.u.back() + du);
+    yr.add(m.v.front() - dv), yr.add(m.v.back() + dv);
+  }
+}
+
+// The colour map's palette, range and bar for one panel (continuous: a perceptually even blue-green-
+// yellow scale; categories: one palette colour each).
+std::string map_commands(const HeatMap& m, double bar_left, double bar_bottom, double bar_height) {
+  std::string out;
+  if (!m.categories.empty()) {
+    const std::size_t n = m.categories.size();
+    out += fmt::format("set palette maxcolors {}\nset palette defined (", n);
+    for (std::size_t k = 0; k < n; ++k)
+      out += fmt::format("{}{} '{}'", k ? ", " : "", k, kPalette[k % kPalette.size()]);
+    out += fmt::format(")\nset cbrange [0.5:{}.5]\nset cbtics (", n);
+    for (std::size_t k = 0; k < n; ++k) out += fmt::format("{}{} {}", k ? ", " : "", gp_string(m.categories[k]), k + 1);
+    out += ") scale 0\n";
+  } else {
+    out +=
+        "set palette defined (0 '#440154', 0.125 '#472d7b', 0.25 '#3b528b', 0.375 '#2c728e', 0.5 '#21918c', "
+        "0.625 '#28ae80', 0.75 '#5ec962', 0.875 '#addc30', 1 '#fde725')\nset palette maxcolors 0\n";
+    Range r;
+    for (const double v : m.values)
+      if (std::isfinite(v)) r.add(v);
+    if (r.empty()) r.add(0.0), r.add(1.0);
+    if (!(r.hi > r.lo)) r.hi = r.lo + (r.lo != 0.0 ? 0.01 * std::abs(r.lo) : 1.0);
+    const Ticks t = ticks_for('x', r, 8.0, true);
+    // The same ticks on the bar: the range and tick list of ticks_for, renamed to the cb axis.
+    std::string cb = t.commands;
+    for (std::size_t at = cb.find("set xrange"); at != std::string::npos; at = cb.find("set xrange"))
+      cb.replace(at, 10, "set cbrange");
+    for (std::size_t at = cb.find("set xtics"); at != std::string::npos; at = cb.find("set xtics"))
+      cb.replace(at, 9, "set cbtics");
+    out += cb;
+  }
+  out += fmt::format("set colorbox user origin screen {:.5f},{:.5f} size screen {:.5f},{:.5f} border\n", bar_left,
+                     bar_bottom, kColorBoxWidth / kWidth, bar_height);
+  out += fmt::format("set cblabel {} offset 1,0\n", gp_string(m.label));
+  return out;
+}
+
 // Every panel is placed by hand (margins at screen positions) so that the plot areas of a figure
 // line up under each other, whatever their tick labels.
-FigureCommands figure_commands(const Figure& fig, std::size_t f, const std::vector<PanelRanges>& ranges) {
+FigureCommands figure_commands(const Figure& fig, std::size_t f, std::vector<PanelRanges> ranges) {
   static const Panel kNoPanel{};
   const std::size_t n_panels = ranges.size();
   const auto panel = [&](std::size_t p) -> const Panel& { return p < fig.panels.size() ? fig.panels[p] : kNoPanel; };
+  const auto panel_height = [&](std::size_t p) {
+    return static_cast<double>(panel(p).height > 0 ? panel(p).height : kPanelHeight);
+  };
+  bool maps = false;
+  for (const Panel& p : fig.panels) maps = maps || p.map.has_value();
 
   // Ticks first: the widest y tick label of the figure sets the left margin.
   std::vector<Ticks> xticks, yticks;
@@ -281,24 +361,25 @@ FigureCommands figure_commands(const Figure& fig, std::size_t f, const std::vect
   const double left_px = kLeftLabelSpace + kDigitWidth * static_cast<double>(ytick_chars);
 
   // The key never covers the data: right of the plot area, as wide as the longest label of the
-  // figure (so every panel has the same plot width), or, for labels too long for that, in one
-  // column under the x label.
+  // figure (so every panel has the same plot width), or, for labels too long for that or beside a
+  // colour map's bar, in one column under the x label.
   std::size_t longest = 0;
   for (const Panel& p : fig.panels)
     for (const Series& s : p.series) longest = std::max(longest, s.label.size());
   const double key_px = longest == 0 ? 0.0 : kKeySampleWidth + kCharWidth * static_cast<double>(longest);
-  const bool key_below = key_px > kMaxKeyWidth;
+  const bool key_below = key_px > kMaxKeyWidth || (maps && longest > 0);
   // Without a key on the right, room for half of the last x tick label, which is centred on the edge.
   const double right_px =
-      kWidth - (key_below ? std::max(kRightSpace, 0.5 * kDigitWidth * static_cast<double>(xtick_last) + 10.0)
-                          : kRightSpace + key_px);
+      maps ? kWidth - kColorBoxSpace
+           : kWidth - (key_below ? std::max(kRightSpace, 0.5 * kDigitWidth * static_cast<double>(xtick_last) + 10.0)
+                                 : kRightSpace + key_px);
 
   // Vertical layout [px from the top].
   std::vector<double> panel_top(n_panels);
   double height = fig.title.empty() ? 0.0 : kFigureTitleHeight;
   for (std::size_t p = 0; p < n_panels; ++p) {
     panel_top[p] = height;
-    height += kPanelHeight;
+    height += panel_height(p);
     if (key_below && !panel(p).series.empty())
       height += kKeyLineHeight * static_cast<double>(panel(p).series.size()) + kKeyBelowGap;
   }
@@ -318,34 +399,56 @@ FigureCommands figure_commands(const Figure& fig, std::size_t f, const std::vect
   for (std::size_t p = 0; p < n_panels; ++p) {
     const Panel& pn = panel(p);
     const double plot_top = panel_top[p] + (pn.title.empty() ? kPanelTopSpace : kPanelTitleSpace);
-    const double plot_bottom = panel_top[p] + kPanelHeight - kPanelBottomSpace;
+    const double plot_bottom = panel_top[p] + panel_height(p) - kPanelBottomSpace;
+    if (pn.equal_axes && !ranges[p].x.empty() && !ranges[p].y.empty()) {
+      // One unit as long on both axes: the range that is short for its side widened about its centre.
+      Range& x = ranges[p].x;
+      Range& y = ranges[p].y;
+      const double w = right_px - left_px, h = plot_bottom - plot_top;
+      const double per_px = std::max((x.hi - x.lo) / w, (y.hi - y.lo) / h) * 1.04;
+      const double cx = 0.5 * (x.lo + x.hi), cy = 0.5 * (y.lo + y.hi);
+      x = Range{cx - 0.5 * per_px * w, cx + 0.5 * per_px * w};
+      y = Range{cy - 0.5 * per_px * h, cy + 0.5 * per_px * h};
+      xticks[p] = ticks_for('x', x, 8.0, true);
+      yticks[p] = ticks_for('y', y, 8.0 * h / w * 1.6, true);
+    }
     out += fmt::format("set tmargin at screen {:.5f}\nset bmargin at screen {:.5f}\n", screen_y(plot_top),
                        screen_y(plot_bottom));
     out += pn.title.empty() ? "unset title\n" : fmt::format("set title {} offset 0,-0.3\n", gp_string(pn.title));
     out += fmt::format("set xlabel {}\nset ylabel {}\n", gp_string(pn.xlabel), gp_string(pn.ylabel));
     if (key_below)
       out += fmt::format("set key at screen {:.5f},{:.5f} left top Left reverse samplen 3 spacing 1.15\n",
-                         left_px / kWidth, screen_y(panel_top[p] + kPanelHeight));
+                         left_px / kWidth, screen_y(panel_top[p] + panel_height(p)));
     else
       out += fmt::format("set key at screen {:.5f},{:.5f} left top Left reverse samplen 3 spacing 1.15\n",
                          (right_px + kKeyGap) / kWidth, screen_y(plot_top));
     out += xticks[p].commands + yticks[p].commands;
     out += ranges[p].x.empty() ? "set label 1 'no data' at graph 0.5,0.5 center textcolor rgb '#808080'\n"
                                : "unset label 1\n";
-    if (pn.series.empty()) {
+    if (pn.map)
+      out += map_commands(*pn.map, (right_px + kColorBoxGap) / kWidth, screen_y(plot_bottom),
+                          (plot_bottom - plot_top) / height);
+    else
+      out += "unset colorbox\n";
+    if (pn.series.empty() && !pn.map) {
       out += "plot NaN notitle\n";
       continue;
     }
     out += "plot";
+    const char* sep = "";  // a std::string here meets GCC 12's false -Wrestrict on its assignment
+    if (pn.map) {
+      out += fmt::format(" {} using 1:2:3 with image notitle", map_block_name(f, p));
+      sep = ",";
+    }
     for (std::size_t s = 0; s < pn.series.size(); ++s) {
       const Series& series = pn.series[s];
       if (series.style == Series::Style::Points)
-        out += fmt::format("{} {} using 1:2 with points pt 7 ps 0.4 lc rgb '{}' title {}", s == 0 ? "" : ",",
-                           block_name(f, p, s), kPalette[s % kPalette.size()], gp_string(series.label));
+        out += fmt::format("{} {} using 1:2 with points pt 7 ps 0.4 lc rgb '{}' title {}", sep, block_name(f, p, s),
+                           kPalette[s % kPalette.size()], gp_string(series.label));
       else
-        out += fmt::format("{} {} using 1:2 with lines lw {} lc rgb '{}' dt {} title {}", s == 0 ? "" : ",",
-                           block_name(f, p, s), kLineWidth, kPalette[s % kPalette.size()], dash(series.style),
-                           gp_string(series.label));
+        out += fmt::format("{} {} using 1:2 with lines lw {} lc rgb '{}' dt {} title {}", sep, block_name(f, p, s),
+                           kLineWidth, kPalette[s % kPalette.size()], dash(series.style), gp_string(series.label));
+      sep = ",";
       if (s + 1 < pn.series.size()) out += " \\\n ";
     }
     out += "\n";
@@ -363,9 +466,11 @@ Script build_script(const std::vector<Figure>& figures, const fs::path& dir) {
     script.figure_start.push_back(out.size());
     // A figure without panels is drawn as one empty panel.
     std::vector<PanelRanges> ranges(std::max<std::size_t>(fig.panels.size(), 1));
-    for (std::size_t p = 0; p < fig.panels.size(); ++p)
+    for (std::size_t p = 0; p < fig.panels.size(); ++p) {
+      if (fig.panels[p].map) append_map_block(out, map_block_name(f, p), *fig.panels[p].map, ranges[p].x, ranges[p].y);
       for (std::size_t s = 0; s < fig.panels[p].series.size(); ++s)
         append_datablock(out, block_name(f, p, s), fig.panels[p].series[s], ranges[p].x, ranges[p].y);
+    }
     const FigureCommands commands = figure_commands(fig, f, ranges);
     const std::string common = fmt::format("size {},{} font '{}' noenhanced", kWidth, commands.height, kFont);
     out += fmt::format("set terminal pngcairo {} background rgb 'white'\n", common);
@@ -376,8 +481,10 @@ Script build_script(const std::vector<Figure>& figures, const fs::path& dir) {
     out += commands.text;
     out += "set output\n";
     // Free the data of this figure before the next is read.
-    for (std::size_t p = 0; p < fig.panels.size(); ++p)
+    for (std::size_t p = 0; p < fig.panels.size(); ++p) {
+      if (fig.panels[p].map) out += "undefine " + map_block_name(f, p) + "\n";
       for (std::size_t s = 0; s < fig.panels[p].series.size(); ++s) out += "undefine " + block_name(f, p, s) + "\n";
+    }
   }
   return script;
 }
@@ -540,6 +647,13 @@ void write_figures(const std::vector<Figure>& figures) {
     if (!stems.insert(fig.stem).second)
       throw ExitError(kExitOutputFailed,
                       fmt::format("two figures would both be written to '{}.png'", printable(fig.stem)));
+    for (const Panel& panel : fig.panels)
+      if (panel.map && (panel.map->u.empty() || panel.map->v.empty() ||
+                        panel.map->values.size() != panel.map->u.size() * panel.map->v.size()))
+        throw ExitError(kExitOutputFailed,
+                        fmt::format("figure '{}': colour map '{}' has {} values for {} x {} cells", printable(fig.stem),
+                                    printable(panel.map->label), panel.map->values.size(), panel.map->u.size(),
+                                    panel.map->v.size()));
     for (const Panel& panel : fig.panels)
       for (const Series& s : panel.series)
         if (s.x.size() != s.y.size())

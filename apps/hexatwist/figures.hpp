@@ -2,8 +2,10 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hexatwist::cli {
@@ -16,12 +18,29 @@ struct Series {
   enum class Style { Solid, Dashed, Dotted, Points } style = Style::Solid;
 };
 
+/// A colour map on a regular grid, drawn under a panel's series with its colour bar right of the
+/// plot: value j * u.size() + i at (u[i], v[j]); NaN cells are left blank.
+struct HeatMap {
+  std::vector<double> u, v;             ///< cell centres, evenly spaced and increasing [caller's units]
+  std::vector<double> values;           ///< v.size() rows of u.size() values
+  std::string label;                    ///< the colour bar's label with its unit
+  std::vector<std::string> categories;  ///< when set, values are 1..n drawn in n distinct colours named by these
+};
+
 /// One plot with its own axes; colours follow the order of `series` (a fixed palette of six).
 struct Panel {
+  Panel() = default;
+  /// The common case, a plot of lines or points: title, axis labels, series (map, height, axes default).
+  Panel(std::string title_, std::string xlabel_, std::string ylabel_, std::vector<Series> series_ = {})
+      : title(std::move(title_)), xlabel(std::move(xlabel_)), ylabel(std::move(ylabel_)), series(std::move(series_)) {}
+
   std::string title;   ///< may be empty
   std::string xlabel;  ///< axis label with its unit, e.g. "time [s]"
   std::string ylabel;  ///< axis label with its unit
   std::vector<Series> series;
+  std::optional<HeatMap> map;  ///< a colour map under the series (a figure with one puts its key under the plots)
+  int height = 0;              ///< of the panel [px]; 0 = 380
+  bool equal_axes = false;     ///< one unit as long on both axes (a ranges widened to fit), for maps of a plane
 };
 
 /// One figure: panels stacked vertically, each with its own axes (they share nothing).

@@ -56,20 +56,20 @@ std::atomic<unsigned>& thread_setting() noexcept;
 /// The threads a batch call may use: the setting, or every core.
 unsigned thread_count() noexcept;
 
-/// Runs body(begin, end) over [0, n) in blocks of kBlock poses spread over the cores, with the GIL
-/// released. Small batches run on the calling thread.
+/// Runs body(begin, end) over [0, n) in blocks of `block` items (kBlock poses by default) spread
+/// over the cores, with the GIL released. Small batches run on the calling thread.
 template <class F>
-void parallel_blocks(std::size_t n, F&& body) {
+void parallel_blocks(std::size_t n, F&& body, std::size_t block = kBlock) {
   py::gil_scoped_release release;
-  const std::size_t blocks = (n + kBlock - 1) / kBlock;
+  const std::size_t blocks = (n + block - 1) / block;
   const std::size_t workers = blocks > 1 ? std::min<std::size_t>(thread_count(), blocks) : 1;
   if (workers <= 1) {
-    for (std::size_t b = 0; b < blocks; ++b) body(b * kBlock, std::min(n, (b + 1) * kBlock));
+    for (std::size_t b = 0; b < blocks; ++b) body(b * block, std::min(n, (b + 1) * block));
     return;
   }
   std::atomic<std::size_t> next{0};
   auto run = [&] {
-    for (std::size_t b = next++; b < blocks; b = next++) body(b * kBlock, std::min(n, (b + 1) * kBlock));
+    for (std::size_t b = next++; b < blocks; b = next++) body(b * block, std::min(n, (b + 1) * block));
   };
   std::vector<std::thread> threads;
   threads.reserve(workers - 1);
@@ -102,6 +102,28 @@ std::shared_ptr<const PyRig> rig_of(const py::handle& src);
 /// A copy of that configuration.
 Config python_config(const py::object& src);
 
+/// A platform argument of the design functions: a Model, or a config (Rig, YAML text, path, None
+/// for the seed) with its study section and its text (empty for a Model).
+struct PlatformSource {
+  std::shared_ptr<const Model> model;
+  StudySpec study;
+  std::string yaml, source;
+};
+PlatformSource platform_of(const py::handle& src);
+
+/// A (3,) float64 vector argument (lists accepted); InputError naming it otherwise, or for NaN/inf.
+Vector3d vector3(const py::handle& obj, const char* name);
+
+/// The workspace searches' settings from Python arguments (InputError for an unknown strategy).
+WorkspaceOptions search_options(double step, double tolerance, const std::string& strategy);
+/// The slice `plane` ("xy", "xz", "yz") at `offset` [m] of `model` at `orientation` [rad], searched
+/// `spacing` [m] apart; InputError / StatusError beginning with `what` when it cannot be searched.
+WorkspaceSlice slice_of(const Model& model, const py::object& orientation, const std::string& plane, double offset,
+                        double spacing, double step, double tolerance, const std::string& strategy, const char* what);
+
+/// A limit report as a dict: status (name), leg (0-based), value, bound.
+py::dict limit_dict(const LimitReport& r);
+
 /// A (6,) float64 vector argument (lists accepted); InputError naming it otherwise, or for NaN/inf.
 Vector6d vector6(const py::handle& obj, const char* name);
 
@@ -131,5 +153,10 @@ void expose_motor_sizing(py::module_& m);
 void expose_registration(py::module_& m);
 void expose_workspace(py::module_& m);
 void expose_mjcf(py::module_& m);
+void expose_workspace_volume(py::module_& m);
+void expose_workspace_boundary(py::module_& m);
+void expose_workspace_map(py::module_& m);
+void expose_axis_design(py::module_& m);
+void expose_tolerance(py::module_& m);
 
 }  // namespace hexatwist::python

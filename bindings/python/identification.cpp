@@ -32,7 +32,10 @@ std::vector<int> targets_of(const py::object& targets, std::size_t n) {
 
 namespace {
 
-py::array_t<double> array(const Eigen::VectorXd& v) {
+// A copy of a vector, fixed-size or dynamic (no conversion to a dynamic one: GCC 12 then flags
+// Eigen's AVX-512 loads).
+template <class V>
+py::array_t<double> array(const V& v) {
   return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
 }
 
@@ -159,7 +162,7 @@ py::dict result(const Identification& id, Status s) {
   d["axes_fitted"] = py::tuple(fitted_axes);
   py::list targets;
   for (int t = 0; t < ps.targets() && id.estimate.size() == ps.size(); ++t)
-    targets.append(array(ps.target(id.estimate, t)));
+    targets.append(array(Vector3d(ps.target(id.estimate, t))));
   d["targets"] = targets;
   d["observations"] = id.observations;
   d["stations"] = id.stations;

@@ -20,4 +20,9 @@ PYBIND11_MODULE(_hexatwist, m) {
   expose_registration(m);
   expose_workspace(m);
   expose_mjcf(m);
+  expose_workspace_volume(m);
+  expose_workspace_boundary(m);
+  expose_workspace_map(m);
+  expose_axis_design(m);
+  expose_tolerance(m);
 }

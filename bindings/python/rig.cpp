@@ -57,6 +57,42 @@ std::shared_ptr<const PyRig> rig_of(const py::handle& src) {
 
 Config python_config(const py::object& src) { return *rig_of(src)->config; }
 
+PlatformSource platform_of(const py::handle& src) {
+  PlatformSource p;
+  if (py::isinstance<Model>(src)) {
+    p.model = src.cast<std::shared_ptr<Model>>();
+    p.source = "model";
+    return p;
+  }
+  const std::shared_ptr<const PyRig> rig = rig_of(src);
+  p.model = std::shared_ptr<const Model>(rig, &rig->config->rig.model());
+  p.study = rig->config->study;
+  p.yaml = rig->yaml;
+  p.source = rig->source;
+  return p;
+}
+
+Vector3d vector3(const py::handle& obj, const char* name) {
+  py::array_t<double> a;
+  try {
+    a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(obj);
+  } catch (...) {
+  }
+  if (!a || a.ndim() != 1 || a.shape(0) != 3) raise_input(std::string(name) + ": expected 3 numbers");
+  const Vector3d v(a.data()[0], a.data()[1], a.data()[2]);
+  if (!v.allFinite()) raise_input(std::string(name) + ": holds NaN or inf");
+  return v;
+}
+
+py::dict limit_dict(const LimitReport& r) {
+  py::dict d;
+  d["status"] = std::string(to_string(r.status));
+  d["leg"] = r.leg;
+  d["value"] = r.value;
+  d["bound"] = r.bound;
+  return d;
+}
+
 void expose_rig(py::module_& m) {
   py::class_<PyRig, std::shared_ptr<PyRig>> c(
       m, "Rig",

@@ -22,15 +22,6 @@ int coordinate_of(const py::object& c) {
   return i;
 }
 
-py::dict limit_of(const LimitReport& r) {
-  py::dict d;
-  d["status"] = std::string(to_string(r.status));
-  d["leg"] = r.leg;
-  d["value"] = r.value;
-  d["bound"] = r.bound;
-  return d;
-}
-
 py::dict axis_range_py(const Model& model, const py::object& coordinate, const std::string& strategy,
                        double linear_step, double angular_step, double linear_bound, double angular_bound,
                        double tolerance) {
@@ -54,8 +45,8 @@ py::dict axis_range_py(const Model& model, const py::object& coordinate, const s
   d["coordinate"] = kCoordinates[static_cast<std::size_t>(k)];
   d["lower"] = r.lower;
   d["upper"] = r.upper;
-  d["lower_limit"] = limit_of(r.lower_limit);
-  d["upper_limit"] = limit_of(r.upper_limit);
+  d["lower_limit"] = limit_dict(r.lower_limit);
+  d["upper_limit"] = limit_dict(r.upper_limit);
   return d;
 }
 

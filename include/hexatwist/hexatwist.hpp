@@ -37,6 +37,13 @@
 #include "hexatwist/calibration/stations.hpp"
 #include "hexatwist/calibration/synthesis.hpp"
 
+#include "hexatwist/design/axis_design.hpp"
+#include "hexatwist/design/required_workspace.hpp"
+#include "hexatwist/design/tolerance.hpp"
+#include "hexatwist/design/workspace_boundary.hpp"
+#include "hexatwist/design/workspace_map.hpp"
+#include "hexatwist/design/workspace_volume.hpp"
+
 #include "hexatwist/io/config.hpp"
 #include "hexatwist/io/mjcf.hpp"
 #include "hexatwist/io/platform_yaml.hpp"

@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import enum
 import os
+import sys
 
 import numpy as np
 
 from ._hexatwist import (  # noqa: F401  (re-exported)
     BLOCK,
     MAX_TRAJECTORY_SAMPLES,
+    HISTOGRAM_BINS,
     STATUS_NAMES,
     ConfigError,
     DTypeError,
@@ -28,28 +30,102 @@ from ._hexatwist import (  # noqa: F401  (re-exported)
     StatusError,
     Stream,
     TORQUE_TERMS,
-    _input_copies,
-    bias,
-    control_period,
-    default_model,
-    describe_status,
-    forward_dynamics,
-    kinetic_energy,
-    mass_matrix,
-    mjcf,
-    motor_angles,
-    motor_jacobian,
-    peak_torque_at,
-    potential_energy,
-    get_num_threads,
-    set_num_threads,
-    load_model,
-    motor_command,
-    seed_config_yaml,
-    study_trajectory,
 )
 from . import _hexatwist as _core
-from .distributed import map_batch, map_simulations  # noqa: F401
+
+
+def _exported(name):
+    """The compiled function ``name`` as a Python function of this package. A pybind11 function is
+    bound to a PyCapsule, which does not pickle; this one pickles by reference (``hexatwist.<name>``),
+    so it can be shipped to Dask workers (``client.run(hexatwist.get_num_threads)``)."""
+    compiled = getattr(_core, name)
+
+    def function(*args, **kwargs):
+        return compiled(*args, **kwargs)
+
+    function.__name__ = function.__qualname__ = name
+    function.__module__ = __name__
+    function.__doc__ = compiled.__doc__
+    return function
+
+
+_input_copies = _exported("_input_copies")
+bias = _exported("bias")
+control_period = _exported("control_period")
+default_model = _exported("default_model")
+describe_status = _exported("describe_status")
+forward_dynamics = _exported("forward_dynamics")
+kinetic_energy = _exported("kinetic_energy")
+load_model = _exported("load_model")
+mass_matrix = _exported("mass_matrix")
+mjcf = _exported("mjcf")
+motor_angles = _exported("motor_angles")
+def _motor_command_function():
+    compiled = _core.motor_command
+
+    # The one-pose call is the one whose cost matters: its arguments spelt out (about 25 ns over the
+    # compiled function, where *args, **kwargs cost 150 ns).
+    def motor_command(model, pose, strategy="compensated"):
+        return compiled(model, pose, strategy)
+
+    motor_command.__module__, motor_command.__qualname__ = __name__, "motor_command"
+    motor_command.__doc__ = compiled.__doc__
+    return motor_command
+
+
+motor_command = _motor_command_function()
+motor_jacobian = _exported("motor_jacobian")
+peak_torque_at = _exported("peak_torque_at")
+potential_energy = _exported("potential_energy")
+seed_config_yaml = _exported("seed_config_yaml")
+study_trajectory = _exported("study_trajectory")
+tilt_torsion_rotation = _exported("tilt_torsion_rotation")
+
+_explicit_threads = False
+
+
+def _worker_threads():
+    """The thread count of the Dask worker this process is, or None outside one."""
+    distributed = sys.modules.get("distributed")
+    if distributed is None:
+        return None
+    try:
+        worker = distributed.get_worker()
+    except (ValueError, AttributeError):
+        return None
+    state = getattr(worker, "state", None)  # distributed >= 2022.10 keeps it there
+    return getattr(state, "nthreads", None) if state is not None else getattr(worker, "nthreads", None)
+
+
+def _follow_worker():
+    """On a Dask worker, hexatwist's threads follow the worker's (``--nthreads``) unless
+    :func:`set_num_threads` chose a count."""
+    if not _explicit_threads:
+        n = _worker_threads()
+        if n:
+            _core.set_num_threads(int(n))
+
+
+def set_num_threads(n: int) -> None:
+    """Threads of the batch and design functions (0, the default: every core; on a Dask worker, the
+    worker's thread count). Results do not depend on it."""
+    global _explicit_threads
+    _core.set_num_threads(n)
+    _explicit_threads = n != 0
+    if n == 0:
+        _follow_worker()
+
+
+def get_num_threads() -> int:
+    """Threads the batch and design functions use."""
+    _follow_worker()
+    return _core.get_num_threads()
+
+
+_follow_worker()
+
+from .distributed import map_batch, map_simulations  # noqa: E402,F401
+from . import distributed as _distributed  # noqa: E402
 
 __all__ = [
     "BLOCK", "MAX_TRAJECTORY_SAMPLES", "STATUS_NAMES", "Status", "Result", "Error", "ConfigError", "InputError", "DTypeError", "StatusError",
@@ -60,6 +136,8 @@ __all__ = [
     "Rig", "TORQUE_TERMS", "platform_motion", "inverse_dynamics", "mass_matrix", "bias", "forward_dynamics",
     "kinetic_energy", "potential_energy", "motor_angles", "motor_jacobian", "peak_torque_at", "size_motors",
     "FkTracker", "forward_kinematics_tracked", "register_points", "axis_range", "COORDINATES", "mjcf",
+    "HISTOGRAM_BINS", "workspace_volume", "workspace_slice", "orientation_workspace", "tilt_torsion_rotation",
+    "workspace_map", "required_workspace", "design_axes", "tolerance",
 ]
 
 COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
@@ -328,3 +406,148 @@ def axis_range(model: Model, coordinate, strategy: str = "compensated", **option
     linear_bound [m], angular_bound [rad], tolerance [m or rad]. Raises StatusError when home is outside a limit.
     """
     return Result(_core._axis_range(model, coordinate, strategy, **options))
+
+
+# ---- design: workspace, U-joint axes, tolerances (docs/theory/design.md §16-19) -------------------
+
+
+def _workspace_spec(workspace):
+    """The required workspace's settings (dict keys tests, test_samples, random, linear [m], angular
+    [rad], seed), defaults filled in."""
+    spec = dict(tests=True, test_samples=41, random=2000, linear=0.25, angular=float(np.radians(15.0)), seed=1)
+    unknown = set(workspace or {}) - set(spec)
+    if unknown:
+        raise InputError(f"workspace: unknown key(s) {', '.join(sorted(unknown))}; expected {', '.join(spec)}")
+    spec.update(workspace or {})
+    return dict(tests=bool(spec["tests"]), test_samples=int(spec["test_samples"]), random=int(spec["random"]),
+                linear=float(spec["linear"]), angular=float(spec["angular"]), seed=int(spec["seed"]))
+
+
+def required_workspace(config=None, *, strategy: str = "compensated", **workspace) -> Result:
+    """The poses a platform must reach (required_workspace.hpp): the study's four tests at their
+    amplitudes (``tests``, ``test_samples`` poses each) and ``random`` combined poses uniform in
+    +-``linear`` [m] and +-``angular`` [rad] (``seed``), kept where the platform reaches them.
+    ``config``: a Model, a Rig, YAML text, a path or None (the seed; the tests come from its study
+    section). Returns ``poses`` (N, 6) [m, rad], ``test_poses``, ``tests_dropped``, ``random_drawn``,
+    ``random_reached``."""
+    w = _workspace_spec(workspace)
+    return Result(_core._required_workspace(config, w["tests"], w["test_samples"], w["random"], w["linear"],
+                                            w["angular"], w["seed"], strategy))
+
+
+def workspace_volume(model: Model, orientation=(0.0, 0.0, 0.0), *, cell: float = 0.0, refine: int = 3,
+                     step: float = 0.005, tolerance: float = 1e-9, strategy: str = "compensated", client=None,
+                     chunk: int | None = None) -> Result:
+    """Volume of the constant-orientation workspace at ``orientation`` (roll, pitch, yaw [rad]) inside
+    every limit (workspace_volume.hpp): z columns searched (``step`` [m], bisected to ``tolerance``)
+    over an x-y grid of ``cell`` [m] (0: the bounds' larger side / 64) refined ``refine`` times across
+    the shadow's edge. Returns ``volume`` [m^3], ``error`` (its difference to the grid twice as coarse:
+    the stated error) [m^3], ``coarse_volume``, ``columns`` and ``grid``. With a dask ``client`` the
+    cells are computed on the workers (``chunk`` cells a task) and only their sums come back: the same
+    numbers, bit for bit."""
+    if client is not None:
+        return Result(_distributed.workspace_volume_on(client, model, orientation, cell, refine, step, tolerance,
+                                                       strategy, chunk))
+    return Result(_core._workspace_volume(model, orientation, cell, refine, step, tolerance, strategy,
+                                          get_num_threads()))
+
+
+def workspace_slice(model: Model, orientation=(0.0, 0.0, 0.0), plane: str = "xy", offset: float = 0.0,
+                    spacing: float = 0.01, *, step: float = 0.005, tolerance: float = 1e-9,
+                    strategy: str = "compensated") -> Result:
+    """The boundary of a slice of the constant-orientation workspace (workspace_boundary.hpp):
+    ``plane`` "xy" (at z = ``offset`` [m]), "xz" (y = offset) or "yz" (x = offset), searched along
+    lines ``spacing`` [m] apart both ways. Per boundary point: ``u``, ``v`` in-plane [m], ``inside``
+    and ``outside`` (K, 3) positions [m, B] at most ``tolerance`` apart, the limit the outside one
+    breaks (``status`` int8, ``leg`` 0-based, ``value``, ``bound``), ``along`` (0: a line along u);
+    ``area`` [m^2] and ``extent`` (u0, u1, v0, v1) searched."""
+    return Result(_core._workspace_slice(model, orientation, plane, offset, spacing, step, tolerance, strategy))
+
+
+def orientation_workspace(model: Model, position=(0.0, 0.0, 0.0), torsions=(0.0,), directions: int = 72, *,
+                          step: float = float(np.radians(0.5)), max_tilt: float = float(np.radians(90.0)),
+                          tolerance: float = 1e-9, strategy: str = "compensated") -> Result:
+    """The orientation workspace at ``position`` [m] (workspace_boundary.hpp): for each torsion [rad]
+    (the yaw at zero tilt) and each of ``directions`` azimuths, the largest tilt [rad] with every
+    smaller one inside every limit (tilt-and-torsion angles, :func:`tilt_torsion_rotation`). Returns
+    ``azimuth`` (D,), ``torsion`` (T,), ``tilt`` (T, D) [rad] (NaN: the torsion alone is refused) and
+    the limit met just beyond: ``status``, ``leg``, ``value``, ``bound`` (T, D)."""
+    return Result(_core._orientation_workspace(model, position, [float(t) for t in torsions], directions, step,
+                                               max_tilt, tolerance, strategy))
+
+
+def workspace_map(model: Model, orientation=(0.0, 0.0, 0.0), plane: str = "xy", offset: float = 0.0,
+                  spacing: float = 0.02, *, grid: dict | None = None, step: float = 0.005, tolerance: float = 1e-9,
+                  strategy: str = "compensated", client=None, chunk: int | None = None) -> Result:
+    """Maps over a slice (workspace_map.hpp) on a grid ``spacing`` [m] apart around the slice's
+    boundary (or ``grid``: plane, offset, u0, u1, nu, v0, v1, nv): per node (nv, nu) the ``status``
+    and ``limit_leg`` of its pose, and inside the workspace (NaN outside) ``max_twist`` [rad] and
+    ``twist_leg``, ``max_length_error`` [m] and ``length_error_leg``, the Jacobian's ``condition``
+    [-], the ``margin`` to the nearest limit (share of its range left) with ``nearest_status`` and
+    ``nearest_leg``; ``u`` (nu,), ``v`` (nv,) [m] and ``grid``. With a dask ``client`` the rows are
+    computed on the workers (``chunk`` rows a task): the same arrays, bit for bit."""
+    if client is not None:
+        return Result(_distributed.workspace_map_on(client, model, orientation, plane, offset, spacing, grid, step,
+                                                    tolerance, strategy, chunk))
+    if grid is None:
+        grid = _core._map_grid(model, orientation, plane, offset, spacing, step, tolerance, strategy)
+    r = Result(_core._workspace_map_rows(model, orientation, grid, strategy, 0, grid["nv"]))
+    return _map_result(r, grid)
+
+
+def _map_result(r, grid):
+    r["grid"] = dict(grid)
+    r["u"] = np.linspace(grid["u0"], grid["u1"], grid["nu"])
+    r["v"] = np.linspace(grid["v0"], grid["v1"], grid["nv"])
+    return r
+
+
+def design_axes(config=None, poses=None, *, objective: str = "twist", symmetry: str = "symmetric",
+                tilt: bool = False, max_tilt: float = float(np.radians(30.0)), grid_step: float = float(np.radians(5.0)),
+                fine_step: float = float(np.radians(0.05)), clearance: float = 0.0, max_volume_loss: float = 0.05,
+                volume_orientation=(0.0, 0.0, 0.0), cell: float = 0.0, volume_samples: int = 4000, seed: int = 1,
+                **workspace) -> Result:
+    """The fixed U-joint axes that minimise ``objective`` ("twist" [rad], "length_error" [m] or
+    "lead_sensitivity" [m per unit relative lead error]) over the required workspace (``poses`` (N, 6),
+    or the :func:`required_workspace` settings in ``workspace``), every limit kept at each of its poses
+    and the volume at ``volume_orientation`` within ``max_volume_loss`` (axis_design.hpp).
+    ``symmetry``: "symmetric" (odd legs turn +a, even legs -a), "threefold" or "per_leg"; ``tilt``
+    also searches tilts out of the joint planes. Returns the turns (6,) [rad] ``turn_base``,
+    ``turn_platform``, ``tilt_base``, ``tilt_platform``; ``before`` and ``after`` (largest twist,
+    length error and lead sensitivity, each limit's ``margins``, ``volume``); ``objective_before``,
+    ``objective_after``; the designed ``model``; and ``yaml``, the configuration with the new axes
+    (None when ``config`` is a Model)."""
+    w = _workspace_spec(workspace)
+    return Result(_core._design_axes(config, poses, w, objective, symmetry, tilt, max_tilt, grid_step, fine_step,
+                                     clearance, max_volume_loss, volume_orientation, cell, volume_samples, seed,
+                                     get_num_threads()))
+
+
+def tolerance(config=None, poses=None, *, platforms: int = 1000, seed: int = 1, sigmas: dict | None = None,
+              calibration: str = "none", linear_worst: bool = True, client=None, chunk: int | None = None,
+              **workspace) -> Result:
+    """Tolerance analysis (tolerance.hpp): ``platforms`` platforms with manufacturing errors
+    (``sigmas``: base_joint, platform_joint [m per coordinate], base_axis, platform_axis [rad], lead
+    [relative], offset [m]; per leg), each driven by the compensated commands of its controller (the
+    nominal model; ``calibration="perfect"``: one that knows the real platform) over the required
+    workspace (``poses``, or the :func:`required_workspace` settings in ``workspace``). Returns per
+    platform ``max_point``, ``rms_point``, ``max_position`` [m], ``max_orientation`` [rad],
+    ``max_point_linear`` (the linear model, same errors) and ``failures``; the pooled histograms
+    ``histogram_point`` ...; ``linear`` (the covariance answer: median and p95 of the point, position
+    and orientation errors); and ``summary``: Monte Carlo and linearised quantiles side by side. With
+    a dask ``client`` the platforms are sampled and evaluated on the workers (``chunk`` platforms a
+    task, poses generated there) and only their summaries come back: the same numbers, bit for bit."""
+    w = _workspace_spec(workspace)
+    sig = {k: float(v) for k, v in (sigmas or {}).items()}
+    if client is not None:
+        chunk_result, linear = _distributed.tolerance_on(client, config, poses, w, sig, int(seed), int(platforms),
+                                                         calibration, bool(linear_worst), chunk)
+    else:
+        threads = get_num_threads()
+        chunk_result = _core._tolerance_chunk(config, poses, w, sig, int(seed), 0, int(platforms), calibration,
+                                              bool(linear_worst), threads)
+        linear = _core._tolerance_linear(config, poses, w, sig, threads)
+    r = Result(chunk_result)
+    r["linear"] = linear
+    r["summary"] = _core._tolerance_summary(chunk_result, linear["poses"], linear)
+    return r

@@ -12,6 +12,7 @@ ConfigLike = Union["Rig", str, os.PathLike[str], None]  # a Rig, YAML text, a pa
 
 BLOCK: int
 MAX_TRAJECTORY_SAMPLES: int
+HISTOGRAM_BINS: int  # bins of the tolerance study's error histograms
 STATUS_NAMES: tuple[str, ...]
 TORQUE_TERMS: tuple[str, ...]  # gravity, platform_inertia, velocity_product, legs, drives, friction
 COORDINATES: tuple[str, ...]   # x, y, z, roll, pitch, yaw
@@ -170,3 +171,29 @@ def register_points(points_T: npt.ArrayLike, points_B: npt.ArrayLike, max_condit
 def axis_range(model: Model, coordinate: Union[int, str], strategy: str = "compensated", *,
                linear_step: float = 1e-3, angular_step: float = 1e-3, linear_bound: float = 10.0,
                angular_bound: float = ..., tolerance: float = 1e-9) -> Result: ...
+# Design (docs/theory/design.md §16-19): workspace, U-joint axes, tolerances. Orientation = roll, pitch, yaw [rad].
+def required_workspace(config: Union[Model, ConfigLike] = None, *, strategy: str = "compensated", tests: bool = True,
+                       test_samples: int = 41, random: int = 2000, linear: float = 0.25, angular: float = ...,
+                       seed: int = 1) -> Result: ...
+def workspace_volume(model: Model, orientation: PoseLike = (0.0, 0.0, 0.0), *, cell: float = 0.0, refine: int = 3,
+                     step: float = 0.005, tolerance: float = 1e-9, strategy: str = "compensated", client: Any = None,
+                     chunk: int | None = None) -> Result: ...
+def workspace_slice(model: Model, orientation: PoseLike = (0.0, 0.0, 0.0), plane: str = "xy", offset: float = 0.0,
+                    spacing: float = 0.01, *, step: float = 0.005, tolerance: float = 1e-9,
+                    strategy: str = "compensated") -> Result: ...
+def orientation_workspace(model: Model, position: PoseLike = (0.0, 0.0, 0.0), torsions: Sequence[float] = (0.0,),
+                          directions: int = 72, *, step: float = ..., max_tilt: float = ..., tolerance: float = 1e-9,
+                          strategy: str = "compensated") -> Result: ...
+def tilt_torsion_rotation(azimuth: float, tilt: float, torsion: float = 0.0) -> Array: ...  # (3, 3)
+def workspace_map(model: Model, orientation: PoseLike = (0.0, 0.0, 0.0), plane: str = "xy", offset: float = 0.0,
+                  spacing: float = 0.02, *, grid: dict[str, Any] | None = None, step: float = 0.005,
+                  tolerance: float = 1e-9, strategy: str = "compensated", client: Any = None,
+                  chunk: int | None = None) -> Result: ...
+def design_axes(config: Union[Model, ConfigLike] = None, poses: npt.ArrayLike | None = None, *,
+                objective: str = "twist", symmetry: str = "symmetric", tilt: bool = False, max_tilt: float = ...,
+                grid_step: float = ..., fine_step: float = ..., clearance: float = 0.0, max_volume_loss: float = 0.05,
+                volume_orientation: PoseLike = (0.0, 0.0, 0.0), cell: float = 0.0, volume_samples: int = 4000,
+                seed: int = 1, **workspace: Any) -> Result: ...
+def tolerance(config: Union[Model, ConfigLike] = None, poses: npt.ArrayLike | None = None, *, platforms: int = 1000,
+              seed: int = 1, sigmas: dict[str, float] | None = None, calibration: str = "none",
+              linear_worst: bool = True, client: Any = None, chunk: int | None = None, **workspace: Any) -> Result: ...

@@ -87,10 +87,31 @@ YAML::Node legs_node(const ModelSpec& platform) {
   return legs;
 }
 
+// Error unless `designed` is `base` with other axes.
+void check_only_axes(const ModelSpec& base, const ModelSpec& designed, std::string_view source) {
+  const auto fail = [&](const std::string& what) {
+    throw Error(
+        fmt::format("{}: the designed platform differs from the configuration in {}; only the U-joint axes "
+                    "may change",
+                    source, what));
+  };
+  if (designed.home_height != base.home_height) fail("home_height");
+  for (int i = 0; i < kLegs; ++i) {
+    const LegSpec& a = base.legs[static_cast<std::size_t>(i)];
+    const LegSpec& b = designed.legs[static_cast<std::size_t>(i)];
+    if (a.base_B != b.base_B) fail(fmt::format("leg {}: base", i + 1));
+    if (a.platform_P != b.platform_P) fail(fmt::format("leg {}: platform", i + 1));
+    if ((a.axis_base_B == Vector3d::Zero()) != (b.axis_base_B == Vector3d::Zero()))
+      fail(fmt::format("leg {}: base_axis (given in one, not the other)", i + 1));
+    if ((a.axis_platform_P == Vector3d::Zero()) != (b.axis_platform_P == Vector3d::Zero()))
+      fail(fmt::format("leg {}: platform_axis (given in one, not the other)", i + 1));
+  }
+}
+
 // The platform block, in the order the legs form reads.
 YAML::Node platform_block(const ModelSpec& platform, const Model& model, bool write_home_commands) {
   const LegSpec& first = platform.legs[0];
-  // The platform block, in the order the legs form reads.
+
   YAML::Node block(YAML::NodeType::Map);
   block["name"] = platform.name;
   block["home_height"] = number(platform.home_height);
@@ -168,6 +189,13 @@ std::string platform_config_yaml(std::string_view yaml_text, std::string_view so
   const std::string text = with_header(header, root);
   (void)load_config(text, source);  // what is written loads (a bug here must not reach a file)
   return text;
+}
+
+std::string designed_config_yaml(std::string_view yaml_text, std::string_view source, const ModelSpec& designed,
+                                 std::string_view header) {
+  const Config config = load_config(yaml_text, source);  // located errors for text that does not load
+  check_only_axes(config.rig.model().spec(), designed, source);
+  return platform_config_yaml(yaml_text, source, designed, header, false);
 }
 
 }  // namespace hexatwist

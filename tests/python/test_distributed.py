@@ -91,3 +91,87 @@ def test_sixteen_simulations_equal_the_local_run(client):
         assert a.summary == b.summary
         for key in ("time", "actual", "command", "motor", "error", "twist"):
             assert np.array_equal(a[key], b[key]), key
+
+
+def test_hexatwist_threads_follow_the_workers_and_its_functions_pickle(client):
+    # A compiled function shipped to every worker: it pickles, and each --nthreads 1 worker runs one thread.
+    assert set(client.run(hexatwist.get_num_threads).values()) == {1}
+    assert client.submit(hexatwist.get_num_threads, pure=False).result() == 1
+
+
+def test_per_row_keyword_arrays_are_cut_with_the_rows(client, model):
+    q = random_poses(20_000, seed=8)
+    r = hexatwist.commands(model, q)
+    m = r.commands[r.ok]
+    guess = q[r.ok]  # each row starts at its own pose
+    local = hexatwist.forward(model, m, guess=guess)
+    remote = hexatwist.map_batch("forward", model, m, client=client, chunk=4096, guess=guess)
+    for key in local:
+        assert np.array_equal(local[key], remote[key], equal_nan=True), key
+    # A single guess for every row stays whole.
+    one = hexatwist.map_batch("forward", model, m[:5000], client=client, chunk=4096, guess=guess[0])
+    assert np.array_equal(one.poses, hexatwist.forward(model, m[:5000], guess=guess[0]).poses, equal_nan=True)
+
+
+def same(a, b):
+    """Equal numbers, NaN equal to NaN, through nested dicts."""
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
+    if a is None or b is None:  # JSON's null for a number without a value
+        return a is None and b is None
+    return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True)
+
+
+def test_a_tolerance_study_on_two_workers_equals_the_local_run_bit_for_bit(client, model):
+    settings = dict(platforms=120, seed=4, random=150, test_samples=11, sigmas=dict(base_joint=80e-6, lead=1e-4))
+    local = hexatwist.tolerance(model, **settings)
+    remote = hexatwist.tolerance(model, client=client, chunk=17, **settings)
+    for key in local:
+        if isinstance(local[key], np.ndarray):
+            assert np.array_equal(local[key], remote[key], equal_nan=True), key
+    assert same(local.summary, remote.summary)
+    assert same(local.linear, remote.linear)
+    assert len(local.max_point) == 120 and local.summary["failures"] == 0
+
+
+def test_a_workspace_map_and_volume_on_two_workers_equal_the_local_run_bit_for_bit(client, model):
+    orientation = (0.05, -0.1, 0.2)
+    local = hexatwist.workspace_map(model, orientation, spacing=0.04)
+    remote = hexatwist.workspace_map(model, orientation, spacing=0.04, client=client, chunk=3)
+    for key in local:
+        if isinstance(local[key], np.ndarray):
+            assert np.array_equal(local[key], remote[key], equal_nan=True), key
+    assert local.grid == remote.grid
+    v_local = hexatwist.workspace_volume(model, orientation, cell=0.05)
+    v_remote = hexatwist.workspace_volume(model, orientation, cell=0.05, client=client, chunk=50)
+    assert (v_local.volume, v_local.error, v_local.coarse_volume) == (v_remote.volume, v_remote.error, v_remote.coarse_volume)
+
+
+@pytest.mark.skipif(not os.environ.get("HEXATWIST_CLI"), reason="the command-line tool is not built")
+def test_the_command_line_on_the_cluster_equals_its_local_run(client, tmp_path):
+    # hexatwist tolerance / workspace --scheduler: the samples on the workers, the report the same.
+    import json
+
+    cli = os.environ["HEXATWIST_CLI"]
+    scheduler = client.scheduler.address
+    env = dict(os.environ, HEXATWIST_PYTHON=sys.executable,
+               PYTHONPATH=os.pathsep.join(p for p in [os.path.dirname(os.path.dirname(hexatwist.__file__)),
+                                                      os.environ.get("PYTHONPATH", "")] if p))
+
+    def run(*args):
+        r = subprocess.run([cli, *args], env=env, capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0, r.stderr
+        return json.loads(r.stdout)
+
+    common = ["--platforms", "60", "--workspace", "random=80,samples=5", "--json", "--no-figures"]
+    local = run("tolerance", *common, "--out", str(tmp_path / "tl"))
+    remote = run("tolerance", *common, "--out", str(tmp_path / "tr"), "--scheduler", scheduler)
+    assert remote["cluster"]["workers"] == 2
+    for key in ("monte_carlo", "linearised", "worst_per_platform", "failures"):
+        assert same(local[key], remote[key]), key
+    assert (tmp_path / "tl" / "platforms.csv").read_text() == (tmp_path / "tr" / "platforms.csv").read_text()
+    common = ["--heights", "0", "--spacing", "0.05", "--map-spacing", "0.05", "--yaws", "0", "--json", "--no-figures"]
+    local = run("workspace", *common, "--out", str(tmp_path / "wl"))
+    remote = run("workspace", *common, "--out", str(tmp_path / "wr"), "--scheduler", scheduler)
+    assert (local["volume"], local["volume_error"]) == (remote["volume"], remote["volume_error"])
+    assert (tmp_path / "wl" / "map.csv").read_text() == (tmp_path / "wr" / "map.csv").read_text()

@@ -221,7 +221,9 @@ TEST(Simulation, TheHoldingTorqueIsWhatTheTrajectoryCheckComparesWithTheLimit) {
     const Rig limited(rig.model(), servo, rig.load(), rig.simulation(), rig.mechanism());
     const Status s = check_trajectory(limited, still(pose, 0.01), issue);
     EXPECT_EQ(s, factor > 1.0 ? Status::Ok : Status::TorqueAboveMax);
-    if (s == Status::TorqueAboveMax) EXPECT_EQ(issue.limit.value, worst);
+    if (s == Status::TorqueAboveMax) {
+      EXPECT_EQ(issue.limit.value, worst);
+    }
   }
 }
 

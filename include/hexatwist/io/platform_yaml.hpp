@@ -23,6 +23,13 @@ namespace hexatwist {
 std::string platform_config_yaml(std::string_view yaml_text, std::string_view source, const ModelSpec& platform,
                                  std::string_view header, bool write_home_commands);
 
+/// A design's configuration (docs/theory/design.md §17): platform_config_yaml of `designed`, which
+/// must be the text's platform with other U-joint axes (a `symmetric` block becomes the same platform
+/// in the legs form). Throws hexatwist::Error as load_config for text that does not load, and naming
+/// the leg and field when `designed` differs from the text's platform in more than its axes.
+std::string designed_config_yaml(std::string_view yaml_text, std::string_view source, const ModelSpec& designed,
+                                 std::string_view header);
+
 /// The model `spec` alone as a configuration in the legs form: the platform block as above, its
 /// limits (angles in degrees, as the file takes them) and pivot, nothing else. Loads back to the
 /// same model, every double exactly. Throws hexatwist::Error if `spec` is no model.

@@ -1,0 +1,374 @@
+// hexatwist tolerance: how accurate a platform built with manufacturing errors is, before it is built
+// (design/tolerance.hpp): the Monte Carlo over sampled platforms driven by the nominal compensated
+// commands, beside the linearised (covariance) answer; on this machine or a Dask cluster.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <initializer_list>
+#include <memory>
+
+#include "cli_common.hpp"
+#include "cluster.hpp"
+#include "design_options.hpp"
+#include "figures.hpp"
+#include "json.hpp"
+#include "output_files.hpp"
+#include "study_report.hpp"
+
+namespace hexatwist::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ToleranceCommandOptions {
+  ModelOptions model;
+  RequiredOptions required;
+  std::uint64_t platforms = 1000;
+  std::uint64_t seed = 1;
+  double joint_um = 50.0;
+  double base_joint_um = NAN, platform_joint_um = NAN;
+  double axis_deg = 0.1;
+  double lead_ppm = 50.0;
+  double offset_um = 100.0;
+  std::string calibration = "none";
+  std::string out = "tolerance-out";
+  std::string scheduler;
+  bool json = false;
+  bool no_figures = false;
+  bool no_csv = false;
+};
+
+ToleranceSigmas sigmas_of(const ToleranceCommandOptions& o) {
+  const auto um = [](double v, const char* option) {
+    check_option(v >= 0.0 && v <= 1e5, option, v, "a standard deviation from 0 to 1e5 um");
+    return 1e-6 * v;
+  };
+  ToleranceSigmas s;
+  s.base_joint = um(std::isnan(o.base_joint_um) ? o.joint_um : o.base_joint_um,
+                    std::isnan(o.base_joint_um) ? "--sigma-joint-um" : "--sigma-base-joint-um");
+  s.platform_joint = um(std::isnan(o.platform_joint_um) ? o.joint_um : o.platform_joint_um,
+                        std::isnan(o.platform_joint_um) ? "--sigma-joint-um" : "--sigma-platform-joint-um");
+  check_option(o.axis_deg >= 0.0 && o.axis_deg <= 10.0, "--sigma-axis-deg", o.axis_deg, "0 to 10 deg");
+  s.base_axis = s.platform_axis = deg2rad(o.axis_deg);
+  check_option(o.lead_ppm >= 0.0 && o.lead_ppm <= 1e5, "--sigma-lead-ppm", o.lead_ppm, "0 to 1e5 ppm");
+  s.lead = 1e-6 * o.lead_ppm;
+  s.offset = um(o.offset_um, "--sigma-offset-um");
+  return s;
+}
+
+void sigmas_json(JsonWriter& j, const ToleranceSigmas& s) {
+  j.begin_object();
+  j.field("base_joint", s.base_joint).field("platform_joint", s.platform_joint);
+  j.field("base_axis", s.base_axis).field("platform_axis", s.platform_axis);
+  j.field("lead", s.lead).field("offset", s.offset);
+  j.end_object();
+}
+
+// The Monte Carlo on the cluster: platforms sampled and evaluated on the workers, their summaries here.
+ToleranceChunk chunk_on_cluster(const ToleranceCommandOptions& o, const RequiredPoses& req, const ToleranceSigmas& s,
+                                int& workers) {
+  JsonWriter j;
+  j.begin_object();
+  j.field("job", "tolerance");
+  j.field("scheduler", o.scheduler);
+  j.key("config");
+  if (o.model.config.empty())
+    j.null();
+  else
+    j.value(read_text_file(o.model.config, "--config", "configuration", kMaxConfigBytes));
+  j.key("workspace");
+  write_spec_json(j, req.spec);
+  if (!req.from_spec) {
+    j.key("poses").begin_array();
+    for (const Pose& p : req.poses) j.vector(p.to_vector());
+    j.end_array();
+  }
+  j.key("sigmas");
+  sigmas_json(j, s);
+  j.field("seed", o.seed);
+  j.field("platforms", o.platforms);
+  j.field("calibration", o.calibration);
+  j.field("timeout", 10);
+  j.end_object();
+  const ClusterArrays a = run_cluster_job(o.scheduler, j.str());
+  workers = static_cast<int>(cluster_array(a, "workers", 1)[0]);
+  const std::size_t n = o.platforms;
+  ToleranceChunk c;
+  c.first = static_cast<std::uint64_t>(cluster_array(a, "first", 1)[0]);
+  c.max_point = cluster_array(a, "max_point", n);
+  c.rms_point = cluster_array(a, "rms_point", n);
+  c.max_position = cluster_array(a, "max_position", n);
+  c.max_orientation = cluster_array(a, "max_orientation", n);
+  c.max_point_linear = cluster_array(a, "max_point_linear", n);
+  for (const double f : cluster_array(a, "failures", n)) c.failures.push_back(static_cast<std::uint32_t>(f));
+  const auto histogram = [&](const char* name, ErrorHistogram& h) {
+    const auto& v = cluster_array(a, name, static_cast<std::size_t>(ErrorHistogram::kBins));
+    for (std::size_t k = 0; k < v.size(); ++k) h.counts[k] = static_cast<std::uint64_t>(v[k]);
+  };
+  histogram("histogram_point", c.point);
+  histogram("histogram_position", c.position);
+  histogram("histogram_orientation", c.orientation);
+  return c;
+}
+
+void quantiles_json(JsonWriter& j, const ErrorQuantiles& q) {
+  j.begin_object().field("median", q.median).field("p95", q.p95).field("max", q.max).end_object();
+}
+
+std::string summary_json(const Model& model, const ToleranceCommandOptions& o, const RequiredPoses& req,
+                         const ToleranceSigmas& s, const ToleranceSummary& sm, int workers, double seconds,
+                         const std::vector<std::string>& files) {
+  JsonWriter j;
+  j.begin_object();
+  j.field("command", "tolerance");
+  j.field("units", "SI: m, rad; lead relative");
+  j.field("config", model_source(o.model));
+  j.field("model", model.spec().name);
+  j.key("required_workspace");
+  write_required_json(j, req);
+  j.key("sigmas");
+  sigmas_json(j, s);
+  j.field("platforms", static_cast<std::uint64_t>(sm.platforms));
+  j.field("poses", static_cast<std::uint64_t>(sm.poses));
+  j.field("seed", o.seed);
+  j.field("calibration", o.calibration);
+  j.field("failures", sm.failures);
+  // Each group of quantiles an object of its errors.
+  const auto group = [&](const char* name, std::initializer_list<std::pair<const char*, const ErrorQuantiles*>> items) {
+    j.key(name).begin_object();
+    for (const auto& [key, q] : items) {
+      j.key(key);
+      quantiles_json(j, *q);
+    }
+    j.end_object();
+  };
+  group("monte_carlo", {{"point", &sm.point}, {"position", &sm.position}, {"orientation", &sm.orientation}});
+  group("linearised",
+        {{"point", &sm.point_linear}, {"position", &sm.position_linear}, {"orientation", &sm.orientation_linear}});
+  group("worst_per_platform", {{"point", &sm.worst_point},
+                               {"point_linear_model", &sm.worst_point_linear},
+                               {"position", &sm.worst_position},
+                               {"orientation", &sm.worst_orientation}});
+  j.field("definitions",
+          "pooled over every (platform, pose): the point A, pivot position and orientation (rotation angle) errors of "
+          "the sampled platform driven by its controller's compensated commands; linearised: the same from the "
+          "covariance of the linear model; worst_per_platform: each platform's largest error over the poses");
+  j.key("cluster");
+  if (o.scheduler.empty())
+    j.null();
+  else
+    j.begin_object().field("scheduler", o.scheduler).field("workers", workers).end_object();
+  j.field("seconds", seconds);
+  j.key("files").begin_array();
+  for (const std::string& f : files) j.value(f);
+  j.end_array();
+  j.end_object();
+  return j.str();
+}
+
+std::string platforms_csv(const ToleranceChunk& c) {
+  std::string out = "platform,max_point_m,rms_point_m,max_position_m,max_orientation_rad,max_point_linear_m,failures\n";
+  auto it = std::back_inserter(out);
+  for (std::size_t k = 0; k < c.size(); ++k)
+    fmt::format_to(it, "{},{},{},{},{},{},{}\n", c.first + k, c.max_point[k], c.rms_point[k], c.max_position[k],
+                   c.max_orientation[k], c.max_point_linear[k], c.failures[k]);
+  return out;
+}
+
+// Error values log-spaced over what the histogram holds (its 0.1 % to 99.9 % quantiles, widened).
+std::vector<double> error_axis(const ErrorHistogram& h) {
+  std::vector<double> r;
+  const double lo = h.quantile(0.001), hi = h.quantile(0.999);
+  if (!(lo > 0.0) || !(hi > lo)) return r;
+  const double a = std::log(lo / 1.5), b = std::log(hi * 1.5);
+  for (int k = 0; k <= 80; ++k) r.push_back(std::exp(a + (b - a) * k / 80.0));
+  return r;
+}
+
+Panel cdf_panel(const std::string& title, const std::string& xlabel, double scale, const ErrorHistogram& h,
+                const std::vector<Matrix3d>& covariances) {
+  Panel p(title, xlabel, "share of (platform, pose) pairs [-]");
+  const std::vector<double> r = error_axis(h);
+  const std::vector<double> lin = gaussian_norm_mixture_cdf(covariances, r, 0);
+  Series mc{"Monte Carlo (sampled platforms, forward kinematics)", {}, {}, Series::Style::Solid};
+  Series li{"linearised (covariance of the linear model)", {}, {}, Series::Style::Dashed};
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    mc.x.push_back(scale * r[k]);
+    mc.y.push_back(h.cdf(r[k]));
+    li.x.push_back(scale * r[k]);
+    li.y.push_back(lin[k]);
+  }
+  p.series = {std::move(mc), std::move(li)};
+  return p;
+}
+
+// The empirical distribution of each platform's worst error.
+Series sorted_series(std::string label, std::vector<double> v, double scale, Series::Style style) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
+  std::sort(v.begin(), v.end());
+  Series s{std::move(label), {}, {}, style};
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    s.x.push_back(scale * v[k]);
+    s.y.push_back((static_cast<double>(k) + 0.5) / static_cast<double>(v.size()));
+  }
+  return s;
+}
+
+Figure figure(const std::string& stem, const ToleranceChunk& c, const ToleranceLinear& lin,
+              const ToleranceSummary& sm) {
+  Figure f{
+      stem, fmt::format("Accuracy with manufacturing errors: {} platforms x {} poses", sm.platforms, sm.poses), {}};
+  f.panels.push_back(
+      cdf_panel("Error of point A over the workspace", "point A error [mm]", 1e3, c.point, lin.point_covariance));
+  f.panels.push_back(cdf_panel("Orientation error over the workspace", "orientation error [mrad]", 1e3, c.orientation,
+                               lin.orientation_covariance));
+  Panel worst("Each platform's largest point A error over the workspace", "largest point A error [mm]",
+              "share of platforms [-]");
+  worst.series.push_back(sorted_series("Monte Carlo", c.max_point, 1e3, Series::Style::Solid));
+  worst.series.push_back(sorted_series("linear model, same errors", c.max_point_linear, 1e3, Series::Style::Dashed));
+  f.panels.push_back(std::move(worst));
+  return f;
+}
+
+std::string row(const char* what, const ErrorQuantiles& mc, const ErrorQuantiles& lin, double scale) {
+  return fmt::format("{:<24}{:>10.4f}{:>10.4f}{:>10.4f}   {:>10.4f}{:>10.4f}   {:>7.3f}{:>7.3f}\n", what,
+                     scale * mc.median, scale * mc.p95, scale * mc.max, scale * lin.median, scale * lin.p95,
+                     mc.median / lin.median, mc.p95 / lin.p95);
+}
+
+std::string report_text(const Model& model, const ToleranceCommandOptions& o, const RequiredPoses& req,
+                        const ToleranceSigmas& s, const ToleranceSummary& sm, int workers, double seconds) {
+  std::string out = fmt::format("hexatwist tolerance on {}: {}\n", model_source(o.model), model.spec().name);
+  out += fmt::format("required workspace: {}\n", req.description);
+  out += fmt::format(
+      "manufacturing errors (standard deviations, every leg): joint centres {:g} um (base), {:g} um (platform) per "
+      "axis; U-joint axes {:g} deg; lead {:g} ppm; zero offsets {:g} um\n",
+      1e6 * s.base_joint, 1e6 * s.platform_joint, rad2deg(s.base_axis), 1e6 * s.lead, 1e6 * s.offset);
+  out +=
+      fmt::format("{} platforms (seed {}) x {} poses, driven by {} compensated commands{} in {:.1f} s\n", sm.platforms,
+                  o.seed, sm.poses, o.calibration == "perfect" ? "a perfectly calibrated controller's" : "the nominal",
+                  workers > 0 ? fmt::format(" on {} Dask workers ({})", workers, printable(o.scheduler)) : "", seconds);
+  if (sm.failures > 0)
+    out += fmt::format("failures: {} (platform, pose) pairs without an error (refused or forward kinematics failed)\n",
+                       sm.failures);
+  out += fmt::format("\n{:<24}{:>30}   {:>20}   {:>14}\n", "", "Monte Carlo", "linearised", "MC / linear");
+  out += fmt::format("{:<24}{:>10}{:>10}{:>10}   {:>10}{:>10}   {:>7}{:>7}\n", "error", "median", "p95", "max",
+                     "median", "p95", "median", "p95");
+  out += row("point A [mm]", sm.point, sm.point_linear, 1e3);
+  out += row("pivot position [mm]", sm.position, sm.position_linear, 1e3);
+  out += row("orientation [mrad]", sm.orientation, sm.orientation_linear, 1e3);
+  out += fmt::format(
+      "worst over the workspace, per platform: point A {:.4f} mm median, {:.4f} mm p95, {:.4f} mm max (the linear "
+      "model with the same errors: {:.4f}, {:.4f}, {:.4f} mm)\n",
+      1e3 * sm.worst_point.median, 1e3 * sm.worst_point.p95, 1e3 * sm.worst_point.max,
+      1e3 * sm.worst_point_linear.median, 1e3 * sm.worst_point_linear.p95, 1e3 * sm.worst_point_linear.max);
+  return out;
+}
+
+int run_tolerance(const ToleranceCommandOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  const Config config = load_config_from(o.model);
+  const Model& model = config.rig.model();
+  const ToleranceSigmas sigmas = sigmas_of(o);
+  check_option(o.platforms >= 1 && o.platforms <= 100'000'000, "--platforms", static_cast<double>(o.platforms),
+               "1 to 1e8 platforms");
+  OutputFiles set("tolerance");
+  set.input("--config", o.model.config);
+  for (const std::string& t : o.required.trajectories) set.input("--trajectory", t);
+  set.folder("--out", o.out);
+  const RequiredPoses req = required_poses(config, o.required);
+
+  // The linear model (no sample in it) here; the samples here or on the cluster.
+  ToleranceLinear linear;
+  if (const Status s = tolerance_linear(model, req.poses, sigmas, linear, 0); s != Status::Ok)
+    throw ExitError(kExitOutOfLimit, fmt::format("the linear model failed: {} ({})", describe(s), to_string(s)));
+  int workers = 0;
+  ToleranceChunk chunk;
+  if (!o.scheduler.empty()) {
+    chunk = chunk_on_cluster(o, req, sigmas, workers);
+  } else {
+    ToleranceOptions to;
+    to.sigmas = sigmas;
+    to.seed = o.seed;
+    to.threads = 0;
+    if (o.calibration == "perfect")
+      to.calibration = [](const Model&, const Model& real, std::uint64_t, ModelSpec& controller) {
+        controller = real.spec();
+        return Status::Ok;
+      };
+    if (const Status s = tolerance_chunk(model, req.poses, to, 0, o.platforms, chunk, &linear); s != Status::Ok)
+      throw ExitError(kExitOutOfLimit, fmt::format("the study failed: {} ({})", describe(s), to_string(s)));
+  }
+  const ToleranceSummary sm = summarize_tolerance(chunk, req.poses.size(), &linear, 0);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  const fs::path dir(o.out);
+  std::vector<std::string> names;
+  if (!o.no_csv) names.push_back("platforms.csv");
+  std::vector<Figure> figs;
+  if (!o.no_figures) {
+    figs.push_back(figure((dir / "tolerance").string(), chunk, linear, sm));
+    names.insert(names.end(), {"tolerance.png", "tolerance.svg"});
+  }
+  names.push_back("summary.json");
+  if (!o.no_csv) set.add((dir / "platforms.csv").string(), platforms_csv(chunk));
+  const std::string json = summary_json(model, o, req, sigmas, sm, workers, seconds, names);
+  set.add((dir / "summary.json").string(), json);
+  set.stage();
+  for (Figure& f : figs) f.stem = set.external(f.stem, {".png", ".svg"});
+  if (!figs.empty()) write_figures(figs);
+  set.commit();
+  std::string text = o.json ? json : report_text(model, o, req, sigmas, sm, workers, seconds);
+  if (!o.json) text += fmt::format("\n{} files written to {}\n", set.paths().size(), o.out);
+  set.finish(text);
+  return kExitOk;
+}
+
+}  // namespace
+
+Command make_tolerance_command(CLI::App& root) {
+  auto o = std::make_shared<ToleranceCommandOptions>();
+  CLI::App* app = root.add_subcommand(
+      "tolerance",
+      "Tolerance analysis (docs/theory/design.md §18): how accurate the platform will be with manufacturing errors, "
+      "before it is built. --platforms platforms are sampled, each leg with errors of its joint centres, U-joint axis "
+      "directions, lead and zero offset (normal, the standard deviations below), driven over the required workspace "
+      "(--workspace SPEC or --trajectory FILE..., as design) by the nominal compensated commands; each pose found "
+      "by twist-aware forward kinematics. The Monte Carlo's errors (point A, pivot position, orientation; median, "
+      "95th percentile, largest) beside the linearised answer (the covariance of the linear model). Writes to "
+      "--out: summary.json (SI), platforms.csv (each platform's worst and RMS errors), tolerance.png/.svg.");
+  add_model_options(*app, o->model);
+  add_required_options(*app, o->required);
+  app->add_option("--platforms", o->platforms, "Platforms sampled")->capture_default_str();
+  app->add_option("--seed", o->seed, "Seed of the sampled errors (platform k's errors depend on the seed and k only)")
+      ->capture_default_str();
+  app->add_option("--sigma-joint-um", o->joint_um, "Joint centres, each coordinate [um]")->capture_default_str();
+  app->add_option("--sigma-base-joint-um", o->base_joint_um,
+                  "Base joint centres alone [um] (default: --sigma-joint-um)");
+  app->add_option("--sigma-platform-joint-um", o->platform_joint_um,
+                  "Platform joint centres alone [um] (default: --sigma-joint-um)");
+  app->add_option("--sigma-axis-deg", o->axis_deg, "U-joint fixed axis directions, about each normal [deg]")
+      ->capture_default_str();
+  app->add_option("--sigma-lead-ppm", o->lead_ppm,
+                  "Relative lead error [ppm] (ISO 3408 classes over 300 mm as 2 sd: C3 13, C5 30, C7 83)")
+      ->capture_default_str();
+  app->add_option("--sigma-offset-um", o->offset_um, "Zero offsets, the legs' lengths at the drives' reference [um]")
+      ->capture_default_str();
+  app->add_option("--calibration", o->calibration,
+                  "none: the controller runs the nominal configuration; perfect: it runs each real platform's own "
+                  "(the floor a calibration reaches; the calibration subsystem plugs in here)")
+      ->check(CLI::IsMember({"none", "perfect"}))
+      ->capture_default_str();
+  app->add_option("--out", o->out, "Output folder (created if missing), written as a set: all files or none (exit 4)")
+      ->capture_default_str();
+  app->add_flag("--json", o->json, "Print summary.json instead of the text report");
+  app->add_flag("--no-figures", o->no_figures, "Skip the figure (gnuplot)");
+  app->add_flag("--no-csv", o->no_csv, "Skip platforms.csv");
+  add_scheduler_option(*app, o->scheduler);
+  return {app, [o] { return run_tolerance(*o); }};
+}
+
+}  // namespace hexatwist::cli

@@ -1,0 +1,195 @@
+// Tolerance analysis (design/tolerance.hpp): a range of sampled platforms (locally, or one chunk of
+// a Dask study), the covariance answer's quantiles, and the summary of the whole study.
+#include <pybind11/stl.h>
+
+#include "common.hpp"
+
+namespace hexatwist::python {
+
+std::vector<Pose> design_poses(const PlatformSource& p, const py::object& poses, const py::dict& required);
+
+namespace {
+
+ToleranceSigmas sigmas_of(const py::dict& d) {
+  ToleranceSigmas s;
+  const auto get = [&](const char* key, double& out) {
+    if (!d.contains(key)) return;
+    out = d[key].cast<double>();
+    if (!(out >= 0.0) || !std::isfinite(out)) raise_input(std::string("sigmas: ") + key + " must be finite and >= 0");
+  };
+  for (const auto& kv : d) {
+    const std::string k = kv.first.cast<std::string>();
+    if (k != "base_joint" && k != "platform_joint" && k != "base_axis" && k != "platform_axis" && k != "lead" &&
+        k != "offset")
+      raise_input("sigmas: unknown key '" + k +
+                  "'; expected base_joint, platform_joint [m], base_axis, platform_axis [rad], lead [-], offset [m]");
+  }
+  get("base_joint", s.base_joint);
+  get("platform_joint", s.platform_joint);
+  get("base_axis", s.base_axis);
+  get("platform_axis", s.platform_axis);
+  get("lead", s.lead);
+  get("offset", s.offset);
+  return s;
+}
+
+template <class T>
+py::array_t<T> array_of(const std::vector<T>& v) {
+  return py::array_t<T>(static_cast<py::ssize_t>(v.size()), v.data());
+}
+
+py::dict chunk_dict(const ToleranceChunk& c) {
+  py::dict d;
+  d["first"] = c.first;
+  d["max_point"] = array_of(c.max_point);
+  d["rms_point"] = array_of(c.rms_point);
+  d["max_position"] = array_of(c.max_position);
+  d["max_orientation"] = array_of(c.max_orientation);
+  d["max_point_linear"] = array_of(c.max_point_linear);
+  d["failures"] = array_of(c.failures);
+  d["histogram_point"] = array_of(c.point.counts);
+  d["histogram_position"] = array_of(c.position.counts);
+  d["histogram_orientation"] = array_of(c.orientation.counts);
+  return d;
+}
+
+template <class T>
+std::vector<T> vector_of(const py::handle& a, const char* name) {
+  const auto arr = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
+  if (!arr || arr.ndim() != 1) raise_input(std::string("chunk: ") + name + " must be a 1-D array");
+  return std::vector<T>(arr.data(), arr.data() + arr.size());
+}
+
+ToleranceChunk chunk_of(const py::dict& d) {
+  ToleranceChunk c;
+  c.first = d["first"].cast<std::uint64_t>();
+  c.max_point = vector_of<double>(d["max_point"], "max_point");
+  c.rms_point = vector_of<double>(d["rms_point"], "rms_point");
+  c.max_position = vector_of<double>(d["max_position"], "max_position");
+  c.max_orientation = vector_of<double>(d["max_orientation"], "max_orientation");
+  c.max_point_linear = vector_of<double>(d["max_point_linear"], "max_point_linear");
+  c.failures = vector_of<std::uint32_t>(d["failures"], "failures");
+  c.point.counts = vector_of<std::uint64_t>(d["histogram_point"], "histogram_point");
+  c.position.counts = vector_of<std::uint64_t>(d["histogram_position"], "histogram_position");
+  c.orientation.counts = vector_of<std::uint64_t>(d["histogram_orientation"], "histogram_orientation");
+  const std::size_t n = c.max_point.size();
+  if (c.rms_point.size() != n || c.max_position.size() != n || c.max_orientation.size() != n ||
+      c.max_point_linear.size() != n || c.failures.size() != n)
+    raise_input("chunk: the per-platform arrays differ in length");
+  for (const auto* h : {&c.point.counts, &c.position.counts, &c.orientation.counts})
+    if (h->size() != static_cast<std::size_t>(ErrorHistogram::kBins))
+      raise_input("chunk: a histogram has the wrong size");
+  return c;
+}
+
+// Platforms [first, first + count) of the study.
+py::dict chunk_py(const py::object& config, const py::object& poses_in, const py::dict& required,
+                  const py::dict& sigmas, std::uint64_t seed, std::uint64_t first, std::size_t count,
+                  const std::string& calibration, bool linear_worst, int threads) {
+  const PlatformSource p = platform_of(config);
+  const std::vector<Pose> poses = design_poses(p, poses_in, required);
+  ToleranceOptions o;
+  o.sigmas = sigmas_of(sigmas);
+  o.seed = seed;
+  o.linear_worst = linear_worst;
+  o.threads = threads;
+  if (calibration == "perfect") {
+    o.calibration = [](const Model&, const Model& real, std::uint64_t, ModelSpec& controller) {
+      controller = real.spec();
+      return Status::Ok;
+    };
+  } else if (calibration != "none") {
+    raise_input("calibration: expected 'none' or 'perfect' (a controller that knows the real platform), got '" +
+                calibration + "'");
+  }
+  ToleranceLinear linear;
+  ToleranceChunk c;
+  Status s = Status::Ok;
+  {
+    py::gil_scoped_release release;
+    if (linear_worst) s = tolerance_linear(*p.model, poses, o.sigmas, linear, threads);
+    if (s == Status::Ok) s = tolerance_chunk(*p.model, poses, o, first, count, c, linear_worst ? &linear : nullptr);
+  }
+  if (s != Status::Ok) raise_status(s, "tolerance: a pose outside the nominal workspace");
+  return chunk_dict(c);
+}
+
+py::dict quantiles_dict(const ErrorQuantiles& q) {
+  py::dict d;
+  d["median"] = q.median;
+  d["p95"] = q.p95;
+  d["max"] = q.max;
+  return d;
+}
+
+// The covariance answer: median and p95 of point, position and orientation errors.
+py::dict linear_py(const py::object& config, const py::object& poses_in, const py::dict& required,
+                   const py::dict& sigmas, int threads) {
+  const PlatformSource p = platform_of(config);
+  const std::vector<Pose> poses = design_poses(p, poses_in, required);
+  const ToleranceSigmas s = sigmas_of(sigmas);
+  ToleranceLinear linear;
+  ToleranceSummary summary;
+  Status st;
+  {
+    py::gil_scoped_release release;
+    st = tolerance_linear(*p.model, poses, s, linear, threads);
+    if (st == Status::Ok) linear_quantiles(linear, summary, threads);
+  }
+  if (st != Status::Ok) raise_status(st, "tolerance: a pose outside the nominal workspace");
+  py::dict d;
+  d["point"] = quantiles_dict(summary.point_linear);
+  d["position"] = quantiles_dict(summary.position_linear);
+  d["orientation"] = quantiles_dict(summary.orientation_linear);
+  d["poses"] = poses.size();
+  return d;
+}
+
+ErrorQuantiles quantiles_of(const py::dict& d) {
+  ErrorQuantiles q;
+  q.median = d["median"].cast<double>();
+  q.p95 = d["p95"].cast<double>();
+  q.max = d["max"].is_none() ? NAN : d["max"].cast<double>();
+  return q;
+}
+
+py::dict summary_py(const py::dict& chunk, std::size_t poses, const py::object& linear) {
+  const ToleranceChunk c = chunk_of(chunk);
+  ToleranceSummary s = summarize_tolerance(c, poses, nullptr);
+  if (!linear.is_none()) {
+    const py::dict l = linear;
+    s.point_linear = quantiles_of(l["point"]);
+    s.position_linear = quantiles_of(l["position"]);
+    s.orientation_linear = quantiles_of(l["orientation"]);
+  }
+  py::dict d;
+  d["platforms"] = s.platforms;
+  d["poses"] = s.poses;
+  d["failures"] = s.failures;
+  const std::pair<const char*, const ErrorQuantiles*> quantiles[] = {{"point", &s.point},
+                                                                     {"position", &s.position},
+                                                                     {"orientation", &s.orientation},
+                                                                     {"point_linear", &s.point_linear},
+                                                                     {"position_linear", &s.position_linear},
+                                                                     {"orientation_linear", &s.orientation_linear},
+                                                                     {"worst_point", &s.worst_point},
+                                                                     {"worst_point_linear", &s.worst_point_linear},
+                                                                     {"worst_position", &s.worst_position},
+                                                                     {"worst_orientation", &s.worst_orientation}};
+  for (const auto& [key, q] : quantiles) d[key] = quantiles_dict(*q);
+  return d;
+}
+
+}  // namespace
+
+void expose_tolerance(py::module_& m) {
+  m.def("_tolerance_chunk", &chunk_py, py::arg("config"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
+        py::arg("seed"), py::arg("first"), py::arg("count"), py::arg("calibration") = "none",
+        py::arg("linear_worst") = true, py::arg("threads") = 1);
+  m.def("_tolerance_linear", &linear_py, py::arg("config"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
+        py::arg("threads") = 1);
+  m.def("_tolerance_summary", &summary_py, py::arg("chunk"), py::arg("poses"), py::arg("linear"));
+  m.attr("HISTOGRAM_BINS") = ErrorHistogram::kBins;
+}
+
+}  // namespace hexatwist::python

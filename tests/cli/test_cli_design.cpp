@@ -1,0 +1,233 @@
+// The design commands end to end (hexatwist workspace, design, tolerance): the real binary, its
+// JSON, its files; boundary points checked with `hexatwist ik` as a user would; bad inputs one line
+// with their exit codes.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kPi = 3.14159265358979323846;
+
+const fs::path& temp_dir() {
+  struct Dir {
+    fs::path path;
+    Dir() {
+      std::string tmpl = (fs::temp_directory_path() / "hexatwist_cli_design_XXXXXX").string();
+      if (mkdtemp(tmpl.data()) == nullptr) std::abort();
+      path = tmpl;
+    }
+    ~Dir() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string quote(const std::string& s) {
+  std::string out = "'";
+  for (const char c : s) {
+    if (c == '\'')
+      out.append("'\\''");
+    else
+      out.push_back(c);
+  }
+  out.push_back('\'');
+  return out;
+}
+
+struct Outcome {
+  int code = -1;
+  std::string out, err;
+};
+
+Outcome run(const std::vector<std::string>& args, const std::string& redirect = "") {
+  const fs::path err = temp_dir() / "stderr.txt";
+  std::string command = quote(HEXATWIST_CLI);
+  for (const std::string& a : args) {
+    command.push_back(' ');
+    command.append(quote(a));
+  }
+  command.append(" 2>").append(quote(err.string())).append(redirect);
+  Outcome r;
+  FILE* p = popen(command.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[4096];
+  for (std::size_t n; (n = fread(buf, 1, sizeof buf, p)) > 0;) r.out.append(buf, n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.err = read_file(err);
+  return r;
+}
+
+// One line on stderr, "hexatwist: error: ..." holding `part`.
+void expect_one_line_error(const Outcome& r, int code, const std::string& part) {
+  EXPECT_EQ(r.code, code) << r.err;
+  EXPECT_EQ(r.err.rfind("hexatwist: error: ", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> f;
+  std::stringstream s(line);
+  for (std::string x; std::getline(s, x, ',');) f.push_back(x);
+  return f;
+}
+
+std::string pose_text(double x, double y, double z, double roll, double pitch, double yaw) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "--pose=%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", x, y, z, roll, pitch, yaw);
+  return buf;
+}
+
+TEST(CliWorkspace, WritesItsVolumeSlicesMapsAndFiguresAndEveryBoundaryPointPassesIkInsideAndFailsOutside) {
+  const fs::path out = temp_dir() / "ws";
+  const Outcome r = run({"workspace", "--orientation", "2,-4,6", "--heights", "-0.2,0.1", "--spacing", "0.03",
+                         "--map-spacing", "0.05", "--yaws", "0,15", "--out", out.string(), "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const YAML::Node j = YAML::Load(r.out);
+  const double volume = j["volume"].as<double>(), error = j["volume_error"].as<double>();
+  EXPECT_GT(volume, 0.5);
+  EXPECT_LT(volume, 1.3);
+  EXPECT_LT(error, 0.01 * volume);
+  EXPECT_EQ(j["slices"].size(), 4u);  // two x-y, x-z, y-z
+  EXPECT_EQ(j["orientation_workspace"]["torsions"].size(), 2u);
+  EXPECT_GT(j["map"]["inside"].as<int>(), 50);
+  EXPECT_EQ(read_file(out / "summary.json"), r.out);
+  for (const char* f : {"slices.csv", "orientation.csv", "map.csv", "slices_xy.png", "slices_vertical.svg",
+                        "orientation.png", "map_twist.png", "map_dexterity.svg"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+
+  // The check: points just inside a slice's boundary pass ik, just outside fail it for the
+  // limit named (every 97th boundary point of the file).
+  std::istringstream csv(read_file(out / "slices.csv"));
+  std::string line;
+  std::getline(csv, line);
+  int checked = 0;
+  for (int k = 0; std::getline(csv, line); ++k) {
+    if (k % 97 != 0) continue;
+    const std::vector<std::string> f = split(line);
+    ASSERT_EQ(f.size(), 14u) << line;
+    const auto pose = [&](int first) {
+      return pose_text(std::stod(f[static_cast<std::size_t>(first)]), std::stod(f[static_cast<std::size_t>(first) + 1]),
+                       std::stod(f[static_cast<std::size_t>(first) + 2]), 2, -4, 6);
+    };
+    const Outcome in = run({"ik", pose(4), "--json"});
+    EXPECT_EQ(in.code, 0) << line << in.err;
+    const Outcome outside = run({"ik", pose(7), "--json"});
+    EXPECT_EQ(outside.code, 3) << line;
+    const YAML::Node o = YAML::Load(outside.out);
+    EXPECT_EQ(o["status"].as<std::string>(), f[10]) << line;
+    EXPECT_EQ(o["limit"]["leg"].as<int>(), std::stoi(f[11])) << line;
+    ++checked;
+  }
+  EXPECT_GE(checked, 4);
+}
+
+TEST(CliDesign, WritesAConfigurationWhoseLargestTwistIsHalvedWithEveryLimitKept) {
+  const fs::path designed = temp_dir() / "designed.yaml";
+  const Outcome r = run({"design", "--workspace", "random=400,samples=21", "--out", designed.string(), "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const YAML::Node j = YAML::Load(r.out);
+  const double before = j["before"]["max_twist"].as<double>(), after = j["after"]["max_twist"].as<double>();
+  EXPECT_LT(after, 0.5 * before);
+  EXPECT_EQ(j["after"]["reached"].as<int>(), j["after"]["poses"].as<int>());
+  EXPECT_GE(j["after"]["volume"].as<double>(), 0.95 * j["before"]["volume"].as<double>());
+  // The designed file is a whole configuration: the study's sections kept, its axes the report's.
+  const YAML::Node y = YAML::LoadFile(designed.string());
+  EXPECT_TRUE(y["servo"]) << read_file(designed);
+  EXPECT_TRUE(y["study"]);
+  EXPECT_EQ(y["legs"].size(), 6u);
+  EXPECT_EQ(y["legs"][2]["base_axis"][0].as<double>(), j["axes"][2]["base_axis"][0].as<double>());
+  // It loads, and its twist at the pose the report names is the largest it reports.
+  const Outcome ik = run({"ik", "--config", designed.string(), "--pose=0,0,0,0,0,30", "--json"});
+  ASSERT_EQ(ik.code, 0) << ik.err;
+  double largest = 0.0;
+  for (const YAML::Node& leg : YAML::Load(ik.out)["legs"])
+    largest = std::max(largest, std::abs(leg["twist"].as<double>()));
+  EXPECT_LE(largest, after + 1e-12);
+  EXPECT_GT(largest, 0.5 * after);  // yaw 30 deg is one of the tests' poses, among the largest
+  // The text report says the same.
+  const Outcome text =
+      run({"design", "--workspace", "random=50,samples=5", "--out", (temp_dir() / "d2.yaml").string()});
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_NE(text.out.find("largest |twist|"), std::string::npos);
+  EXPECT_NE(text.out.find("U-joint singularity"), std::string::npos);
+}
+
+TEST(CliTolerance, ReportsTheMonteCarloBesideTheLinearisedAnswer) {
+  const fs::path out = temp_dir() / "tol";
+  const Outcome r = run({"tolerance", "--platforms", "200", "--workspace", "random=100,samples=11", "--out",
+                         out.string(), "--json", "--sigma-joint-um", "30", "--sigma-lead-ppm", "100"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const YAML::Node j = YAML::Load(r.out);
+  EXPECT_EQ(j["platforms"].as<int>(), 200);
+  EXPECT_EQ(j["failures"].as<int>(), 0);
+  EXPECT_DOUBLE_EQ(j["sigmas"]["base_joint"].as<double>(), 30e-6);
+  for (const char* what : {"point", "position", "orientation"}) {
+    const double mc = j["monte_carlo"][what]["p95"].as<double>(), lin = j["linearised"][what]["p95"].as<double>();
+    EXPECT_NEAR(mc / lin, 1.0, 0.15) << what;
+  }
+  EXPECT_EQ(std::count(std::istreambuf_iterator<char>(std::ifstream(out / "platforms.csv").rdbuf()), {}, '\n'), 201);
+  EXPECT_TRUE(fs::exists(out / "tolerance.png"));
+  // The same seed, the same platforms: the CSV again bit for bit.
+  const Outcome again =
+      run({"tolerance", "--platforms", "200", "--workspace", "random=100,samples=11", "--out",
+           (temp_dir() / "tol2").string(), "--sigma-joint-um", "30", "--sigma-lead-ppm", "100", "--no-figures"});
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_EQ(read_file(temp_dir() / "tol2" / "platforms.csv"), read_file(out / "platforms.csv"));
+  // A perfect calibration: nothing left.
+  const Outcome perfect = run({"tolerance", "--platforms", "5", "--workspace", "random=20,samples=3", "--calibration",
+                               "perfect", "--json", "--no-figures", "--out", (temp_dir() / "tol3").string()});
+  ASSERT_EQ(perfect.code, 0) << perfect.err;
+  EXPECT_LT(YAML::Load(perfect.out)["monte_carlo"]["point"]["max"].as<double>(), 1e-11);
+}
+
+TEST(CliDesignCommands, BadInputsAreOneLineWithTheirExitCodes) {
+  const std::string out = (temp_dir() / "bad").string();
+  expect_one_line_error(run({"design", "--workspace", "random=many", "--out", out}), 2, "--workspace 'random=many'");
+  expect_one_line_error(run({"design", "--workspace", "colour=red", "--out", out}), 2, "unknown key");
+  expect_one_line_error(run({"tolerance", "--sigma-joint-um", "-1", "--out", out}), 2, "--sigma-joint-um");
+  expect_one_line_error(run({"workspace", "--orientation", "0,0", "--out", out}), 2, "--orientation");
+  expect_one_line_error(run({"workspace", "--spacing", "0", "--out", out}), 2, "--spacing");
+  const Outcome s = run({"tolerance", "--scheduler", "localhost:8786", "--out", out});
+  EXPECT_EQ(s.code, 2) << s.err;
+  EXPECT_NE(s.err.find("tcp://HOST:PORT"), std::string::npos) << s.err;
+  // A required trajectory outside the limits: file, line and limit.
+  const fs::path csv = temp_dir() / "high.csv";
+  std::ofstream(csv) << "t,x,y,z,roll,pitch,yaw\n0,0,0,0,0,0,0\n1,0,0,0.9,0,0,0\n";
+  expect_one_line_error(run({"design", "--trajectory", csv.string(), "--out", out}), 3, "high.csv:3");
+  // The designed file cannot be written: exit 4, nothing left.
+  expect_one_line_error(run({"design", "--workspace", "random=10,samples=3", "--out", "/nonexistent/d.yaml"}), 4,
+                        "/nonexistent/d.yaml");
+  // Standard output that cannot be written: exit 4, and no report left behind.
+  const Outcome full =
+      run({"tolerance", "--platforms", "2", "--workspace", "random=5,samples=3", "--no-figures", "--out", out},
+          " >/dev/full");
+  EXPECT_EQ(full.code, 4) << full.err;
+  EXPECT_FALSE(fs::exists(fs::path(out) / "summary.json"));
+}
+
+}  // namespace

@@ -1,0 +1,105 @@
+"""The design functions from Python (docs/theory/design.md §16-19): the workspace's volume, slices, maps
+and orientation workspace against the batch functions, the designed configuration through its YAML,
+and the tolerance study's independence from threads."""
+import numpy as np
+import pytest
+
+import hexatwist
+
+
+def test_volume_from_its_cells_equals_the_whole_computation(model):
+    v = hexatwist.workspace_volume(model, cell=0.05)
+    core = hexatwist._core
+    grid = core._volume_grid(model, (0, 0, 0), 0.05)
+    fine, coarse, columns = core._volume_cells(model, grid, 0.005, 1e-9, "compensated", 0, grid["cells"])
+    again = core._volume_from_cells(grid, fine, coarse, columns)
+    assert again["volume"] == v.volume and again["error"] == v.error
+    assert 1.2 < v.volume < 1.35 and v.error < 0.01 * v.volume
+
+
+def test_slice_points_are_inside_just_inside_and_refused_just_outside(model):
+    orientation = np.array([0.05, 0.0, -0.2])
+    s = hexatwist.workspace_slice(model, orientation, "xz", 0.1, spacing=0.03)
+    assert len(s.u) > 50
+    poses = lambda p: np.hstack([p, np.tile(orientation, (len(p), 1))])  # noqa: E731
+    inside = hexatwist.commands(model, poses(s.inside))
+    outside = hexatwist.commands(model, poses(s.outside))
+    assert inside.ok.all()
+    assert np.array_equal(outside.status, s.status)
+    assert np.array_equal(outside.limit_leg, s.leg)
+    assert np.all(np.linalg.norm(s.outside - s.inside, axis=1) <= 1e-9)
+    assert np.array_equal(s.u, s.inside[:, 0]) and np.array_equal(s.v, s.inside[:, 2])
+
+
+def test_map_holds_the_largest_twist_of_each_pose_and_nan_outside(model):
+    m = hexatwist.workspace_map(model, (0, 0, 0.1), "xy", 0.05, spacing=0.05)
+    uu, vv = np.meshgrid(m.u, m.v)
+    poses = np.column_stack([uu.ravel(), vv.ravel(), np.full(uu.size, 0.05), np.zeros(uu.size), np.zeros(uu.size),
+                             np.full(uu.size, 0.1)])
+    c = hexatwist.commands(model, poses)
+    assert np.array_equal(c.status.reshape(uu.shape), m.status)
+    t = hexatwist.twist(model, poses)
+    ok = c.ok.reshape(uu.shape)
+    assert np.array_equal(np.abs(t.twist).max(axis=1).reshape(uu.shape)[ok], m.max_twist[ok])
+    assert np.isnan(m.max_twist[~ok]).all() and (m.margin[ok] > 0).all()
+    assert ok.sum() > 100 and (~ok).sum() > 20
+
+
+def test_orientation_workspace_reach_is_accepted_and_the_next_step_refused(model):
+    o = hexatwist.orientation_workspace(model, (0, 0, 0.1), torsions=[0.0, 0.3], directions=12)
+    for t, torsion in enumerate(o.torsion):
+        for j, azimuth in enumerate(o.azimuth):
+            rpy = []
+            for tilt in (o.tilt[t, j], o.tilt[t, j] + 1e-8):
+                R = hexatwist.tilt_torsion_rotation(azimuth, tilt, torsion)
+                rpy.append([np.arctan2(R[2, 1], R[2, 2]), np.arcsin(-R[2, 0]), np.arctan2(R[1, 0], R[0, 0])])
+            c = hexatwist.commands(model, np.hstack([np.tile([0, 0, 0.1], (2, 1)), rpy]))
+            assert c.status[0] == 0 and c.status[1] == o.status[t, j]
+
+
+def test_designed_axes_halve_the_twist_and_their_yaml_loads_back(model):
+    w = hexatwist.required_workspace(random=600)
+    d = hexatwist.design_axes(None, w.poses)
+    designed = hexatwist.load_model(d.yaml)
+    assert np.allclose(designed.base_axes, d.model.base_axes, rtol=0, atol=0)
+    before = np.abs(hexatwist.twist(model, w.poses).twist).max()
+    after = np.abs(hexatwist.twist(designed, w.poses).twist).max()
+    assert after < 0.5 * before
+    assert after == pytest.approx(d.after["max_twist"], abs=1e-12)
+    assert hexatwist.commands(designed, w.poses).ok.all()
+    assert d.after["volume"] >= 0.95 * d.before["volume"]
+    assert set(d.after["margins"]) == {"stroke", "command", "bend", "singularity", "condition"}
+    with pytest.raises(hexatwist.InputError, match="objective"):
+        hexatwist.design_axes(None, w.poses, objective="speed")
+
+
+def test_tolerance_does_not_depend_on_threads_and_a_perfect_calibration_leaves_no_error():
+    settings = dict(platforms=40, random=60, test_samples=5)
+    n = hexatwist.get_num_threads()
+    try:
+        hexatwist.set_num_threads(1)
+        one = hexatwist.tolerance(**settings)
+        hexatwist.set_num_threads(2)
+        two = hexatwist.tolerance(**settings)
+    finally:
+        hexatwist.set_num_threads(0)
+    assert n >= 1
+    for key in ("max_point", "rms_point", "max_point_linear", "histogram_point"):
+        assert np.array_equal(one[key], two[key]), key
+    perfect = hexatwist.tolerance(calibration="perfect", **settings)
+    assert perfect.max_point.max() < 1e-11
+    with pytest.raises(hexatwist.InputError, match="sigmas"):
+        hexatwist.tolerance(sigmas=dict(joint=1e-5), **settings)
+    with pytest.raises(hexatwist.InputError, match="workspace"):
+        hexatwist.tolerance(platforms=2, randoms=5)
+
+
+def test_every_public_function_pickles_by_reference():
+    # Dask ships functions pickled (client.run(hexatwist.get_num_threads)): a pybind11 function does not pickle.
+    import pickle
+
+    functions = [getattr(hexatwist, n) for n in hexatwist.__all__
+                 if callable(getattr(hexatwist, n)) and not isinstance(getattr(hexatwist, n), type)]
+    assert len(functions) > 40
+    for f in functions:
+        assert pickle.loads(pickle.dumps(f)) is f, f.__name__
