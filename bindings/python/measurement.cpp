@@ -152,13 +152,16 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
   const std::size_t k = set.observations.size();
   py::array_t<double> motor({static_cast<py::ssize_t>(k), py::ssize_t{6}}),
       pts({static_cast<py::ssize_t>(k), py::ssize_t{3}});
+  py::array_t<int> tg(static_cast<py::ssize_t>(k));
   for (std::size_t i = 0; i < k; ++i) {
     std::copy(set.observations[i].motor.data(), set.observations[i].motor.data() + 6, motor.mutable_data() + 6 * i);
     std::copy(set.observations[i].p_T.data(), set.observations[i].p_T.data() + 3, pts.mutable_data() + 3 * i);
+    tg.mutable_data()[i] = set.observations[i].target;
   }
   py::dict d;
   d["motor"] = motor;
   d["points"] = pts;
+  d["targets"] = tg;
   d["index"] = py::cast(set.points);
   d["poses"] = set.poses;
   return d;

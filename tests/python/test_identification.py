@@ -1,0 +1,94 @@
+"""Identification from Python reaches the CLI's decisions on the same data, bit for bit (issues 21, 24):
+a log made by ``hexatwist synth`` with joint-centre errors, identified by ``hexatwist identify --json``
+and by the Python pipeline (read_point_log, stations_run, observations_at_rest, identify with its
+defaults): the same status, the same estimate to the last bit, the same corrected configuration; the
+basic model refused by both on the same data; per-leg targets of a multi-target log.
+"""
+import json
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import hexatwist
+
+CLI = os.environ.get("HEXATWIST_CLI")
+pytestmark = pytest.mark.skipif(not CLI, reason="the command-line tool is not built")
+
+
+def run(*args, cwd, check=True):
+    r = subprocess.run([CLI, *args], cwd=cwd, capture_output=True, text=True, timeout=240)
+    if check:
+        assert r.returncode == 0, r.stderr
+    return r
+
+
+@pytest.fixture(scope="module")
+def log_dir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("identify")
+    run("synth", "--stations", "30", "--station-seed", "4", "--lead-error-pct", "2", "--offsets-mm", "0.5",
+        "--point-offset-mm", "1,-2,1.5", "--joint-errors-mm", "1", "--seed", "6", "--out", "s.csv", cwd=d)
+    run("synth", "--stations", "30", "--station-seed", "4", "--joint-errors-mm", "1", "--seed", "6",
+        "--targets-mm", "-600,1000,20;-600,-1000,-30", "--out", "t.csv", cwd=d)
+    return d
+
+
+def python_identification(log_path, **options):
+    model = hexatwist.default_model()
+    log = hexatwist.read_point_log(str(log_path))
+    stations = hexatwist.stations_run(count=30, seed=4)
+    obs = hexatwist.observations_at_rest(model, stations.t, stations.poses, log.stamps, log.points,
+                                         targets=log.targets)
+    return model, hexatwist.identify(model, obs.motor, obs.points, obs.targets, **options)
+
+
+def test_python_and_the_cli_reach_the_same_estimate_bit_for_bit(log_dir):
+    cli = json.loads(run("identify", "--points", "s.csv", "--stations", "30", "--station-seed", "4", "--json",
+                         "--no-figures", cwd=log_dir).stdout)
+    model, py = python_identification(log_dir / "s.csv")
+    assert cli["status"] == "ok" and py.status == "ok", py.reason
+    names = [p["name"] for p in cli["estimate"]["parameters"]]
+    assert names == list(py.parameter_names)
+    np.testing.assert_array_equal([p["estimate"] for p in cli["estimate"]["parameters"]], py.estimate)
+    np.testing.assert_array_equal([p["sd"] for p in cli["estimate"]["parameters"]], py.sd)
+    assert cli["sigma"] == py.sigma and cli["fit_test"]["z"] == py.fit_z
+    assert cli["accuracy"]["median"] == py.accuracy["median"]
+    # The corrected configuration: Python writes the CLI's file, byte for byte but for the header
+    # comments and the name, which the CLI gives the log's file name.
+    def body(text):
+        return [line for line in text.splitlines() if not line.startswith(("#", "name:"))]
+    written = (log_dir / "identified.yaml").read_text()
+    assert body(written) == body(hexatwist.corrected_config(None, py.corrected_model))
+
+
+def test_the_basic_model_on_joint_errors_is_refused_by_both(log_dir):
+    cli = run("identify", "--points", "s.csv", "--stations", "30", "--station-seed", "4", "--model", "basic",
+              "--json", "--out", "basic.yaml", cwd=log_dir, check=False)
+    assert cli.returncode == 5 and not (log_dir / "basic.yaml").exists()
+    result = json.loads(cli.stdout)
+    _, py = python_identification(log_dir / "s.csv", calibration="basic")
+    assert result["identification"] == py.status == "model_mismatch"
+    assert result["fit_test"]["z"] == py.fit_z and py.fit_z > 5
+    assert "geometry" in py.hint and py.corrected_model is None
+
+
+def test_several_targets_each_get_their_point(log_dir):
+    _, py = python_identification(log_dir / "t.csv")
+    assert py.status == "ok", py.reason
+    truth = json.loads((log_dir / "t.truth.json").read_text())["real"]["targets"]
+    assert len(py.targets) == 3
+    for t, (est, true) in enumerate(zip(py.targets, truth)):
+        sd = py.sd[py.parameter_names.index("A x" if t == 0 else f"target {t + 1} x"):][:3]
+        assert np.all(np.abs(est - true) < 4 * sd + 1e-9), (t, est - true, sd)
+
+
+def test_bad_arguments_raise_one_line():
+    model = hexatwist.default_model()
+    motor = np.tile(model.length_home, (10, 1))
+    with pytest.raises(hexatwist.InputError, match="calibration"):
+        hexatwist.identify(model, motor, np.zeros((10, 3)), calibration="exact")
+    with pytest.raises(hexatwist.InputError, match="targets"):
+        hexatwist.identify(model, motor, np.zeros((10, 3)), targets=np.full(10, -1))
+    with pytest.raises(hexatwist.InputError, match="NaN"):
+        hexatwist.identify(model, motor, np.full((10, 3), np.nan))
