@@ -21,6 +21,8 @@ const CLI::Validator kWholeNumber(
 
 }  // namespace
 
+// Where to measure (cmd_stations.cpp).
+Command make_stations_command(CLI::App& root);
 // The design commands (cmd_workspace.cpp, cmd_design.cpp, cmd_tolerance.cpp).
 Command make_workspace_command(CLI::App& root);
 Command make_design_command(CLI::App& root);
@@ -28,11 +30,10 @@ Command make_tolerance_command(CLI::App& root);
 
 std::vector<Command> add_commands(CLI::App& app) {
   std::vector<Command> commands{
-      make_study_command(app),     make_simulate_command(app), make_dynamics_command(app),
-      make_synth_command(app),     make_measure_command(app),  make_identify_command(app),
-      make_workspace_command(app), make_design_command(app),   make_tolerance_command(app),
-      make_stream_command(app),    make_ik_command(app),       make_fk_command(app),
-      make_config_command(app),    make_linuxcnc_command(app), make_mjcf_command(app)};
+      make_study_command(app),   make_simulate_command(app),  make_dynamics_command(app), make_synth_command(app),
+      make_measure_command(app), make_identify_command(app),  make_stations_command(app), make_workspace_command(app),
+      make_design_command(app),  make_tolerance_command(app), make_stream_command(app),   make_ik_command(app),
+      make_fk_command(app),      make_config_command(app),    make_linuxcnc_command(app), make_mjcf_command(app)};
   for (const Command& c : commands)
     for (CLI::Option* opt : c.app->get_options())
       if (opt->get_type_name() == "UINT") opt->check(kWholeNumber);

@@ -34,6 +34,7 @@
 #include "hexatwist/calibration/parameter_set.hpp"
 #include "hexatwist/calibration/point_log.hpp"
 #include "hexatwist/calibration/registration.hpp"
+#include "hexatwist/calibration/station_plan.hpp"
 #include "hexatwist/calibration/stations.hpp"
 #include "hexatwist/calibration/synthesis.hpp"
 

@@ -96,6 +96,7 @@ std::map<std::string, std::vector<std::string>> base_arguments(const Inputs& in)
        {"--config", c, "--points", in.log, "--trajectory", t, "--register-first", "150", "--settle", "0",
         "--no-figures", "--no-csv", "--out", "out"}},
       {"identify", {"--config", c, "--points", in.log, "--trajectory", t, "--settle", "0", "--out", "id.yaml"}},
+      {"stations", {"--config", c, "--count", "13", "--candidates", "100", "--out", "run.csv"}},
       {"stream", {"--config", c}},
       {"ik", {"--config", c}},
       {"fk", {"--config", c, "--lengths=1.9,1.9,1.9,1.9,1.9,1.9"}},

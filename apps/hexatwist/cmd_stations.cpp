@@ -1,0 +1,227 @@
+// hexatwist stations: where to measure. The library plans the stations of a calibration run
+// (station_plan.hpp: the Ds-optimal choice among candidates inside every limit, ordered into a run
+// of reachable moves) and compares them with random stations; this command prints the plan and
+// writes the run in the --run-out format (docs/theory/calibration.md §13).
+#include <fmt/format.h>
+
+#include <cmath>
+#include <memory>
+
+#include "cli_common.hpp"
+#include "json.hpp"
+#include "output_files.hpp"
+
+namespace hexatwist::cli {
+namespace {
+
+struct StationsOptions {
+  ModelOptions model;
+  int count = 0;
+  std::string range = "0.25,15";
+  int candidates = 3000;
+  std::uint64_t seed = 1;
+  std::string strategy = "compensated";
+  double noise_um = 10.0;
+  int points_per_station = 75;
+  double rate = 100.0;
+  std::string out;
+  bool json = false;
+};
+
+// The library's spec from the options, each checked with its own name (exit 2).
+StationPlanSpec plan_spec(const Model& model, const StationsOptions& o) {
+  StationPlanSpec spec;
+  constexpr const char* kRangeWhat =
+      "X_M,ROT_DEG: the stations within ±X_M [m] of home in x, y, z and ±ROT_DEG [deg] in roll, pitch, yaw";
+  const std::vector<double> range = parse_numbers(o.range, 2, "--range", kRangeWhat);
+  check_option(range[0] >= 0.0 && range[0] <= 10.0, "--range", range[0], "a translation range of 0 to 10 m");
+  check_option(range[1] >= 0.0 && range[1] <= 90.0, "--range", range[1], "a rotation range of 0 to 90 deg");
+  if (range[0] == 0.0 && range[1] == 0.0)
+    throw ExitError(kExitBadInput,
+                    "--range 0,0: expected a range > 0 in translation or rotation: the stations would "
+                    "all be at home");
+  spec.run.translation = range[0];
+  spec.run.rotation = deg2rad(range[1]);
+  spec.run.seed = o.seed;
+  const int fewest = min_planned_stations(model, spec);
+  check_option(
+      o.count >= fewest && o.count <= kMaxStations, "--count", o.count,
+      fmt::format("{} to {} stations (with home's rests, as many equations as the parameters)", fewest, kMaxStations));
+  spec.run.count = o.count;
+  check_option(o.candidates >= o.count && o.candidates <= kMaxCandidates, "--candidates", o.candidates,
+               fmt::format("the stations ({}) to {} candidates", o.count, kMaxCandidates));
+  spec.candidates = o.candidates;
+  check_option(o.noise_um > 0.0 && o.noise_um < 1e4, "--noise-um", o.noise_um,
+               "a standard deviation > 0 and below 1e4 [um]");
+  spec.noise = o.noise_um * 1e-6;
+  check_option(o.points_per_station >= 1 && o.points_per_station <= 1000000, "--points-per-station",
+               o.points_per_station, "1 to 1000000 points");
+  spec.points_per_station = o.points_per_station;
+  return spec;
+}
+
+// Samples of the run between rows at `rate`: the control rate over it, a whole number (exit 2).
+std::size_t rows_every(const Rig& rig, double rate) {
+  const double control_rate = rig.simulation().control_rate;
+  const double ratio = control_rate / rate;
+  check_option(
+      rate > 0.0 && std::isfinite(ratio) && ratio >= 1.0 - 1e-9 && std::abs(ratio - std::round(ratio)) <= 1e-9 * ratio,
+      "--rate", rate,
+      fmt::format("a rate that divides the control rate {:g} Hz ({:g} Hz, {:g} Hz, ...) [Hz]", control_rate,
+                  control_rate, control_rate / 2.0));
+  return static_cast<std::size_t>(std::llround(ratio));
+}
+
+std::string quality_row(const std::string& label, const StationsQuality& q) {
+  if (q.status != Status::Ok) return fmt::format("{:<16} do not determine the model: {}\n", label, q.reason);
+  const AccuracyPrediction& a = q.accuracy;
+  return fmt::format("{:<16} {:>9.2f} {:>7.2f} {:>9.3g} {:>11.1f} {:>10.1f} {:>14.2f} {:>13.2f} {:>14.2f}\n", label,
+                     q.criterion, 1e6 * q.sd_geometric, q.condition, 1e6 * a.median, 1e6 * a.max,
+                     1e6 * a.aligned_median, 1e6 * a.aligned_max, q.path);
+}
+
+std::string text_report(const StationsOptions& o, const Model& model, const StationPlanSpec& spec,
+                        const StationPlan& plan, const Trajectory& run) {
+  std::string t = fmt::format("hexatwist stations on {}: {}\n", model_source(o.model), model.spec().name);
+  t += fmt::format(
+      "plan: {} stations within ±{:g} m and ±{:g} deg, {} commands, for the {} model ({} parameters; the tracker "
+      "frame a nuisance): the Ds criterion over {} candidates inside the limits ({} drawn, seed {}), {} exchanges in "
+      "{} sweeps{}\n",
+      spec.run.count, spec.run.translation, rad2deg(spec.run.rotation), o.strategy,
+      spec.model == CalibrationModel::Basic ? "basic" : "geometry", plan.parameters.platform_size(), plan.candidates,
+      plan.draws, o.seed, plan.exchanges, plan.sweeps,
+      plan.replaced > 0 ? fmt::format(", {} replaced to keep every move inside the limits", plan.replaced) : "");
+  t += fmt::format("{:>7} {:>9} {:>9} {:>9} {:>11} {:>11} {:>11}\n", "station", "x [mm]", "y [mm]", "z [mm]",
+                   "roll [deg]", "pitch [deg]", "yaw [deg]");
+  for (std::size_t i = 0; i < plan.planned.stations.size(); ++i) {
+    const Vector6d& q = plan.planned.stations[i];
+    t += fmt::format("{:>7} {:>9.1f} {:>9.1f} {:>9.1f} {:>11.2f} {:>11.2f} {:>11.2f}\n", i + 1, 1e3 * tidy(q[0]),
+                     1e3 * tidy(q[1]), 1e3 * tidy(q[2]), rad2deg(tidy(q[3])), rad2deg(tidy(q[4])), rad2deg(tidy(q[5])));
+  }
+  t += fmt::format(
+      "criterion: log det of the parameters' information ({:g} um noise, {} points per station, home's two rests "
+      "included); sd: their geometric-mean standard deviation; median, worst: the predicted error of point A over the "
+      "range ({} poses) in the gauge frames, aligned: after a rigid re-alignment; moves: the run's path\n",
+      o.noise_um, o.points_per_station, plan.planned.accuracy.poses);
+  t += fmt::format("{:<16} {:>9} {:>7} {:>9} {:>11} {:>10} {:>14} {:>13} {:>14}\n", "stations", "criterion", "sd [um]",
+                   "condition", "median [um]", "worst [um]", "aligned median", "aligned worst", "moves [m, rad]");
+  t += quality_row("planned", plan.planned);
+  t += quality_row(fmt::format("random (seed {})", o.seed), plan.random);
+  t += fmt::format(
+      "wrote {}: home, the {} stations, home; {:g} s at each, straight jerk-limited moves, {:.2f} s at {:g} Hz (read "
+      "by synth and identify with --trajectory)\n",
+      o.out, plan.planned.stations.size(), spec.run.dwell, run.duration(), o.rate);
+  return t;
+}
+
+void quality_json(JsonWriter& j, const StationsQuality& q) {
+  j.begin_object().field("status", q.status == Status::Ok ? "ok" : "failed");
+  if (q.status != Status::Ok) {
+    j.field("reason", q.reason).end_object();
+    return;
+  }
+  j.field("criterion", q.criterion).field("sd_geometric", q.sd_geometric).field("condition", q.condition);
+  j.field("path", q.path);
+  const AccuracyPrediction& a = q.accuracy;
+  j.key("accuracy").begin_object().field("poses", a.poses).field("median", a.median).field("max", a.max);
+  j.field("aligned_median", a.aligned_median).field("aligned_max", a.aligned_max).end_object();
+  j.key("sd").vector(Eigen::VectorXd(q.covariance.diagonal().cwiseSqrt()));
+  j.key("stations").begin_array(true);
+  for (const Vector6d& s : q.stations) j.vector(s);
+  j.end_array().end_object();
+}
+
+std::string json_report(const StationsOptions& o, const Model& model, const StationPlanSpec& spec,
+                        const StationPlan& plan, const Trajectory& run) {
+  JsonWriter j;
+  j.begin_object()
+      .field("command", "stations")
+      .field("model", model.spec().name)
+      .field("config", model_source(o.model));
+  j.field("strategy", o.strategy).field("count", spec.run.count);
+  j.key("range").begin_array().value(spec.run.translation).value(spec.run.rotation).end_array();
+  j.field("seed", o.seed).field("candidates", plan.candidates).field("draws", plan.draws);
+  j.field("noise", spec.noise).field("points_per_station", spec.points_per_station);
+  j.field("sweeps", plan.sweeps).field("exchanges", plan.exchanges).field("converged", plan.converged);
+  j.field("replaced", plan.replaced);
+  j.key("parameters").begin_array();
+  for (int k = 0; k < plan.parameters.platform_size(); ++k) j.value(plan.parameters.name(k));
+  j.end_array();
+  j.key("planned");
+  quality_json(j, plan.planned);
+  j.key("random");
+  quality_json(j, plan.random);
+  j.key("run").begin_object().field("out", o.out).field("rate", o.rate).field("duration", run.duration());
+  j.field("dwell", spec.run.dwell).end_object();
+  return j.end_object().str();
+}
+
+int run_stations(const StationsOptions& o) {
+  OutputFiles files("stations");
+  files.input("--config", o.model.config);
+  files.output("--out", o.out);
+  const Config config = load_config_from(o.model);
+  const Model& model = config.rig.model();
+  const Strategy strategy = o.strategy == "conventional" ? Strategy::Conventional : Strategy::Compensated;
+  const StationPlanSpec spec = plan_spec(model, o);
+  const std::size_t every = rows_every(config.rig, o.rate);
+  StationPlan plan;
+  try {
+    if (plan_stations(model, strategy, spec, plan) != Status::Ok)
+      throw ExitError(kExitOutOfLimit, fmt::format("{}; nothing was written", plan.reason));
+  } catch (const Error& e) {
+    throw ExitError(kExitBadInput, e.what());
+  }
+  Trajectory run;
+  try {
+    run = station_run(model, strategy, plan.planned.stations, spec.run, config.rig.control_period());
+  } catch (const Error& e) {
+    throw ExitError(kExitOutOfLimit, fmt::format("the planned run: {}; nothing was written", e.what()));
+  }
+  files.add(o.out, format_trajectory_csv(run, every));
+  files.commit();
+  files.finish(o.json ? json_report(o, model, spec, plan, run) : text_report(o, model, spec, plan, run));
+  return kExitOk;
+}
+
+}  // namespace
+
+Command make_stations_command(CLI::App& root) {
+  auto o = std::make_shared<StationsOptions>();
+  CLI::App* app = root.add_subcommand(
+      "stations",
+      "Where to measure: plans the stations of a calibration run so that identify determines the platform best. "
+      "From seeded candidate poses inside every limit it chooses --count stations that maximise the Ds criterion "
+      "(the log determinant of the geometric model's information, the tracker frame a nuisance) by an exchange "
+      "algorithm, orders them into a run of short straight moves that stay inside the limits, prints them with the "
+      "criterion and the predicted accuracy beside random stations of the same count (synth --stations), and writes "
+      "the run as a trajectory CSV (the --run-out format: drive the platform through it, or give it to synth and "
+      "identify as --trajectory). Exit 3 when the ranges leave too few poses inside the limits.");
+  add_model_options(*app, o->model);
+  app->add_option("--count", o->count, "Stations, not counting home at the start and the end")->required();
+  app->add_option("--range", o->range,
+                  "X_M,ROT_DEG: candidates within ±X_M of home in x, y, z [m] and ±ROT_DEG in roll, pitch, yaw [deg]")
+      ->capture_default_str();
+  app->add_option("--candidates", o->candidates, "Candidate poses to choose from (at least --count)")
+      ->capture_default_str();
+  app->add_option("--seed", o->seed,
+                  "Seed of the candidates and of the random stations compared (synth --station-seed)")
+      ->capture_default_str();
+  app->add_option("--strategy", o->strategy, "The commands the platform runs: conventional or compensated")
+      ->check(CLI::IsMember({"conventional", "compensated"}))
+      ->capture_default_str();
+  app->add_option("--noise-um", o->noise_um,
+                  "The tracker's noise per axis [um], for the predicted accuracy (the choice does not depend on it)")
+      ->capture_default_str();
+  app->add_option(
+         "--points-per-station", o->points_per_station,
+         "Points at rest per station (1 s at 100 Hz less identify's 0.25 s settle), for the predicted accuracy")
+      ->capture_default_str();
+  app->add_option("--rate", o->rate, "Rows of the run per second [Hz]; must divide the control rate")
+      ->capture_default_str();
+  app->add_option("--out", o->out, "The run to write (t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad)")->required();
+  app->add_flag("--json", o->json, "Print the plan as JSON (SI units)");
+  return {app, [o] { return run_stations(*o); }};
+}
+
+}  // namespace hexatwist::cli
