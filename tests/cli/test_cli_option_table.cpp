@@ -102,6 +102,13 @@ std::map<std::string, std::vector<std::string>> base_arguments(const Inputs& in)
       {"config", {"--config", c}},
       {"linuxcnc", {"--config", c}},
       {"mjcf", {"--config", c}},
+      {"workspace",
+       {"--config", c, "--heights", "0", "--spacing", "0.05", "--yaws", "0", "--map-spacing", "0.1", "--cell", "0.05",
+        "--no-figures", "--no-csv", "--out", "out"}},
+      {"design", {"--config", c, "--workspace", "tests=off,random=5", "--out", "d.yaml"}},
+      {"tolerance",
+       {"--config", c, "--workspace", "tests=off,random=5", "--platforms", "5", "--no-figures", "--no-csv", "--out",
+        "out"}},
   };
 }
 
