@@ -391,13 +391,9 @@ int run_identify(const IdentifyOptions& o) {
                fmt::format("a time shorter than the run ({:g} s): no point can be still for longer [s]",
                            run.test.trajectory.duration()));
   const PointLog log = read_point_log(o.log, format);
-  ObservationSet set;
-  try {
-    set =
-        observations_at_rest(model, run.commanded, log, {o.log.time_offset, o.log.rate}, strategy_of(o.run), o.settle);
-  } catch (const Error& e) {
-    throw ExitError(kExitBadInput, e.what());
-  }
+  // Bad input throws (exit 2, naming the option at fault).
+  const ObservationSet set =
+      observations_at_rest(model, run.commanded, log, {o.log.time_offset, o.log.rate}, strategy_of(o.run), o.settle);
   Identification id;
   const Status status = identify(model, set.observations, id, library_options(o));
   const Report report{o, model, set, log, id, run.test.description};

@@ -71,11 +71,7 @@ int run_measure(const MeasureOptions& o) {
   }
   const PointLog log = read_point_log(o.log, format);
   ReportedMeasurement measured;
-  try {
-    measured.measurement = measure_points(rig.model(), run.commanded, log, mo);
-  } catch (const Error& e) {
-    throw ExitError(kExitBadInput, e.what());
-  }
+  measured.measurement = measure_points(rig.model(), run.commanded, log, mo);  // bad input throws: exit 2
   // A point farther from the commanded position than a whole leg is long is not a point of this
   // run (a typing or export error): its error would be meaningless and swamp the statistics.
   {

@@ -57,13 +57,17 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
     while (m.window < n && times[m.window] <= w.until) ++m.window;
     window_text = fmt::format("the window t <= {} s", w.until);
   }
+  const char* window_parameter = w.first > 0 ? "register_first" : "register_until";
   if (m.window == 0)
-    throw Error(fmt::format("{}: no point in the registration window ({}); the first point is at t = {} s", src,
-                            window_text, times[0]));
+    throw ParameterError(fmt::format("{}: no point in the registration window ({}); the first point is at t = {} s",
+                                     src, window_text, times[0]),
+                         window_parameter);
   const std::string lines_text = fmt::format("lines {}-{}", log.lines[0], log.lines[m.window - 1]);
   if (m.window == n)
-    throw Error(fmt::format("{}: {} ({}) hold every point: no point is left after the registration to evaluate", src,
-                            lines_text, window_text));
+    throw ParameterError(fmt::format("{}: {} ({}) hold every point: no point is left after the registration to "
+                                     "evaluate",
+                                     src, lines_text, window_text),
+                         window_parameter);
   m.window_end = times[m.window - 1];
   check_settle(src, w.settle);
   std::vector<PointPair> pairs;
@@ -78,11 +82,12 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
   const std::string rest_text =
       w.settle > 0.0 ? fmt::format(" at rest (commanded pose unchanged for {} s)", w.settle) : std::string();
   if (used.size() < 3)
-    throw Error(
+    throw ParameterError(
         fmt::format("{}: {}: only {} of the {} points in {} {}{}; registering the tracker frame needs at least "
                     "3 (widen the window, or lower the settle time)",
                     src, lines_text, used.size(), m.window, window_text, used.size() == 1 ? "is" : "are",
-                    rest_text.empty() ? std::string(" usable") : rest_text));
+                    rest_text.empty() ? std::string(" usable") : rest_text),
+        window_parameter);
 
   // Each registration point's model position: where the nominal model puts the observation point
   // for the commands the platform ran (exactly the commanded position with compensation).
