@@ -4,6 +4,7 @@
 // writes the run in the --run-out format (docs/theory/calibration.md §13).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -53,7 +54,7 @@ StationPlanSpec plan_spec(const Model& model, const StationsOptions& o) {
   spec.candidates = o.candidates;
   check_option(o.noise_um > 0.0 && o.noise_um < 1e4, "--noise-um", o.noise_um,
                "a standard deviation > 0 and below 1e4 [um]");
-  spec.noise = o.noise_um * 1e-6;
+  spec.noise = o.noise_um / 1e6;  // correctly rounded: 10 um is 1e-5 m exactly as Python gives it
   check_option(o.points_per_station >= 1 && o.points_per_station <= 1000000, "--points-per-station",
                o.points_per_station, "1 to 1000000 points");
   spec.points_per_station = o.points_per_station;
@@ -169,8 +170,13 @@ int run_stations(const StationsOptions& o) {
   try {
     if (plan_stations(model, strategy, spec, plan) != Status::Ok)
       throw ExitError(kExitOutOfLimit, fmt::format("{}; nothing was written", plan.reason));
-  } catch (const Error& e) {
-    throw ExitError(kExitBadInput, e.what());
+  } catch (const ParameterError& e) {
+    // The options checked above keep the library's own checks from refusing; should one still
+    // refuse, it names its field, which is this option.
+    const std::string& p = e.parameter();
+    std::string option = p == "translation" || p == "rotation" ? "--range" : p == "noise" ? "--noise-um" : "--" + p;
+    std::replace(option.begin(), option.end(), '_', '-');
+    throw ExitError(kExitBadInput, fmt::format("{}: {}", option, e.what()));
   }
   Trajectory run;
   try {

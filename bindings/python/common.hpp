@@ -146,6 +146,7 @@ void expose_forward(py::module_& m);
 void expose_simulation(py::module_& m);
 void expose_measurement(py::module_& m);
 void expose_identification(py::module_& m);
+void expose_station_plan(py::module_& m);
 void expose_stream(py::module_& m);
 void expose_rig(py::module_& m);
 void expose_mechanism(py::module_& m);

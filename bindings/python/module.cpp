@@ -13,6 +13,7 @@ PYBIND11_MODULE(_hexatwist, m) {
   expose_simulation(m);
   expose_measurement(m);
   expose_identification(m);
+  expose_station_plan(m);
   expose_stream(m);
   expose_rig(m);
   expose_mechanism(m);

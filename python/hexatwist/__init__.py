@@ -131,7 +131,7 @@ __all__ = [
     "BLOCK", "MAX_TRAJECTORY_SAMPLES", "STATUS_NAMES", "Status", "Result", "Error", "ConfigError", "InputError", "DTypeError", "StatusError",
     "Model", "Stream", "default_model", "load_model", "seed_config_yaml", "control_period", "study_trajectory",
     "inverse_kinematics", "twist", "length_error", "commands", "motor_command", "forward",
-    "simulate", "study", "read_point_log", "measured_test", "observations_at_rest", "identify",
+    "simulate", "study", "read_point_log", "measured_test", "observations_at_rest", "identify", "plan_stations",
     "map_batch", "map_simulations", "describe_status", "set_num_threads", "get_num_threads",
     "Rig", "TORQUE_TERMS", "platform_motion", "inverse_dynamics", "mass_matrix", "bias", "forward_dynamics",
     "kinetic_energy", "potential_energy", "motor_angles", "motor_jacobian", "peak_torque_at", "size_motors",
@@ -281,6 +281,29 @@ def stations_run(config=None, count: int = 40, seed: int = 1, strategy: str = "c
     run), or the given ``stations`` (N, 6) [m, rad], home; 1 s at each. ``t`` (T,) [s], ``poses`` (T, 6)
     [m, rad] at the control rate, ``stations`` (N, 6)."""
     return Result(_core._stations_run(config, count, seed, strategy, translation, rotation, stations))
+
+
+def plan_stations(config=None, count: int = 20, seed: int = 1, strategy: str = "compensated",
+                  translation: float = 0.25, rotation: float = float(np.radians(15.0)), candidates: int = 3000,
+                  calibration: str = "geometry", noise: float = 10e-6, points_per_station: int = 75,
+                  accuracy_poses: int = 1000) -> Result:
+    """Where to measure (station_plan.hpp, theory §13): ``count`` stations chosen from ``candidates``
+    poses drawn with ``seed`` within +-``translation`` [m] and +-``rotation`` [rad] inside every limit
+    that maximise the Ds criterion (the ``calibration`` model's information, the tracker frame a
+    nuisance) by an exchange algorithm, in run order; the same plan as ``hexatwist stations --json``.
+    ``status`` ("ok", or why not, ``reason``), ``stations`` (N, 6) [m, rad], ``parameter_names``,
+    ``candidates``, ``draws``, ``sweeps``, ``exchanges``, ``converged``, ``replaced``, and ``planned``
+    and ``random`` (the random stations of the same count and seed, ``stations_run``'s): each with
+    ``status``, ``stations``, ``criterion`` [log m^-2], ``sd_geometric`` [m], ``condition``, ``path``,
+    ``covariance`` (p, p) [m^2], ``sd`` (p,) and ``accuracy`` (``median``, ``max``, ``aligned_median``,
+    ``aligned_max`` [m] of the observation point over the range, ``noise`` [m] and
+    ``points_per_station`` scaling them). ``stations_run(config, stations=plan.stations)`` is the run
+    the CLI writes. A value out of its range raises InputError naming its keyword."""
+    r = Result(_core._plan_stations(config, count, seed, strategy, translation, rotation, candidates, calibration,
+                                    noise, points_per_station, accuracy_poses))
+    r["planned"] = Result(r["planned"])
+    r["random"] = Result(r["random"])
+    return r
 
 
 def observations_at_rest(model: Model, t, poses, stamps, points, targets=None, time_offset: float = 0.0,

@@ -262,36 +262,50 @@ int min_planned_stations(const Model& nominal, const StationPlanSpec& spec) {
 }
 
 void check_station_plan_spec(const Model& nominal, const StationPlanSpec& spec) {
+  // Each refusal names the field at fault (ParameterError: the CLI's option, Python's keyword).
   const StationsSpec& run = spec.run;
-  if (!(std::isfinite(run.translation) && run.translation >= 0.0 && std::isfinite(run.rotation) && run.rotation >= 0.0))
-    throw Error(
-        fmt::format("station plan: expected finite ranges >= 0, got ±{} m and ±{} rad", run.translation, run.rotation));
+  if (!(std::isfinite(run.translation) && run.translation >= 0.0))
+    throw ParameterError(
+        fmt::format("station plan: expected a finite translation range >= 0 m, got {}", run.translation),
+        "translation");
+  if (!(std::isfinite(run.rotation) && run.rotation >= 0.0))
+    throw ParameterError(fmt::format("station plan: expected a finite rotation range >= 0 rad, got {}", run.rotation),
+                         "rotation");
   if (spec.targets_P.size() + 1 > static_cast<std::size_t>(kMaxPlanTargets))
-    throw Error(fmt::format("station plan: {} targets with the observation point, at most {}",
-                            spec.targets_P.size() + 1, kMaxPlanTargets));
+    throw ParameterError(fmt::format("station plan: {} targets with the observation point, at most {}",
+                                     spec.targets_P.size() + 1, kMaxPlanTargets),
+                         "targets");
   for (const Vector3d& t : spec.targets_P)
-    if (!t.allFinite()) throw Error("station plan: a target holds NaN or inf");
+    if (!t.allFinite()) throw ParameterError("station plan: a target holds NaN or inf", "targets");
   const int fewest = min_planned_stations(nominal, spec);
   if (run.count < fewest || run.count > kMaxStations)
-    throw Error(fmt::format(
-        "station plan: expected {} to {} stations (with home's rests they must give as many "
-        "equations as the {} parameters), got {}",
-        fewest, kMaxStations,
-        ParameterSet(nominal, spec.model, spec.lead_effect, spec.axes, 1 + static_cast<int>(spec.targets_P.size()))
-            .size(),
-        run.count));
+    throw ParameterError(
+        fmt::format(
+            "station plan: expected {} to {} stations (with home's rests they must give as many "
+            "equations as the {} parameters), got {}",
+            fewest, kMaxStations,
+            ParameterSet(nominal, spec.model, spec.lead_effect, spec.axes, 1 + static_cast<int>(spec.targets_P.size()))
+                .size(),
+            run.count),
+        "count");
   if (spec.candidates < run.count || spec.candidates > kMaxCandidates)
-    throw Error(fmt::format("station plan: expected {} (the stations) to {} candidates, got {}", run.count,
-                            kMaxCandidates, spec.candidates));
+    throw ParameterError(fmt::format("station plan: expected {} (the stations) to {} candidates, got {}", run.count,
+                                     kMaxCandidates, spec.candidates),
+                         "candidates");
   if (!(std::isfinite(spec.noise) && spec.noise > 0.0))
-    throw Error(fmt::format("station plan: expected a tracker noise > 0 m, got {}", spec.noise));
-  if (spec.points_per_station < 1 || spec.accuracy_poses < 1 || spec.max_sweeps < 0)
-    throw Error(
-        fmt::format("station plan: expected points per station >= 1, accuracy poses >= 1 and sweeps >= 0, got "
-                    "{}, {} and {}",
-                    spec.points_per_station, spec.accuracy_poses, spec.max_sweeps));
+    throw ParameterError(fmt::format("station plan: expected a tracker noise > 0 m, got {}", spec.noise), "noise");
+  if (spec.points_per_station < 1)
+    throw ParameterError(fmt::format("station plan: expected points per station >= 1, got {}", spec.points_per_station),
+                         "points_per_station");
+  if (spec.accuracy_poses < 1)
+    throw ParameterError(fmt::format("station plan: expected accuracy poses >= 1, got {}", spec.accuracy_poses),
+                         "accuracy_poses");
+  if (spec.max_sweeps < 0)
+    throw ParameterError(fmt::format("station plan: expected exchange sweeps >= 0, got {}", spec.max_sweeps),
+                         "max_sweeps");
   if (!(std::isfinite(spec.tolerance) && spec.tolerance >= 0.0))
-    throw Error(fmt::format("station plan: expected an exchange tolerance >= 0, got {}", spec.tolerance));
+    throw ParameterError(fmt::format("station plan: expected an exchange tolerance >= 0, got {}", spec.tolerance),
+                         "tolerance");
 }
 
 }  // namespace hexatwist

@@ -276,37 +276,50 @@ TEST(StationPlan, TheChoiceDoesNotDependOnTheNoiseOrThePoints) {
 TEST(StationPlan, BadSpecsAreRefusedNamingTheField) {
   const int fewest = min_planned_stations(seed_model(), StationPlanSpec{});
   EXPECT_EQ(fewest, 13);  // 40 parameters (34 and the tracker frame), 3 rows per station, home's too
-  const auto refused = [](StationPlanSpec spec, std::initializer_list<std::string_view> parts) {
+  // One line naming the field (ParameterError's parameter: the CLI's option, Python's keyword).
+  const auto refused = [](StationPlanSpec spec, std::string_view field, std::initializer_list<std::string_view> parts) {
     StationPlan plan;
     expect_error_line([&] { (void)plan_stations(seed_model(), Strategy::Compensated, spec, plan); },
                       "station plan: ", parts);
+    try {
+      (void)plan_stations(seed_model(), Strategy::Compensated, spec, plan);
+      ADD_FAILURE() << field << ": not refused";
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.parameter(), field) << e.what();
+    }
   };
   StationPlanSpec s;
   s.run.count = fewest - 1;
-  refused(s, {"13 to 10000 stations", "40 parameters", "got 12"});
+  refused(s, "count", {"13 to 10000 stations", "40 parameters", "got 12"});
   s.run.count = kMaxStations + 1;
-  refused(s, {"got 10001"});
+  refused(s, "count", {"got 10001"});
   s = {};
   s.run.translation = std::nan("");
-  refused(s, {"finite ranges"});
+  refused(s, "translation", {"finite translation range"});
   s = {};
   s.run.rotation = -0.1;
-  refused(s, {"finite ranges"});
+  refused(s, "rotation", {"finite rotation range"});
   s = {};
   s.candidates = 39;
-  refused(s, {"40 (the stations) to 100000 candidates", "got 39"});
+  refused(s, "candidates", {"40 (the stations) to 100000 candidates", "got 39"});
   s = {};
   s.noise = 0.0;
-  refused(s, {"noise > 0"});
+  refused(s, "noise", {"noise > 0"});
   s = {};
   s.points_per_station = 0;
-  refused(s, {"points per station >= 1"});
+  refused(s, "points_per_station", {"points per station >= 1"});
+  s = {};
+  s.accuracy_poses = 0;
+  refused(s, "accuracy_poses", {"accuracy poses >= 1"});
+  s = {};
+  s.max_sweeps = -1;
+  refused(s, "max_sweeps", {"sweeps >= 0"});
   s = {};
   s.targets_P.assign(4, Vector3d::Zero());
-  refused(s, {"5 targets", "at most 4"});
+  refused(s, "targets", {"5 targets", "at most 4"});
   s = {};
   s.tolerance = -1.0;
-  refused(s, {"tolerance"});
+  refused(s, "tolerance", {"tolerance"});
 }
 
 TEST(StationPlan, RangesBeyondTheLimitsAreNotIdentifiableAndSaySo) {

@@ -79,9 +79,11 @@ struct StationPlan {
   StationsQuality random;
 };
 
-/// Throws hexatwist::Error naming the field of `spec` that is out of its range: count 1 to
-/// kMaxStations and enough to determine the parameters, finite ranges >= 0, candidates count to
-/// kMaxCandidates, noise > 0, points per station >= 1, accuracy poses >= 1, at most 3 more targets.
+/// Throws hexatwist::ParameterError naming the field of `spec` that is out of its range (its
+/// parameter(): count, translation, rotation, candidates, noise, points_per_station, accuracy_poses,
+/// max_sweeps, tolerance, targets): count 1 to kMaxStations and enough to determine the
+/// parameters, finite ranges >= 0, candidates count to kMaxCandidates, noise > 0, points per
+/// station >= 1, accuracy poses >= 1, sweeps >= 0, tolerance >= 0, at most 3 more targets.
 void check_station_plan_spec(const Model& nominal, const StationPlanSpec& spec);
 
 /// Fewest stations whose rests (with home's) can determine every parameter of `spec`'s model.
