@@ -448,8 +448,9 @@ int run_identify(const IdentifyOptions& o) {
   }
   std::string text = o.json ? json_report(report, std::string(), true) : text_report(report);
   if (!o.json)
-    text += fmt::format("wrote {}: the corrected configuration (legs form){}\n", o.out,
-                        o.no_figures ? "" : fmt::format(", and the map of its predicted accuracy {}.png/.svg", figure_stem));
+    text += fmt::format(
+        "wrote {}: the corrected configuration (legs form){}\n", o.out,
+        o.no_figures ? "" : fmt::format(", and the map of its predicted accuracy {}.png/.svg", figure_stem));
   files.finish(text);
   return kExitOk;
 }
