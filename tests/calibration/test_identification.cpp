@@ -308,6 +308,27 @@ TEST(Identification, AnErrorTheModelDoesNotHaveIsRefused) {
   EXPECT_NE(id.hint.find("axes"), std::string::npos) << id.hint;
 }
 
+TEST(Identification, AThreadSenseTheDataDoNotDecideIsRefused) {
+  // Drives with the right lead (the twist term alone sees it): for the wrong sense the best fit is
+  // no twist at all (its lead at the bound 0). Whether that is worse than the right sense by more
+  // than the noise explains decides; under noise that hides the twist (2 mm against its 0.1-0.5 mm
+  // effect) it does not, and the estimate is refused, not reported with an undecided hand.
+  TruthErrors e;
+  e.lead = 0.0;
+  IdentificationOptions o = quick();
+  o.lead_effect = LeadEffect::TwistOnly;
+  std::mt19937_64 rng(kSeed + 23);
+  const Truth truth = random_truth(seed_model(), e, rng);
+  Identification id;
+  ASSERT_EQ(identify(seed_model(), station_data(truth, 42, 20, kTrackerNoise, rng), id, o), Status::Ok) << id.reason;
+  EXPECT_EQ(id.twist_sign, 1.0);
+  EXPECT_TRUE(id.fits[1].lead_at_bound);
+  EXPECT_GT(id.sign_separation, 1e3);
+  EXPECT_EQ(identify(seed_model(), station_data(truth, 42, 20, 2e-3, rng), id, o), Status::SignUndecided) << id.reason;
+  EXPECT_LT(id.sign_separation, o.sign_separation_min);
+  EXPECT_NE(id.reason.find("thread senses"), std::string::npos) << id.reason;
+}
+
 TEST(Identification, AxesAreFittedOnlyWhereTheDataDetermineThem) {
   // With 42 stations at 10 um the axes are not determined to 0.1 deg (their effect on A is a few
   // um per 0.5 deg, issue 21): Auto fits none and says how well each is known.
