@@ -373,6 +373,26 @@ Figure accuracy_figure(const Identification& id, const std::string& stem) {
   return fig;
 }
 
+// The corrected configuration: the user's file (or the seed) with the identified platform in the
+// legs form, and the drives' reference recorded (the contract of theory §4). Throws Error if it
+// does not load.
+std::string corrected_config(const IdentifyOptions& o, const Model& model, const Identification& id) {
+  const std::string source_text = o.run.model.config.empty()
+                                      ? std::string(seed_config_yaml())
+                                      : read_text_file(o.run.model.config, "--config", "config file");
+  ModelSpec corrected = id.corrected;
+  corrected.name = fmt::format("{} (identified from {})", model.spec().name, o.log.points);
+  const std::string header = fmt::format(
+      "corrected by hexatwist identify ({} model) from {} ({} points at rest at {} stations, rms {:.4f} -> {:.4f} "
+      "mm):\njoint centres, leads, thread hands, length_offsets and observation_point identified; home_commands and\n"
+      "drive_lead record the drives' reference and scale the log was recorded with (keep the controller's HOME and "
+      "scale);\nB and P are the least-squares frames of the base and platform joint centres; everything else as in "
+      "{}.",
+      model_name(id.parameters.model()), o.log.points, id.observations, id.stations, 1e3 * id.rms_before,
+      1e3 * id.rms_after, model_source(o.run.model));
+  return platform_config_yaml(source_text, model_source(o.run.model), corrected, header, true);
+}
+
 int run_identify(const IdentifyOptions& o) {
   // Inputs and outputs first: an output that is an input is refused before any work.
   OutputFiles files("identify");
@@ -416,24 +436,9 @@ int run_identify(const IdentifyOptions& o) {
                                printable(o.log.points), set.observations.size(), set.poses, set.poses == 1 ? "" : "s",
                                status_word(status), id.reason, id.hint.empty() ? "" : "; hint: " + id.hint)));
 
-  // The corrected configuration: the user's file (or the seed) with the identified platform in the
-  // legs form, and the drives' reference recorded (the contract of theory §4).
-  const std::string source_text = o.run.model.config.empty()
-                                      ? std::string(seed_config_yaml())
-                                      : read_text_file(o.run.model.config, "--config", "config file");
-  ModelSpec corrected = id.corrected;
-  corrected.name = fmt::format("{} (identified from {})", model.spec().name, o.log.points);
-  const std::string header = fmt::format(
-      "corrected by hexatwist identify ({} model) from {} ({} points at rest at {} stations, rms {:.4f} -> {:.4f} "
-      "mm):\njoint centres, leads, thread hands, length_offsets and observation_point identified; home_commands and\n"
-      "drive_lead record the drives' reference and scale the log was recorded with (keep the controller's HOME and "
-      "scale);\nB and P are the least-squares frames of the base and platform joint centres; everything else as in "
-      "{}.",
-      model_name(id.parameters.model()), o.log.points, id.observations, id.stations, 1e3 * id.rms_before,
-      1e3 * id.rms_after, model_source(o.run.model));
   std::string yaml;
   try {
-    yaml = platform_config_yaml(source_text, model_source(o.run.model), corrected, header, true);
+    yaml = corrected_config(o, model, id);
   } catch (const Error& e) {
     fail(ExitError(kExitNotIdentified,
                    fmt::format("{}: the corrected configuration does not load: {}; nothing was written",
