@@ -183,41 +183,29 @@ std::string text_report(const Report& r) {
   return t;
 }
 
-std::string json_report(const Report& r, const std::string& failure, bool written) {
+// A number, or null where there is none.
+void json_number(JsonWriter& w, std::string_view key, double v, bool known) {
+  w.key(key);
+  known&& std::isfinite(v) ? w.value(v) : w.null();
+}
+
+// The fit, its tests and the solves of both thread senses.
+void json_fit(JsonWriter& j, const Report& r) {
   const Identification& id = r.id;
-  const ParameterSet& ps = r.ps();
-  const bool solved = id.status == Status::Ok;
-  const auto number = [](JsonWriter& w, std::string_view key, double v, bool known) {
-    w.key(key);
-    known&& std::isfinite(v) ? w.value(v) : w.null();
-  };
-  JsonWriter j;
-  j.begin_object().field("command", "identify").field("status", failure.empty() ? "ok" : "failed");
-  j.field("identification", to_string(id.status));
-  if (!failure.empty()) j.field("reason", failure);
-  if (!id.hint.empty()) j.field("hint", id.hint);
-  j.field("model", r.nominal.spec().name).field("config", model_source(r.o.run.model)).field("points", r.o.log.points);
-  j.field("calibration_model", model_name(ps.model())).field("lead_effect", r.o.lead_effect);
-  j.field("log_points", static_cast<int>(r.log.points_T.size())).field("observations", id.observations);
-  j.field("stations", id.stations).field("groups", id.groups).field("settle", r.set.settle);
-  j.field("strategy", r.o.run.strategy);
-  j.key("targets").begin_array();
-  for (const std::string& name : r.set.targets) j.value(name);
-  j.end_array();
-  number(j, "rms_before", id.rms_before, true);
-  number(j, "rms_after", id.rms_after, id.fitted);
-  number(j, "max_after", id.max_after, id.fitted);
+  json_number(j, "rms_before", id.rms_before, true);
+  json_number(j, "rms_after", id.rms_after, id.fitted);
+  json_number(j, "max_after", id.max_after, id.fitted);
   j.key("max_after_line");
   id.fitted&& id.max_after_index >= 0 ? j.value(r.line_of(static_cast<std::size_t>(id.max_after_index))) : j.null();
-  number(j, "sigma", id.sigma, id.fitted);
-  number(j, "tracker_noise", id.tracker_noise, true);
-  number(j, "scatter", id.scatter, true);
-  number(j, "noise_ratio", id.sigma / id.tracker_noise, id.fitted);
+  json_number(j, "sigma", id.sigma, id.fitted);
+  json_number(j, "tracker_noise", id.tracker_noise, true);
+  json_number(j, "scatter", id.scatter, true);
+  json_number(j, "noise_ratio", id.sigma / id.tracker_noise, id.fitted);
   j.key("fit_test").begin_object();
-  number(j, "statistic", id.fit_statistic, id.fitted);
+  json_number(j, "statistic", id.fit_statistic, id.fitted);
   j.field("dof", id.fit_dof);
-  number(j, "z", id.fit_z, id.fitted);
-  j.field("limit", 5.0).end_object();
+  json_number(j, "z", id.fit_z, id.fitted);
+  j.field("limit", library_options(r.o).fit_sigmas).end_object();
   j.key("worst_stations").begin_array(true);
   for (const StationResidual& w : id.worst) {
     j.begin_object().field("station", w.station + 1).field("target", r.set.targets[static_cast<std::size_t>(w.target)]);
@@ -225,88 +213,108 @@ std::string json_report(const Report& r, const std::string& failure, bool writte
     j.field("statistic", w.statistic).end_object();
   }
   j.end_array();
-  number(j, "condition", id.condition, true);
+  json_number(j, "condition", id.condition, true);
   if (!id.undetermined.empty()) j.field("undetermined", id.undetermined);
-  number(j, "cost_ratio", id.cost_ratio, id.fitted);
-  number(j, "sign_separation", id.sign_separation, id.fitted);
+  json_number(j, "cost_ratio", id.cost_ratio, id.fitted);
+  json_number(j, "sign_separation", id.sign_separation, id.fitted);
   j.key("fits").begin_array(true);
   for (const SignFit& f : id.fits) {
     j.begin_object().field("twist_sign", f.twist_sign).field("status", describe(f.status));
-    number(j, "cost", f.cost, std::isfinite(f.cost));
+    json_number(j, "cost", f.cost, std::isfinite(f.cost));
     j.field("iterations", f.iterations).field("lead_at_bound", f.lead_at_bound).end_object();
   }
   j.end_array();
+}
+
+// The axes, the cross-validation and the predicted accuracy.
+void json_diagnostics(JsonWriter& j, const Identification& id) {
   j.key("axis_sd").begin_array();
   for (const double sd : id.axis_sd) std::isfinite(sd) ? j.value(sd) : j.null();
   j.end_array();
   j.key("axes_fitted").begin_array();
-  for (const bool a : ps.axes()) j.value(a);
+  for (const bool a : id.parameters.axes()) j.value(a);
   j.end_array();
   const CrossValidation& cv = id.cross_validation;
   j.key("cross_validation").begin_object().field("folds", cv.folds).field("predicted", cv.predicted);
-  number(j, "rms", cv.rms, cv.folds > 0);
-  number(j, "max", cv.max, cv.folds > 0);
-  number(j, "expected", cv.expected, cv.folds > 0);
+  json_number(j, "rms", cv.rms, cv.folds > 0);
+  json_number(j, "max", cv.max, cv.folds > 0);
+  json_number(j, "expected", cv.expected, cv.folds > 0);
   j.end_object();
   const AccuracyPrediction& acc = id.accuracy;
   j.key("accuracy").begin_object().field("poses", acc.poses);
-  number(j, "median", acc.median, acc.poses > 0);
-  number(j, "max", acc.max, acc.poses > 0);
-  number(j, "aligned_median", acc.aligned_median, acc.poses > 0);
-  number(j, "aligned_max", acc.aligned_max, acc.poses > 0);
+  json_number(j, "median", acc.median, acc.poses > 0);
+  json_number(j, "max", acc.max, acc.poses > 0);
+  json_number(j, "aligned_median", acc.aligned_median, acc.poses > 0);
+  json_number(j, "aligned_max", acc.aligned_max, acc.poses > 0);
   j.key("range_low").vector(acc.range_low);
   j.key("range_high").vector(acc.range_high);
   j.end_object();
+}
+
+// The estimate: every parameter with its sd, and the corrected platform's quantities.
+void json_estimate(JsonWriter& j, const Identification& id) {
+  const ParameterSet& ps = id.parameters;
+  j.begin_object();
+  j.key("parameters").begin_array(true);
+  for (int k = 0; k < ps.size(); ++k)
+    j.begin_object()
+        .field("name", ps.name(k))
+        .field("nominal", id.nominal[k])
+        .field("estimate", id.estimate[k])
+        .field("sd", id.sd[k])
+        .end_object();
+  j.end_array();
+  j.field("twist_sign", id.twist_sign);
+  const ModelSpec& c = id.corrected;
+  const auto per_leg = [&](std::string_view key, auto&& value) {
+    j.key(key).begin_array();
+    for (int i = 0; i < kLegs; ++i) value(i);
+    j.end_array();
+  };
+  const auto leg = [&](int i) -> const LegSpec& { return c.legs[static_cast<std::size_t>(i)]; };
+  per_leg("leads", [&](int i) { j.value(leg(i).lead); });
+  per_leg("threads", [&](int i) { j.value(leg(i).thread == ThreadSense::Right ? "right" : "left"); });
+  per_leg("length_offsets", [&](int i) { j.value(leg(i).length_offset); });
+  per_leg("base_joints", [&](int i) { j.vector(leg(i).base_B); });
+  per_leg("base_joints_sd", [&](int i) { j.vector(Vector3d(id.base_shift_sd.row(i).transpose())); });
+  per_leg("platform_joints", [&](int i) { j.vector(leg(i).platform_P); });
+  per_leg("platform_joints_sd", [&](int i) { j.vector(Vector3d(id.platform_shift_sd.row(i).transpose())); });
+  j.key("targets").begin_array();
+  for (int t = 0; t < ps.targets(); ++t) j.vector(ps.target(id.estimate, t));
+  j.end_array();
+  j.key("observation_point").vector(c.observation_P);
+  j.key("X_BT").begin_object();
+  j.key("R").begin_array();
+  for (int i = 0; i < 3; ++i) j.vector(id.X_BT.R.row(i));
+  j.end_array();
+  j.key("t").vector(id.X_BT.t);
+  j.key("rotation_sd").vector(id.sd.segment<3>(ps.rotation_index()));
+  j.key("t_sd").vector(id.sd.segment<3>(ps.translation_index()));
+  j.end_object().end_object();
+}
+
+std::string json_report(const Report& r, const std::string& failure, bool written) {
+  const Identification& id = r.id;
+  JsonWriter j;
+  j.begin_object().field("command", "identify").field("status", failure.empty() ? "ok" : "failed");
+  j.field("identification", to_string(id.status));
+  if (!failure.empty()) j.field("reason", failure);
+  if (!id.hint.empty()) j.field("hint", id.hint);
+  j.field("model", r.nominal.spec().name).field("config", model_source(r.o.run.model)).field("points", r.o.log.points);
+  j.field("calibration_model", model_name(r.ps().model())).field("lead_effect", r.o.lead_effect);
+  j.field("log_points", static_cast<int>(r.log.points_T.size())).field("observations", id.observations);
+  j.field("stations", id.stations).field("groups", id.groups).field("settle", r.set.settle);
+  j.field("strategy", r.o.run.strategy);
+  j.key("targets").begin_array();
+  for (const std::string& name : r.set.targets) j.value(name);
+  j.end_array();
+  json_fit(j, r);
+  json_diagnostics(j, id);
   j.key("estimate");
-  if (!solved) {
+  if (id.status == Status::Ok)
+    json_estimate(j, id);
+  else
     j.null();
-  } else {
-    j.begin_object();
-    j.key("parameters").begin_array(true);
-    for (int k = 0; k < ps.size(); ++k)
-      j.begin_object()
-          .field("name", ps.name(k))
-          .field("nominal", id.nominal[k])
-          .field("estimate", id.estimate[k])
-          .field("sd", id.sd[k])
-          .end_object();
-    j.end_array();
-    j.field("twist_sign", id.twist_sign);
-    const ModelSpec& c = id.corrected;
-    j.key("leads").begin_array();
-    for (const LegSpec& leg : c.legs) j.value(leg.lead);
-    j.end_array();
-    j.key("threads").begin_array();
-    for (const LegSpec& leg : c.legs) j.value(leg.thread == ThreadSense::Right ? "right" : "left");
-    j.end_array();
-    j.key("length_offsets").begin_array();
-    for (const LegSpec& leg : c.legs) j.value(leg.length_offset);
-    j.end_array();
-    j.key("base_joints").begin_array();
-    for (const LegSpec& leg : c.legs) j.vector(leg.base_B);
-    j.end_array();
-    j.key("base_joints_sd").begin_array();
-    for (int i = 0; i < kLegs; ++i) j.vector(Vector3d(id.base_shift_sd.row(i).transpose()));
-    j.end_array();
-    j.key("platform_joints").begin_array();
-    for (const LegSpec& leg : c.legs) j.vector(leg.platform_P);
-    j.end_array();
-    j.key("platform_joints_sd").begin_array();
-    for (int i = 0; i < kLegs; ++i) j.vector(Vector3d(id.platform_shift_sd.row(i).transpose()));
-    j.end_array();
-    j.key("targets").begin_array();
-    for (int t = 0; t < ps.targets(); ++t) j.vector(ps.target(id.estimate, t));
-    j.end_array();
-    j.key("observation_point").vector(c.observation_P);
-    j.key("X_BT").begin_object();
-    j.key("R").begin_array();
-    for (int i = 0; i < 3; ++i) j.vector(id.X_BT.R.row(i));
-    j.end_array();
-    j.key("t").vector(id.X_BT.t);
-    j.key("rotation_sd").vector(id.sd.segment<3>(ps.rotation_index()));
-    j.key("t_sd").vector(id.sd.segment<3>(ps.translation_index()));
-    j.end_object().end_object();
-  }
   j.key("corrected_config");
   written ? j.value(r.o.out) : j.null();
   j.end_object();
@@ -365,6 +373,26 @@ Figure accuracy_figure(const Identification& id, const std::string& stem) {
   return fig;
 }
 
+// The corrected configuration: the user's file (or the seed) with the identified platform in the
+// legs form, and the drives' reference recorded (the contract of theory §4). Throws Error if it
+// does not load.
+std::string corrected_config(const IdentifyOptions& o, const Model& model, const Identification& id) {
+  const std::string source_text = o.run.model.config.empty()
+                                      ? std::string(seed_config_yaml())
+                                      : read_text_file(o.run.model.config, "--config", "config file");
+  ModelSpec corrected = id.corrected;
+  corrected.name = fmt::format("{} (identified from {})", model.spec().name, o.log.points);
+  const std::string header = fmt::format(
+      "corrected by hexatwist identify ({} model) from {} ({} points at rest at {} stations, rms {:.4f} -> {:.4f} "
+      "mm):\njoint centres, leads, thread hands, length_offsets and observation_point identified; home_commands and\n"
+      "drive_lead record the drives' reference and scale the log was recorded with (keep the controller's HOME and "
+      "scale);\nB and P are the least-squares frames of the base and platform joint centres; everything else as in "
+      "{}.",
+      model_name(id.parameters.model()), o.log.points, id.observations, id.stations, 1e3 * id.rms_before,
+      1e3 * id.rms_after, model_source(o.run.model));
+  return platform_config_yaml(source_text, model_source(o.run.model), corrected, header, true);
+}
+
 int run_identify(const IdentifyOptions& o) {
   // Inputs and outputs first: an output that is an input is refused before any work.
   OutputFiles files("identify");
@@ -408,24 +436,9 @@ int run_identify(const IdentifyOptions& o) {
                                printable(o.log.points), set.observations.size(), set.poses, set.poses == 1 ? "" : "s",
                                status_word(status), id.reason, id.hint.empty() ? "" : "; hint: " + id.hint)));
 
-  // The corrected configuration: the user's file (or the seed) with the identified platform in the
-  // legs form, and the drives' reference recorded (the contract of theory §4).
-  const std::string source_text = o.run.model.config.empty()
-                                      ? std::string(seed_config_yaml())
-                                      : read_text_file(o.run.model.config, "--config", "config file");
-  ModelSpec corrected = id.corrected;
-  corrected.name = fmt::format("{} (identified from {})", model.spec().name, o.log.points);
-  const std::string header = fmt::format(
-      "corrected by hexatwist identify ({} model) from {} ({} points at rest at {} stations, rms {:.4f} -> {:.4f} "
-      "mm):\njoint centres, leads, thread hands, length_offsets and observation_point identified; home_commands and\n"
-      "drive_lead record the drives' reference and scale the log was recorded with (keep the controller's HOME and "
-      "scale);\nB and P are the least-squares frames of the base and platform joint centres; everything else as in "
-      "{}.",
-      model_name(id.parameters.model()), o.log.points, id.observations, id.stations, 1e3 * id.rms_before,
-      1e3 * id.rms_after, model_source(o.run.model));
   std::string yaml;
   try {
-    yaml = platform_config_yaml(source_text, model_source(o.run.model), corrected, header, true);
+    yaml = corrected_config(o, model, id);
   } catch (const Error& e) {
     fail(ExitError(kExitNotIdentified,
                    fmt::format("{}: the corrected configuration does not load: {}; nothing was written",
@@ -448,8 +461,9 @@ int run_identify(const IdentifyOptions& o) {
   }
   std::string text = o.json ? json_report(report, std::string(), true) : text_report(report);
   if (!o.json)
-    text += fmt::format("wrote {}: the corrected configuration (legs form){}\n", o.out,
-                        o.no_figures ? "" : fmt::format(", and the map of its predicted accuracy {}.png/.svg", figure_stem));
+    text += fmt::format(
+        "wrote {}: the corrected configuration (legs form){}\n", o.out,
+        o.no_figures ? "" : fmt::format(", and the map of its predicted accuracy {}.png/.svg", figure_stem));
   files.finish(text);
   return kExitOk;
 }

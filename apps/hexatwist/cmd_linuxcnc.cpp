@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <memory>
 
 #include "cli_common.hpp"
@@ -43,7 +44,11 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
 
   // Speeds: the motors' from the servo section, the axes' from the study's motion profile.
   const ServoSpec& servo = config.rig.servo();
-  const double joint_velocity = servo.max_speed * config.rig.motor_gain().minCoeff();  // [m/s]
+  // The joints are lengths as the drives compute them (drive_lead, theory §4), so a motor's speed
+  // limit is the same joint speed whatever lead the screw really has.
+  double joint_velocity = std::numeric_limits<double>::infinity();  // [m/s]
+  for (int i = 0; i < kLegs; ++i)
+    joint_velocity = std::min(joint_velocity, servo.max_speed * config.rig.motor_gain()[i] / model.leg(i).drive_scale);
   const StudySpec& study = config.study;
 
   std::string t = fmt::format(

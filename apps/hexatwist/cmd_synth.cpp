@@ -115,19 +115,8 @@ std::string mm_list(const Vec& v) {
   return s;
 }
 
-int run_synth(const SynthOptions& o) {
-  const Config config = load_config_from(o.run.model);
-  const Rig& rig = config.rig;
-  const Run run = build_run(config, o.run);
-  const std::string out = o.out.empty() ? fmt::format("tracker_{}.csv", run.test.name) : o.out;
-  const std::filesystem::path csv(out);
-  const std::string truth = (csv.parent_path() / (csv.stem().string() + ".truth.json")).string();
-  OutputFiles files("synth");
-  files.input("--config", o.run.model.config);
-  files.input("--trajectory", o.run.trajectory);
-  files.output("--out", out);
-  files.output("the truth beside --out", truth);
-  files.output("--run-out", o.run_out);
+// The synthesis options from the command's, every value checked (one line naming the option).
+SynthesisOptions synthesis_options(const SynthOptions& o, const Rig& rig) {
   // Finite but absurd values are refused too: a noise, an offset or a point error as large as the
   // whole stroke leaves nothing in the log to measure or identify.
   const double stroke_um = 1e6 * (rig.model().spec().limits.length_max - rig.model().spec().limits.length_min);
@@ -198,29 +187,13 @@ int run_synth(const SynthOptions& o) {
                                                  so.extra_targets_P.size() + 1, kMaxTargets));
   }
 
-  SimulationIssue issue;
-  if (const Status s = check_trajectory(rig, run.test.trajectory, issue); s != Status::Ok)
-    throw ExitError(kExitOutOfLimit,
-                    fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
-                                is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
-  SyntheticLog log;
-  Status synthesized = Status::Ok;
-  try {
-    synthesized = synthesize(rig, run.test.trajectory, so, log, issue);
-  } catch (const Error& e) {
-    // The options were checked above but the rate's divisibility: name the option, not the routine.
-    std::string what = e.what();
-    if (what.starts_with("rate: ")) what = fmt::format("--rate {}: {}", o.rate, what.substr(6));
-    throw ExitError(kExitBadInput, what);
-  }
-  if (const Status s = synthesized; s != Status::Ok)
-    throw ExitError(kExitOutOfLimit,
-                    fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
-                                is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+  return so;
+}
 
-  // Like a tracker's export: millimetres with a unit suffix, 1 nm resolution (noise-free logs stay exact enough).
+// The log like a tracker's export: millimetres with a unit suffix, 1 nm resolution (noise-free
+// logs stay exact enough), a target column when there are several targets.
+std::string log_csv(const SyntheticLog& log, bool targets) {
   fmt::memory_buffer b;
-  const bool targets = !so.extra_targets_P.empty();
   fmt::format_to(std::back_inserter(b), "{}", targets ? "t_s,target,x_mm,y_mm,z_mm\n" : "t_s,x_mm,y_mm,z_mm\n");
   for (std::size_t k = 0; k < log.log.points_T.size(); ++k) {
     const Vector3d p = 1e3 * log.log.points_T[k];
@@ -229,14 +202,13 @@ int run_synth(const SynthOptions& o) {
       fmt::format_to(std::back_inserter(b), "{},", log.log.target_names[static_cast<std::size_t>(log.log.targets[k])]);
     fmt::format_to(std::back_inserter(b), "{:.6f},{:.6f},{:.6f}\n", p.x(), p.y(), p.z());
   }
-  files.add(out, fmt::to_string(b));
-  files.add(truth, truth_json(config, o, run, so, log));
-  if (!o.run_out.empty())
-    files.add(o.run_out,
-              format_trajectory_csv(run.test.trajectory,
-                                    static_cast<std::size_t>(std::llround(rig.simulation().control_rate / so.rate))));
-  files.commit();
+  return fmt::to_string(b);
+}
 
+// What synth tells the user: the run, the real platform's errors, the tracker, the files.
+std::string summary_text(const SynthOptions& o, const Rig& rig, const Run& run, const SynthesisOptions& so,
+                         const SyntheticLog& log, const std::string& out, const std::string& truth) {
+  const bool targets = !so.extra_targets_P.empty();
   const Vector3d& origin = log.X_BT.t;
   std::string text = fmt::format("hexatwist synth on {}: {}\n", model_source(o.run.model), rig.model().spec().name);
   text += fmt::format("run: {}, {} commands, {:.2f} s: {} points at {:g} Hz\n", run.test.description, o.run.strategy,
@@ -268,7 +240,52 @@ int run_synth(const SynthOptions& o) {
                             : fmt::format("wrote {}, {} and the run {}", out, truth, o.run_out);
   if (std::isfinite(run.calibration_end))
     text += fmt::format("; measure registers on the calibration moves, t <= {:.3f} s", run.calibration_end);
-  files.finish(text + "\n");
+  return text + "\n";
+}
+
+int run_synth(const SynthOptions& o) {
+  const Config config = load_config_from(o.run.model);
+  const Rig& rig = config.rig;
+  const Run run = build_run(config, o.run);
+  const std::string out = o.out.empty() ? fmt::format("tracker_{}.csv", run.test.name) : o.out;
+  const std::filesystem::path csv(out);
+  const std::string truth = (csv.parent_path() / (csv.stem().string() + ".truth.json")).string();
+  OutputFiles files("synth");
+  files.input("--config", o.run.model.config);
+  files.input("--trajectory", o.run.trajectory);
+  files.output("--out", out);
+  files.output("the truth beside --out", truth);
+  files.output("--run-out", o.run_out);
+  const SynthesisOptions so = synthesis_options(o, rig);
+  SimulationIssue issue;
+  if (const Status s = check_trajectory(rig, run.test.trajectory, issue); s != Status::Ok)
+    throw ExitError(kExitOutOfLimit,
+                    fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
+                                is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+  SyntheticLog log;
+  Status synthesized = Status::Ok;
+  try {
+    synthesized = synthesize(rig, run.test.trajectory, so, log, issue);
+  } catch (const Error& e) {
+    // The options were checked above but the rate's divisibility: name the option, not the routine.
+    std::string what = e.what();
+    if (what.starts_with("rate: ")) what = fmt::format("--rate {}: {}", o.rate, what.substr(6));
+    throw ExitError(kExitBadInput, what);
+  }
+  if (const Status s = synthesized; s != Status::Ok)
+    throw ExitError(kExitOutOfLimit,
+                    fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
+                                is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+
+  files.add(out, log_csv(log, !so.extra_targets_P.empty()));
+  files.add(truth, truth_json(config, o, run, so, log));
+  if (!o.run_out.empty())
+    files.add(o.run_out,
+              format_trajectory_csv(run.test.trajectory,
+                                    static_cast<std::size_t>(std::llround(rig.simulation().control_rate / so.rate))));
+  files.commit();
+
+  files.finish(summary_text(o, rig, run, so, log, out, truth));
   return kExitOk;
 }
 

@@ -1,31 +1,21 @@
 #include "figures.hpp"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstdlib>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <functional>
 #include <iterator>
 #include <limits>
 #include <set>
 #include <sstream>
 #include <string_view>
-#include <system_error>
 
 #include "cli_common.hpp"
-
-extern char** environ;
+#include "figure_script.hpp"
 
 namespace hexatwist::cli {
 
@@ -76,64 +66,6 @@ std::string gp_string(std::string_view text) {
   }
   return out + "'";
 }
-
-bool is_executable_file(const std::string& path) {
-  struct stat st {};
-  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(path.c_str(), X_OK) == 0;
-}
-
-// Fails with the output path if figures cannot be written into the directory of `stem`, before
-// gnuplot runs.
-void check_output_directory(const std::string& stem) {
-  if (stem.empty()) throw ExitError(kExitOutputFailed, "cannot write a figure: its output path is empty");
-  fs::path dir = fs::path(stem).parent_path();
-  if (dir.empty()) dir = ".";
-  std::error_code ec;
-  const auto status = fs::status(dir, ec);
-  const std::string target = printable(stem + ".png");
-  if (!fs::exists(status))
-    throw ExitError(kExitOutputFailed, fmt::format("cannot write figure '{}': directory '{}' does not exist", target,
-                                                   printable(dir.string())));
-  if (!fs::is_directory(status))
-    throw ExitError(kExitOutputFailed,
-                    fmt::format("cannot write figure '{}': '{}' is not a directory", target, printable(dir.string())));
-  if (::access(dir.c_str(), W_OK) != 0)
-    throw ExitError(kExitOutputFailed, fmt::format("cannot write figure '{}': directory '{}': {}", target,
-                                                   printable(dir.string()), std::strerror(errno)));
-}
-
-// A private directory for the script, gnuplot's messages and the figures while they are drawn;
-// removed with everything in it when the write ends, however it ends.
-class ScratchDir {
- public:
-  ScratchDir() {
-    std::error_code ec;
-    fs::path base = fs::temp_directory_path(ec);
-    if (ec) base = "/tmp";
-    std::string tmpl = (base / "hexatwist_figures_XXXXXX").string();
-    if (::mkdtemp(tmpl.data()) == nullptr)
-      throw ExitError(kExitOutputFailed, fmt::format("cannot create a temporary directory in '{}': {}",
-                                                     printable(base.string()), std::strerror(errno)));
-    path_ = tmpl;
-  }
-  ~ScratchDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  ScratchDir(const ScratchDir&) = delete;
-  ScratchDir& operator=(const ScratchDir&) = delete;
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-// gnuplot's script, with the byte offset where each figure's commands start (to name the figure
-// that a gnuplot error comes from).
-struct Script {
-  std::string text;
-  std::vector<std::size_t> figure_start;
-};
 
 void append_number(std::string& out, double v) {
   // 10 significant digits: a small variation on a large offset still draws smoothly.
@@ -337,28 +269,54 @@ std::string map_commands(const HeatMap& m, double bar_left, double bar_bottom, d
   return out;
 }
 
-// Every panel is placed by hand (margins at screen positions) so that the plot areas of a figure
-// line up under each other, whatever their tick labels.
-FigureCommands figure_commands(const Figure& fig, std::size_t f, std::vector<PanelRanges> ranges) {
-  static const Panel kNoPanel{};
-  const std::size_t n_panels = ranges.size();
-  const auto panel = [&](std::size_t p) -> const Panel& { return p < fig.panels.size() ? fig.panels[p] : kNoPanel; };
-  const auto panel_height = [&](std::size_t p) {
-    return static_cast<double>(panel(p).height > 0 ? panel(p).height : kPanelHeight);
-  };
+// The plot command of panel p of figure f: its map, then its series.
+std::string plot_command(const Panel& pn, std::size_t f, std::size_t p) {
+  if (pn.series.empty() && !pn.map) return "plot NaN notitle\n";
+  std::string out = "plot";
+  const char* sep = "";  // a std::string here meets GCC 12's false -Wrestrict on its assignment
+  if (pn.map) {
+    out += fmt::format(" {} using 1:2:3 with image notitle", map_block_name(f, p));
+    sep = ",";
+  }
+  for (std::size_t s = 0; s < pn.series.size(); ++s) {
+    const Series& series = pn.series[s];
+    if (series.style == Series::Style::Points)
+      out += fmt::format("{} {} using 1:2 with points pt 7 ps 0.4 lc rgb '{}' title {}", sep, block_name(f, p, s),
+                         kPalette[s % kPalette.size()], gp_string(series.label));
+    else
+      out += fmt::format("{} {} using 1:2 with lines lw {} lc rgb '{}' dt {} title {}", sep, block_name(f, p, s),
+                         kLineWidth, kPalette[s % kPalette.size()], dash(series.style), gp_string(series.label));
+    sep = ",";
+    if (s + 1 < pn.series.size()) out += " \\\n ";
+  }
+  return out + "\n";
+}
+
+// Where a figure's parts go [px]: the plot areas' left and right edges (the same for every panel),
+// the key's place, each panel's top and the page's height.
+struct FigureLayout {
+  std::vector<Ticks> xticks, yticks;
+  double left_px = 0.0, right_px = 0.0;
+  bool key_below = false;
+  std::vector<double> panel_top;
+  double height = 0.0;
+};
+
+FigureLayout figure_layout(const Figure& fig, const std::vector<PanelRanges>& ranges,
+                           const std::function<const Panel&(std::size_t)>& panel,
+                           const std::function<double(std::size_t)>& panel_height) {
+  FigureLayout l;
   bool maps = false;
   for (const Panel& p : fig.panels) maps = maps || p.map.has_value();
-
   // Ticks first: the widest y tick label of the figure sets the left margin.
-  std::vector<Ticks> xticks, yticks;
   std::size_t ytick_chars = 0, xtick_last = 0;
   for (const PanelRanges& r : ranges) {
-    xticks.push_back(ticks_for('x', r.x, 8.0));
-    yticks.push_back(ticks_for('y', r.y, 8.0));
-    ytick_chars = std::max(ytick_chars, yticks.back().widest);
-    xtick_last = std::max(xtick_last, xticks.back().last);
+    l.xticks.push_back(ticks_for('x', r.x, 8.0));
+    l.yticks.push_back(ticks_for('y', r.y, 8.0));
+    ytick_chars = std::max(ytick_chars, l.yticks.back().widest);
+    xtick_last = std::max(xtick_last, l.xticks.back().last);
   }
-  const double left_px = kLeftLabelSpace + kDigitWidth * static_cast<double>(ytick_chars);
+  l.left_px = kLeftLabelSpace + kDigitWidth * static_cast<double>(ytick_chars);
 
   // The key never covers the data: right of the plot area, as wide as the longest label of the
   // figure (so every panel has the same plot width), or, for labels too long for that or beside a
@@ -367,22 +325,38 @@ FigureCommands figure_commands(const Figure& fig, std::size_t f, std::vector<Pan
   for (const Panel& p : fig.panels)
     for (const Series& s : p.series) longest = std::max(longest, s.label.size());
   const double key_px = longest == 0 ? 0.0 : kKeySampleWidth + kCharWidth * static_cast<double>(longest);
-  const bool key_below = key_px > kMaxKeyWidth || (maps && longest > 0);
+  l.key_below = key_px > kMaxKeyWidth || (maps && longest > 0);
   // Without a key on the right, room for half of the last x tick label, which is centred on the edge.
-  const double right_px =
+  l.right_px =
       maps ? kWidth - kColorBoxSpace
-           : kWidth - (key_below ? std::max(kRightSpace, 0.5 * kDigitWidth * static_cast<double>(xtick_last) + 10.0)
-                                 : kRightSpace + key_px);
+           : kWidth - (l.key_below ? std::max(kRightSpace, 0.5 * kDigitWidth * static_cast<double>(xtick_last) + 10.0)
+                                   : kRightSpace + key_px);
 
   // Vertical layout [px from the top].
-  std::vector<double> panel_top(n_panels);
-  double height = fig.title.empty() ? 0.0 : kFigureTitleHeight;
-  for (std::size_t p = 0; p < n_panels; ++p) {
-    panel_top[p] = height;
-    height += panel_height(p);
-    if (key_below && !panel(p).series.empty())
-      height += kKeyLineHeight * static_cast<double>(panel(p).series.size()) + kKeyBelowGap;
+  l.panel_top.resize(ranges.size());
+  l.height = fig.title.empty() ? 0.0 : kFigureTitleHeight;
+  for (std::size_t p = 0; p < ranges.size(); ++p) {
+    l.panel_top[p] = l.height;
+    l.height += panel_height(p);
+    if (l.key_below && !panel(p).series.empty())
+      l.height += kKeyLineHeight * static_cast<double>(panel(p).series.size()) + kKeyBelowGap;
   }
+  return l;
+}
+
+// Every panel is placed by hand (margins at screen positions) so that the plot areas of a figure
+// line up under each other, whatever their tick labels.
+FigureCommands figure_commands(const Figure& fig, std::size_t f, std::vector<PanelRanges> ranges) {
+  static const Panel kNoPanel{};
+  const std::size_t n_panels = ranges.size();
+  const std::function<const Panel&(std::size_t)> panel = [&](std::size_t p) -> const Panel& {
+    return p < fig.panels.size() ? fig.panels[p] : kNoPanel;
+  };
+  const std::function<double(std::size_t)> panel_height = [&](std::size_t p) {
+    return static_cast<double>(panel(p).height > 0 ? panel(p).height : kPanelHeight);
+  };
+  FigureLayout l = figure_layout(fig, ranges, panel, panel_height);
+  const double left_px = l.left_px, right_px = l.right_px, height = l.height;
   const auto screen_y = [&](double px) { return 1.0 - px / height; };
 
   std::string out;
@@ -398,8 +372,8 @@ FigureCommands figure_commands(const Figure& fig, std::size_t f, std::vector<Pan
                      fig.title.empty() ? "" : fmt::format(" title {} font '{}'", gp_string(fig.title), kTitleFont));
   for (std::size_t p = 0; p < n_panels; ++p) {
     const Panel& pn = panel(p);
-    const double plot_top = panel_top[p] + (pn.title.empty() ? kPanelTopSpace : kPanelTitleSpace);
-    const double plot_bottom = panel_top[p] + panel_height(p) - kPanelBottomSpace;
+    const double plot_top = l.panel_top[p] + (pn.title.empty() ? kPanelTopSpace : kPanelTitleSpace);
+    const double plot_bottom = l.panel_top[p] + panel_height(p) - kPanelBottomSpace;
     if (pn.equal_axes && !ranges[p].x.empty() && !ranges[p].y.empty()) {
       // One unit as long on both axes: the range that is short for its side widened about its centre.
       Range& x = ranges[p].x;
@@ -409,20 +383,20 @@ FigureCommands figure_commands(const Figure& fig, std::size_t f, std::vector<Pan
       const double cx = 0.5 * (x.lo + x.hi), cy = 0.5 * (y.lo + y.hi);
       x = Range{cx - 0.5 * per_px * w, cx + 0.5 * per_px * w};
       y = Range{cy - 0.5 * per_px * h, cy + 0.5 * per_px * h};
-      xticks[p] = ticks_for('x', x, 8.0, true);
-      yticks[p] = ticks_for('y', y, 8.0 * h / w * 1.6, true);
+      l.xticks[p] = ticks_for('x', x, 8.0, true);
+      l.yticks[p] = ticks_for('y', y, 8.0 * h / w * 1.6, true);
     }
     out += fmt::format("set tmargin at screen {:.5f}\nset bmargin at screen {:.5f}\n", screen_y(plot_top),
                        screen_y(plot_bottom));
     out += pn.title.empty() ? "unset title\n" : fmt::format("set title {} offset 0,-0.3\n", gp_string(pn.title));
     out += fmt::format("set xlabel {}\nset ylabel {}\n", gp_string(pn.xlabel), gp_string(pn.ylabel));
-    if (key_below)
+    if (l.key_below)
       out += fmt::format("set key at screen {:.5f},{:.5f} left top Left reverse samplen 3 spacing 1.15\n",
-                         left_px / kWidth, screen_y(panel_top[p] + panel_height(p)));
+                         left_px / kWidth, screen_y(l.panel_top[p] + panel_height(p)));
     else
       out += fmt::format("set key at screen {:.5f},{:.5f} left top Left reverse samplen 3 spacing 1.15\n",
                          (right_px + kKeyGap) / kWidth, screen_y(plot_top));
-    out += xticks[p].commands + yticks[p].commands;
+    out += l.xticks[p].commands + l.yticks[p].commands;
     out += ranges[p].x.empty() ? "set label 1 'no data' at graph 0.5,0.5 center textcolor rgb '#808080'\n"
                                : "unset label 1\n";
     if (pn.map)
@@ -430,32 +404,13 @@ FigureCommands figure_commands(const Figure& fig, std::size_t f, std::vector<Pan
                           (plot_bottom - plot_top) / height);
     else
       out += "unset colorbox\n";
-    if (pn.series.empty() && !pn.map) {
-      out += "plot NaN notitle\n";
-      continue;
-    }
-    out += "plot";
-    const char* sep = "";  // a std::string here meets GCC 12's false -Wrestrict on its assignment
-    if (pn.map) {
-      out += fmt::format(" {} using 1:2:3 with image notitle", map_block_name(f, p));
-      sep = ",";
-    }
-    for (std::size_t s = 0; s < pn.series.size(); ++s) {
-      const Series& series = pn.series[s];
-      if (series.style == Series::Style::Points)
-        out += fmt::format("{} {} using 1:2 with points pt 7 ps 0.4 lc rgb '{}' title {}", sep, block_name(f, p, s),
-                           kPalette[s % kPalette.size()], gp_string(series.label));
-      else
-        out += fmt::format("{} {} using 1:2 with lines lw {} lc rgb '{}' dt {} title {}", sep, block_name(f, p, s),
-                           kLineWidth, kPalette[s % kPalette.size()], dash(series.style), gp_string(series.label));
-      sep = ",";
-      if (s + 1 < pn.series.size()) out += " \\\n ";
-    }
-    out += "\n";
+    out += plot_command(pn, f, p);
   }
   out += "unset multiplot\n";
   return {out, static_cast<int>(std::lround(height))};
 }
+
+}  // namespace
 
 Script build_script(const std::vector<Figure>& figures, const fs::path& dir) {
   Script script;
@@ -487,98 +442,6 @@ Script build_script(const std::vector<Figure>& figures, const fs::path& dir) {
     }
   }
   return script;
-}
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-// gnuplot's first error from its stderr, as "<message>", and the script line it names (0 if none).
-// gnuplot reports an error as `"script" line N: message`, after echoing the command and a caret.
-std::pair<std::string, std::size_t> first_error(const std::string& err) {
-  std::istringstream in(err);
-  std::string first_text;
-  for (std::string line; std::getline(in, line);) {
-    const auto at = line.find(" line ");
-    if (at != std::string::npos) {
-      std::size_t n = 0;
-      const char* b = line.data() + at + 6;
-      const char* e = line.data() + line.size();
-      const auto [ptr, ec] = std::from_chars(b, e, n);
-      if (ec == std::errc() && ptr + 1 < e && ptr[0] == ':' && ptr[1] == ' ') {
-        const std::string message(ptr + 2, e);
-        if (message.rfind("warning:", 0) == 0) continue;
-        return {message, n};
-      }
-    }
-    const auto text = line.find_first_not_of(" \t^");
-    if (first_text.empty() && text != std::string::npos) first_text = line.substr(text);
-  }
-  return {first_text, 0};
-}
-
-// Runs gnuplot on `script`; its stderr goes to `err`. Returns the wait status.
-int run_gnuplot(const std::string& gnuplot, const fs::path& script, const fs::path& err) {
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-  // --default-settings: no ~/.gnuplot or system gnuplotrc changes the look.
-  std::string arg0 = gnuplot, arg1 = "--default-settings", arg2 = script.string();
-  char* argv[] = {arg0.data(), arg1.data(), arg2.data(), nullptr};
-  pid_t pid = 0;
-  const int rc = posix_spawn(&pid, gnuplot.c_str(), &actions, nullptr, argv, environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0)
-    throw ExitError(kExitOutputFailed,
-                    fmt::format("cannot run gnuplot '{}': {}", printable(gnuplot), std::strerror(rc)));
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR)
-      throw ExitError(kExitOutputFailed, fmt::format("waiting for gnuplot failed: {}", std::strerror(errno)));
-  }
-  return status;
-}
-
-// Moves a drawn file to its place: a rename when on the same file system, else a copy under a
-// temporary name beside the target and a rename, so the target is never half written.
-void publish(const fs::path& from, const std::string& to) {
-  std::error_code ec;
-  fs::rename(from, to, ec);
-  if (!ec) return;
-  if (ec != std::errc::cross_device_link)
-    throw ExitError(kExitOutputFailed, fmt::format("cannot write figure '{}': {}", printable(to), ec.message()));
-  const std::string partial = fmt::format("{}.partial-{}", to, ::getpid());
-  fs::copy_file(from, partial, fs::copy_options::overwrite_existing, ec);
-  if (!ec) fs::rename(partial, to, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(partial, ignored);
-    throw ExitError(kExitOutputFailed, fmt::format("cannot write figure '{}': {}", printable(to), ec.message()));
-  }
-}
-
-}  // namespace
-
-std::string find_gnuplot() {
-  const char* env = std::getenv("HEXATWIST_GNUPLOT");
-  const std::string name = env != nullptr && *env != '\0' ? env : "gnuplot";
-  if (name.find('/') != std::string::npos) return is_executable_file(name) ? name : std::string();
-  const char* path = std::getenv("PATH");
-  std::string_view dirs = path != nullptr ? path : "/usr/local/bin:/usr/bin:/bin";
-  for (;;) {
-    const auto colon = dirs.find(':');
-    std::string dir(dirs.substr(0, colon));
-    if (dir.empty()) dir = ".";
-    const std::string candidate = dir + "/" + name;
-    if (is_executable_file(candidate)) return candidate;
-    if (colon == std::string_view::npos) return {};
-    dirs.remove_prefix(colon + 1);
-  }
 }
 
 std::vector<std::size_t> drawn_points(std::span<const double> x, std::span<const double> y) {
@@ -627,101 +490,6 @@ std::vector<std::size_t> drawn_points(std::span<const double> x, std::span<const
     keep.erase(std::unique(keep.begin() + static_cast<std::ptrdiff_t>(before), keep.end()), keep.end());
   }
   return keep;
-}
-
-void write_figures(const std::vector<Figure>& figures) {
-  if (figures.empty()) return;
-  const std::string gnuplot = find_gnuplot();
-  if (gnuplot.empty()) {
-    const char* env = std::getenv("HEXATWIST_GNUPLOT");
-    throw ExitError(kExitOutputFailed,
-                    env != nullptr && *env != '\0'
-                        ? fmt::format("gnuplot not found at HEXATWIST_GNUPLOT='{}'; run scripts/setup.sh or install "
-                                      "gnuplot-nox",
-                                      printable(env))
-                        : std::string("gnuplot not found; run scripts/setup.sh or install gnuplot-nox"));
-  }
-  std::set<std::string> stems;
-  for (const Figure& fig : figures) {
-    check_output_directory(fig.stem);
-    if (!stems.insert(fig.stem).second)
-      throw ExitError(kExitOutputFailed,
-                      fmt::format("two figures would both be written to '{}.png'", printable(fig.stem)));
-    for (const Panel& panel : fig.panels)
-      if (panel.map && (panel.map->u.empty() || panel.map->v.empty() ||
-                        panel.map->values.size() != panel.map->u.size() * panel.map->v.size()))
-        throw ExitError(kExitOutputFailed,
-                        fmt::format("figure '{}': colour map '{}' has {} values for {} x {} cells", printable(fig.stem),
-                                    printable(panel.map->label), panel.map->values.size(), panel.map->u.size(),
-                                    panel.map->v.size()));
-    for (const Panel& panel : fig.panels)
-      for (const Series& s : panel.series)
-        if (s.x.size() != s.y.size())
-          throw ExitError(kExitOutputFailed,
-                          fmt::format("figure '{}': series '{}' has {} x values but {} y values", printable(fig.stem),
-                                      printable(s.label), s.x.size(), s.y.size()));
-  }
-
-  const ScratchDir scratch;
-  const Script script = build_script(figures, scratch.path());
-  const fs::path script_path = scratch.path() / "figures.gp";
-  const fs::path err_path = scratch.path() / "gnuplot.err";
-  {
-    std::ofstream out(script_path, std::ios::binary);
-    out.write(script.text.data(), static_cast<std::streamsize>(script.text.size()));
-    out.close();
-    if (!out)
-      throw ExitError(kExitOutputFailed,
-                      fmt::format("cannot write gnuplot script '{}'", printable(script_path.string())));
-  }
-
-  const int status = run_gnuplot(gnuplot, script_path, err_path);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    const auto [message, line] = first_error(read_text(err_path));
-    // The figure whose commands hold the failing line.
-    std::string where;
-    if (line > 0) {
-      std::size_t offset = 0;
-      for (std::size_t l = 1; l < line && offset != std::string::npos; ++l) {
-        offset = script.text.find('\n', offset);
-        if (offset != std::string::npos) ++offset;
-      }
-      const auto it = std::upper_bound(script.figure_start.begin(), script.figure_start.end(), offset);
-      if (it != script.figure_start.begin())
-        where = fmt::format(" drawing '{}'",
-                            printable(figures[static_cast<std::size_t>(it - script.figure_start.begin() - 1)].stem));
-    }
-    const std::string how = WIFEXITED(status) ? fmt::format("exit status {}", WEXITSTATUS(status))
-                                              : fmt::format("signal {}", WIFSIGNALED(status) ? WTERMSIG(status) : 0);
-    throw ExitError(kExitOutputFailed, fmt::format("gnuplot failed{} ({}){}{}", where, how, message.empty() ? "" : ": ",
-                                                   printable(message)));
-  }
-
-  // Every file drawn before any is put in place.
-  for (std::size_t f = 0; f < figures.size(); ++f) {
-    for (const char* ext : {"png", "svg"}) {
-      const fs::path drawn = scratch.path() / fmt::format("f{}.{}", f, ext);
-      std::error_code ec;
-      const auto size = fs::file_size(drawn, ec);
-      if (ec || size == 0)
-        throw ExitError(kExitOutputFailed,
-                        fmt::format("gnuplot did not write figure '{}.{}'", printable(figures[f].stem), ext));
-    }
-  }
-  // A failure half way removes the figures already put in place: all of them or none.
-  std::vector<std::string> published;
-  try {
-    for (std::size_t f = 0; f < figures.size(); ++f)
-      for (const char* ext : {"png", "svg"}) {
-        const std::string to = fmt::format("{}.{}", figures[f].stem, ext);
-        publish(scratch.path() / fmt::format("f{}.{}", f, ext), to);
-        published.push_back(to);
-      }
-  } catch (...) {
-    std::error_code ignored;
-    for (const std::string& p : published) fs::remove(p, ignored);
-    throw;
-  }
 }
 
 }  // namespace hexatwist::cli

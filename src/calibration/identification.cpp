@@ -415,8 +415,7 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
     const SignFit& chosen = out.fits[out.twist_sign > 0 ? 0 : 1];
     const SignFit& rejected = out.fits[out.twist_sign > 0 ? 1 : 0];
     out.sign_separation = 2.0 * (rejected.cost - chosen.cost) / (out.sigma * out.sigma);
-    if (rejected.status == Status::Ok && !rejected.lead_at_bound &&
-        !(out.sign_separation >= options.sign_separation_min))
+    if (rejected.status == Status::Ok && !(out.sign_separation >= options.sign_separation_min))
       return fail(Status::SignUndecided,
                   fmt::format("the two thread senses fit the data equally well (cost ratio {:.4g}, difference {:.3g} "
                               "noise variances, {:g} needed): the twist sign and lead are not decided",

@@ -83,6 +83,81 @@ Column find_column(const detail::CsvReader& r, const detail::CsvLine& line, cons
   return {name, *found, 1.0, cells[*found].text};
 }
 
+// The columns a log is read by: time, x, y, z and the target (if any).
+struct LogColumns {
+  Column time;
+  std::array<Column, 3> xyz;
+  std::optional<Column> target;
+
+  // A cell's column as messages name it: as the format does for those read, else the header's.
+  std::string_view name(std::size_t c, const std::vector<detail::CsvCell>& header) const {
+    if (target && c == target->index) return target->name;
+    if (c == time.index) return time.name;
+    for (const Column& a : xyz)
+      if (c == a.index) return a.name;
+    return header[c].text;
+  }
+};
+
+LogColumns find_columns(const detail::CsvReader& r, const detail::CsvLine& head,
+                        const std::vector<detail::CsvCell>& header, const PointLogFormat& format) {
+  LogColumns cols;
+  // The time column: seconds (or ms by suffix), or a bare sample index.
+  std::optional<Suffix> suffix;
+  cols.time = format.indexed ? find_column(r, head, header, format.time_column, {}, suffix)
+                             : find_column(r, head, header, format.time_column, kTimeSuffixes, suffix);
+  cols.time.to_si = suffix ? suffix->to_si : 1.0;
+  // x, y, z: the length unit from the suffix or the format; both given must agree.
+  const std::array<const std::string*, 3> names{&format.x_column, &format.y_column, &format.z_column};
+  for (std::size_t a = 0; a < 3; ++a) {
+    Column& c = cols.xyz[a];
+    c = find_column(r, head, header, *names[a], kLengthSuffixes, suffix);
+    const std::size_t at = header[c.index].offset;
+    if (suffix && format.length_unit > 0.0 && suffix->to_si != format.length_unit)
+      r.fail(head.number, head.text, at, c.name,
+             fmt::format("'{}' is in {} but the units were given as {}", detail::printable(c.header, 40),
+                         unit_name(suffix->to_si), unit_name(format.length_unit)));
+    if (!suffix && !(format.length_unit > 0.0))
+      r.fail(head.number, head.text, at, c.name,
+             fmt::format("units missing: '{}' has no unit suffix (_mm or _m) and no length unit was given (mm or m)",
+                         detail::printable(c.header, 40)));
+    c.to_si = suffix ? suffix->to_si : format.length_unit;
+  }
+  // The target column, if any: named by the format, or a header cell `target`.
+  if (!format.target_column.empty()) {
+    cols.target = find_column(r, head, header, format.target_column, {}, suffix);
+  } else {
+    for (std::size_t c = 0; c < header.size(); ++c)
+      if (same_ignoring_case(header[c].text, "target")) cols.target = Column{"target", c, 1.0, header[c].text};
+  }
+  return cols;
+}
+
+// The target of a row (a new name is appended to log.target_names, with its first point in
+// `last_of_target`).
+int row_target(const detail::CsvReader& r, const detail::CsvLine& line, const detail::CsvCell& cell,
+               const Column& column, PointLog& log, std::vector<std::size_t>& last_of_target) {
+  if (cell.text.empty())
+    r.fail(line.number, line.text, cell.offset, column.name, "empty; expected the name of the target measured");
+  const auto it = std::find(log.target_names.begin(), log.target_names.end(), cell.text);
+  if (it != log.target_names.end()) return static_cast<int>(it - log.target_names.begin());
+  if (log.target_names.size() == kMaxTargets)
+    r.fail(line.number, line.text, cell.offset, column.name,
+           fmt::format("a {}th target '{}'; a log may carry at most {}", kMaxTargets + 1,
+                       detail::printable(cell.text, 40), kMaxTargets));
+  log.target_names.emplace_back(cell.text);
+  last_of_target.push_back(log.stamps.size());
+  return static_cast<int>(log.target_names.size()) - 1;
+}
+
+// The 1-based character column of a byte offset in a UTF-8 line.
+int character_column(std::string_view text, std::size_t offset) {
+  int col = 1;
+  for (std::size_t i = 0; i < offset; ++i)
+    if ((static_cast<unsigned char>(text[i]) & 0xC0) != 0x80) ++col;
+  return col;
+}
+
 }  // namespace
 
 PointLog parse_point_log(std::string_view text, std::string_view source, const PointLogFormat& format) {
@@ -96,59 +171,21 @@ PointLog parse_point_log(std::string_view text, std::string_view source, const P
                        format.x_column, format.y_column, format.z_column, kMinLogPoints));
   const detail::CsvLine& head = lines[0];
   const std::vector<detail::CsvCell> header = detail::split_csv(head.text);
-
-  // The time column: seconds (or ms by suffix), or a bare sample index.
-  std::optional<Suffix> suffix;
-  Column time = format.indexed ? find_column(r, head, header, format.time_column, {}, suffix)
-                               : find_column(r, head, header, format.time_column, kTimeSuffixes, suffix);
-  time.to_si = suffix ? suffix->to_si : 1.0;
-  // x, y, z: the length unit from the suffix or the format; both given must agree.
-  std::array<Column, 3> xyz;
-  const std::array<const std::string*, 3> names{&format.x_column, &format.y_column, &format.z_column};
-  for (std::size_t a = 0; a < 3; ++a) {
-    xyz[a] = find_column(r, head, header, *names[a], kLengthSuffixes, suffix);
-    const std::size_t at = header[xyz[a].index].offset;
-    if (suffix && format.length_unit > 0.0 && suffix->to_si != format.length_unit)
-      r.fail(head.number, head.text, at, xyz[a].name,
-             fmt::format("'{}' is in {} but the units were given as {}", detail::printable(xyz[a].header, 40),
-                         unit_name(suffix->to_si), unit_name(format.length_unit)));
-    if (!suffix && !(format.length_unit > 0.0))
-      r.fail(head.number, head.text, at, xyz[a].name,
-             fmt::format("units missing: '{}' has no unit suffix (_mm or _m) and no length unit was given (mm or m)",
-                         detail::printable(xyz[a].header, 40)));
-    xyz[a].to_si = suffix ? suffix->to_si : format.length_unit;
-  }
-
-  // The target column, if any: named by the format, or a header cell `target`.
-  std::optional<Column> target;
-  if (!format.target_column.empty()) {
-    target = find_column(r, head, header, format.target_column, {}, suffix);
-  } else {
-    for (std::size_t c = 0; c < header.size(); ++c)
-      if (same_ignoring_case(header[c].text, "target")) target = Column{"target", c, 1.0, header[c].text};
-  }
-
-  // A cell's column as messages name it: as the format does for the four read, else the header's.
-  const auto column_name = [&](std::size_t c) -> std::string_view {
-    if (target && c == target->index) return target->name;
-    if (c == time.index) return time.name;
-    for (const Column& a : xyz)
-      if (c == a.index) return a.name;
-    return header[c].text;
-  };
+  const LogColumns cols = find_columns(r, head, header, format);
+  const Column& time = cols.time;
 
   PointLog log;
   log.source = std::string(source);
   log.indexed = format.indexed;
   std::vector<std::size_t> last_of_target;  // per target: its last point
-  if (!target) log.target_names = {"A"};
+  if (!cols.target) log.target_names = {"A"};
   for (std::size_t k = 1; k < lines.size(); ++k) {
     const detail::CsvLine& line = lines[k];
     const std::vector<detail::CsvCell> cells = detail::split_csv(line.text);
     if (cells.size() != header.size()) {
       const bool more = cells.size() > header.size();
       r.fail(line.number, line.text, more ? cells[header.size()].offset : line.text.size(),
-             column_name(more ? header.size() - 1 : cells.size()),
+             cols.name(more ? header.size() - 1 : cells.size(), header),
              fmt::format("{}; the row has {} cells, the header on line {} has {}",
                          more ? fmt::format("extra cell '{}'", detail::printable(cells[header.size()].text, 40))
                               : std::string("missing"),
@@ -161,43 +198,27 @@ PointLog parse_point_log(std::string_view text, std::string_view source, const P
              fmt::format("expected a whole sample index, got '{}'", detail::printable(tc.text, 40)));
     Vector3d p;
     for (std::size_t a = 0; a < 3; ++a)
-      p[static_cast<int>(a)] = r.number(line, cells[xyz[a].index], xyz[a].name, xyz[a].to_si);
+      p[static_cast<int>(a)] = r.number(line, cells[cols.xyz[a].index], cols.xyz[a].name, cols.xyz[a].to_si);
     int t = 0;
-    if (target) {
-      const detail::CsvCell& cell = cells[target->index];
-      if (cell.text.empty())
-        r.fail(line.number, line.text, cell.offset, target->name, "empty; expected the name of the target measured");
-      const auto it = std::find(log.target_names.begin(), log.target_names.end(), cell.text);
-      t = static_cast<int>(it - log.target_names.begin());
-      if (it == log.target_names.end()) {
-        if (log.target_names.size() == kMaxTargets)
-          r.fail(line.number, line.text, cell.offset, target->name,
-                 fmt::format("a {}th target '{}'; a log may carry at most {}", kMaxTargets + 1,
-                             detail::printable(cell.text, 40), kMaxTargets));
-        log.target_names.emplace_back(cell.text);
-        last_of_target.push_back(log.stamps.size());
-      }
-    } else if (last_of_target.empty()) {
+    if (cols.target)
+      t = row_target(r, line, cells[cols.target->index], *cols.target, log, last_of_target);
+    else if (last_of_target.empty())
       last_of_target.push_back(0);
-    }
     // Times increase per target (a tracker may measure several targets at one instant).
     const std::size_t previous = last_of_target[static_cast<std::size_t>(t)];
+    const char* per_target = cols.target ? " per target" : "";
     if (previous < log.stamps.size() && !(stamp > log.stamps[previous]))
       r.fail(line.number, line.text, tc.offset, time.name,
-             format.indexed
-                 ? fmt::format("index {} is not after {} on line {}; indices must be strictly increasing{}", stamp,
-                               log.stamps[previous], log.lines[previous], target ? " per target" : "")
-                 : fmt::format("time {} s is not after {} s on line {}; times must be strictly increasing{}", stamp,
-                               log.stamps[previous], log.lines[previous], target ? " per target" : ""));
+             format.indexed ? fmt::format("index {} is not after {} on line {}; indices must be strictly increasing{}",
+                                          stamp, log.stamps[previous], log.lines[previous], per_target)
+                            : fmt::format("time {} s is not after {} s on line {}; times must be strictly increasing{}",
+                                          stamp, log.stamps[previous], log.lines[previous], per_target));
     last_of_target[static_cast<std::size_t>(t)] = log.stamps.size();
     log.targets.push_back(t);
     log.stamps.push_back(stamp);
     log.points_T.push_back(p);
     log.lines.push_back(line.number);
-    int col = 1;
-    for (std::size_t i = 0; i < tc.offset; ++i)
-      if ((static_cast<unsigned char>(line.text[i]) & 0xC0) != 0x80) ++col;
-    log.stamp_columns.push_back(col);
+    log.stamp_columns.push_back(character_column(line.text, tc.offset));
   }
   if (log.stamps.size() < kMinLogPoints)
     r.fail(lines.back().number, lines.back().text, 0, format.time_column,

@@ -332,3 +332,39 @@ def test_sample_configuration_runs_headless():
         assert "twist [deg]" in r.stdout
     finally:
         harness.clean_stale()
+
+
+def ini_values(ini, key):
+    """Every `key = value` of the INI, in order, as text (the exact digits LinuxCNC reads)."""
+    return [line.split("=", 1)[1].strip() for line in ini.splitlines() if line.split("=", 1)[0].strip() == key]
+
+
+def test_a_calibrated_configuration_keeps_the_machines_home_and_runs_unchanged():
+    """The calibration contract (README "Identification"): a platform identified from a tracker
+    log of a synthetic platform with every error (joint centres off by up to 1 mm, lead +2 %,
+    zero offsets, the observation point) gives a configuration whose INI keeps every HOME value and
+    joint speed of the one the log was recorded with; LinuxCNC runs it unchanged, and its joints
+    are `hexatwist ik`'s compensated commands of the corrected configuration."""
+    work = os.path.join(OUT, "calibrated")
+    os.makedirs(work, exist_ok=True)
+    log = os.path.join(work, "stations.csv")
+    corrected = os.path.join(work, "identified.yaml")
+    cli("synth", "--stations", "30", "--station-seed", "5", "--joint-errors-mm", "1", "--lead-error-pct", "2",
+        "--offsets-mm", "0.5", "--point-offset-mm", "1,-1,2", "--seed", "4", "--out", log)
+    cli("identify", "--points", log, "--stations", "30", "--station-seed", "5", "--no-figures", "--out", corrected)
+    nominal_ini, ini = cli("linuxcnc").stdout, ini_for(corrected)
+    for key in ("HOME", "HOME_OFFSET", "MAX_VELOCITY"):
+        assert ini_values(harness.faster(nominal_ini), key) == ini_values(ini, key), key
+    # The corrected platform differs from the nominal one: its commands do (by the joints' errors).
+    limits = axis_limits(ini)
+    poses = random_inside(random.Random(3), limits, 0.5, corrected, count=6)
+    nominal_cmd = [1000.0 * leg["command_compensated"] for leg in ik(poses[0])["legs"]]
+    corrected_cmd = [1000.0 * leg["command_compensated"] for leg in ik(poses[0], corrected)["legs"]]
+    assert max(abs(a - b) for a, b in zip(nominal_cmd, corrected_cmd)) > 0.05
+    steps = [{"home": True}] + [{"mdi": g0(world)} for world in poses]
+    run = harness.run(ini, {"steps": steps, "pins": PINS}, timeout=120, keep_dir=os.path.join(work, "run"))
+    assert run.results and len(run.results) == len(steps), run.log[-3000:]
+    assert all(r["done"] and not r["errors"] for r in run.results), run.results
+    worst_joint, worst_pose = check_pose_steps(run, corrected)
+    print("calibrated configuration: worst joint difference %.3g mm, worst FK pose difference %.3g" %
+          (worst_joint, worst_pose))
