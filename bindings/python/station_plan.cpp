@@ -23,7 +23,8 @@ py::dict quality_dict(const StationsQuality& q) {
   d["sd_geometric"] = q.sd_geometric;
   d["condition"] = q.condition;
   d["path"] = q.path;
-  py::array_t<double> cov({static_cast<py::ssize_t>(q.covariance.rows()), static_cast<py::ssize_t>(q.covariance.cols())});
+  py::array_t<double> cov(
+      {static_cast<py::ssize_t>(q.covariance.rows()), static_cast<py::ssize_t>(q.covariance.cols())});
   auto v = cov.mutable_unchecked<2>();
   for (Eigen::Index r = 0; r < q.covariance.rows(); ++r)
     for (Eigen::Index c = 0; c < q.covariance.cols(); ++c) v(r, c) = q.covariance(r, c);
@@ -86,10 +87,10 @@ py::dict plan_stations_py(const py::object& config_src, int count, std::uint64_t
 }  // namespace
 
 void expose_station_plan(py::module_& m) {
-  m.def("_plan_stations", &plan_stations_py, py::arg("config") = py::none(), py::arg("count") = 20,
-        py::arg("seed") = 1, py::arg("strategy") = "compensated", py::arg("translation") = 0.25,
-        py::arg("rotation") = deg2rad(15.0), py::arg("candidates") = 3000, py::arg("calibration") = "geometry",
-        py::arg("noise") = 10e-6, py::arg("points_per_station") = 75, py::arg("accuracy_poses") = 1000);
+  m.def("_plan_stations", &plan_stations_py, py::arg("config") = py::none(), py::arg("count") = 20, py::arg("seed") = 1,
+        py::arg("strategy") = "compensated", py::arg("translation") = 0.25, py::arg("rotation") = deg2rad(15.0),
+        py::arg("candidates") = 3000, py::arg("calibration") = "geometry", py::arg("noise") = 10e-6,
+        py::arg("points_per_station") = 75, py::arg("accuracy_poses") = 1000);
 }
 
 }  // namespace hexatwist::python
