@@ -7,7 +7,6 @@
 namespace hexatwist::python {
 
 std::pair<std::string, std::string> read_yaml_source(const py::object& path_or_text);
-Config python_config(const py::object& src);
 
 std::vector<int> targets_of(const py::object& targets, std::size_t n);
 
@@ -65,7 +64,8 @@ py::dict run_dict(const Trajectory& tr) {
 
 py::dict stations_run(const py::object& config_src, int count, std::uint64_t seed, const std::string& strategy,
                       double translation, double rotation, const py::object& stations) {
-  const Config config = python_config(config_src);
+  const auto rig = rig_of(config_src);
+  const Config& config = *rig->config;
   StationsSpec spec;
   spec.count = count;
   spec.seed = seed;
@@ -104,7 +104,8 @@ TimedPoses timed(const py::array& t, const py::array& poses) {
 }
 
 py::dict measured_test(const py::object& config_src, const std::string& test) {
-  const Config config = python_config(config_src);
+  const auto rig = rig_of(config_src);
+  const Config& config = *rig->config;
   for (const StudyTest& st : seed_tests(config.study)) {
     if (st.name != test) continue;
     double end = 0.0;
@@ -163,7 +164,7 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
   d["points"] = pts;
   d["targets"] = tg;
   d["index"] = py::cast(set.points);
-  d["poses"] = set.poses;
+  d["stations"] = set.poses;
   return d;
 }
 
@@ -172,10 +173,10 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
 void expose_measurement(py::module_& m) {
   m.def("_read_point_log", &point_log, py::arg("path_or_text"), py::arg("time_column") = "t",
         py::arg("length_unit") = 0.0, py::arg("indexed") = false, py::arg("target_column") = "");
-  m.def("_stations_run", &stations_run, py::arg("config") = py::none(), py::arg("count") = 40, py::arg("seed") = 1,
+  m.def("_stations_run", &stations_run, py::arg("rig") = py::none(), py::arg("count") = 40, py::arg("seed") = 1,
         py::arg("strategy") = "compensated", py::arg("translation") = 0.25, py::arg("rotation") = deg2rad(15.0),
         py::arg("stations") = py::none());
-  m.def("_measured_test", &measured_test, py::arg("config") = py::none(), py::arg("test") = "Rz");
+  m.def("_measured_test", &measured_test, py::arg("rig") = py::none(), py::arg("test") = "Rz");
   m.def("_observations_at_rest", &observations, py::arg("model"), py::arg("t"), py::arg("poses"), py::arg("stamps"),
         py::arg("points"), py::arg("targets") = py::none(), py::arg("time_offset") = 0.0,
         py::arg("strategy") = "compensated", py::arg("settle") = 0.25);

@@ -21,7 +21,7 @@ py::object violation_of(const EnvelopeViolation& v) {
   if (v.check == EnvelopeCheck::None) return py::none();
   py::dict d;
   d["check"] = std::string(to_string(v.check));
-  d["leg"] = v.leg;
+  d["leg"] = leg_number(v.leg);
   d["index"] = v.index;
   d["time"] = v.time;
   d["value"] = v.value;
@@ -142,7 +142,7 @@ py::dict size_motors_py(const py::object& config_src, const py::object& csv, con
   summary["status"] = std::string(to_string(status));
   summary["failed_index"] = s.failed_index;
   summary["failed_time"] = s.failed_time;
-  summary["limit_leg"] = s.limit.leg;
+  summary["limit_leg"] = leg_number(s.limit.leg);
   summary["limit_value"] = s.limit.value;
   summary["limit_bound"] = s.limit.bound;
   summary["samples"] = n;
@@ -182,7 +182,7 @@ py::dict size_motors_py(const py::object& config_src, const py::object& csv, con
 }  // namespace
 
 void expose_motor_sizing(py::module_& m) {
-  m.def("_size_motors", &size_motors_py, py::arg("config") = py::none(), py::arg("trajectory") = py::none(),
+  m.def("_size_motors", &size_motors_py, py::arg("rig") = py::none(), py::arg("trajectory") = py::none(),
         py::arg("times") = py::none(), py::arg("poses") = py::none(), py::arg("dt") = py::none(), py::arg("t0") = 0.0,
         py::arg("envelope_points") = 64);
   py::list names;

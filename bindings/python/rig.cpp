@@ -55,8 +55,6 @@ std::shared_ptr<const PyRig> rig_of(const py::handle& src) {
   return rig_from_source(py::reinterpret_borrow<py::object>(src));
 }
 
-Config python_config(const py::object& src) { return *rig_of(src)->config; }
-
 PlatformSource platform_of(const py::handle& src) {
   PlatformSource p;
   if (py::isinstance<Model>(src)) {
@@ -87,10 +85,15 @@ Vector3d vector3(const py::handle& obj, const char* name) {
 py::dict limit_dict(const LimitReport& r) {
   py::dict d;
   d["status"] = std::string(to_string(r.status));
-  d["leg"] = r.leg;
+  d["leg"] = leg_number(r.leg);
   d["value"] = r.value;
   d["bound"] = r.bound;
   return d;
+}
+
+std::string limit_text(const LimitReport& r) {
+  return (r.leg >= 0 ? "leg " + std::to_string(leg_number(r.leg)) + ", " : std::string()) + "value " +
+         std::to_string(r.value) + ", bound " + std::to_string(r.bound);
 }
 
 void expose_rig(py::module_& m) {
