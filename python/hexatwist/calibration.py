@@ -17,6 +17,7 @@ from . import _hexatwist as _core
 from ._hexatwist import Model
 from .core import ArrayLike, FloatArray, Int32Array, IntArray, Result, _fields
 from .dynamics import RigLike
+from .kinematics import Strategy
 
 __all__ = [
     "read_point_log", "measured_test", "stations_run", "observations_at_rest", "identify", "register_points",
@@ -294,7 +295,7 @@ def measured_test(rig: RigLike = None, test: Literal["Lz", "Lx", "Rz", "Ry"] = "
 
 
 def stations_run(rig: RigLike = None, count: int = 40, seed: int = 1,
-                 strategy: Literal["compensated", "conventional"] = "compensated", translation: float = 0.25,
+                 strategy: Strategy = "compensated", translation: float = 0.25,
                  rotation: float = float(np.radians(15.0)), stations: ArrayLike | None = None) -> StationsRun:
     """A calibration run (stations.hpp): home, ``count`` random stations within +-``translation`` [m] and
     +-``rotation`` [rad] inside every limit (the same seed gives the command line's ``--stations N
@@ -304,7 +305,7 @@ def stations_run(rig: RigLike = None, count: int = 40, seed: int = 1,
 
 def observations_at_rest(model: Model, t: ArrayLike, poses: ArrayLike, stamps: ArrayLike, points: ArrayLike,
                          targets: ArrayLike | None = None, time_offset: float = 0.0,
-                         strategy: Literal["compensated", "conventional"] = "compensated",
+                         strategy: Strategy = "compensated",
                          settle: float = 0.25) -> Observations:
     """The log points (``stamps`` (K,) [s], ``points`` (K, 3) [m, T], ``targets``) taken while the
     commanded run (``t`` (T,) [s], ``poses`` (T, 6)) had been still for ``settle`` [s], each with the

@@ -23,7 +23,8 @@ from ._hexatwist import BLOCK, Model
 from .core import ArrayLike, FloatArray, Int8Array, Int32Array, PerPose, Result
 
 __all__ = [
-    "BLOCK", "COORDINATES", "Model", "Limits", "inverse_kinematics", "twist", "length_error", "commands",
+    "BLOCK", "COORDINATES", "Strategy", "LengthKind", "Model", "Limits", "inverse_kinematics", "twist", "length_error", "platform_points",
+    "commands",
     "motor_command", "forward", "FkTracker", "forward_kinematics_tracked", "Stream", "axis_range",
     "InverseKinematics", "LegLengths", "Twist", "Commands", "ForwardKinematics", "TrackedForwardKinematics",
     "StreamCommand", "LimitReport", "AxisRange",
@@ -33,7 +34,9 @@ COORDINATES = ("x", "y", "z", "roll", "pitch", "yaw")
 """The six pose coordinates in their order: x, y, z [m], roll, pitch, yaw [rad]."""
 
 Strategy = Literal["compensated", "conventional"]
+"""The motor-side commands: "compensated" (Eq. 12, the twist taken out) or "conventional" (the twist ignored)."""
 LengthKind = Literal["motor", "geometric"]
+"""Leg lengths as the motors see them ("motor": the twist included) or joint to joint ("geometric")."""
 
 
 class Limits(TypedDict):
@@ -205,14 +208,14 @@ def inverse_kinematics(model: Model, poses: ArrayLike, lengths_only: bool = Fals
     returns :class:`LegLengths`, the same lengths and statuses bit for bit, with the poses across the
     SIMD lanes (the library's leg_lengths_batch): a fraction of the time."""
     if lengths_only:
-        return LegLengths(**_core._ik(model, poses, True))
-    return InverseKinematics(**_core._ik(model, poses, False))
+        return LegLengths._of(_core._ik(model, poses, True))
+    return InverseKinematics._of(_core._ik(model, poses, False))
 
 
 def twist(model: Model, poses: ArrayLike) -> Twist:
     """Twist (the passive rotation of each rod relative to its housing about the leg axis) relative to
     home, and the length error it causes, Eq. (10), of (N, 6) poses [m, rad] (theory §3)."""
-    return Twist(**_core._twist(model, poses))
+    return Twist._of(_core._twist(model, poses))
 
 
 def length_error(model: Model, poses: ArrayLike) -> FloatArray:
@@ -221,11 +224,19 @@ def length_error(model: Model, poses: ArrayLike) -> FloatArray:
     return twist(model, poses).length_error
 
 
+def platform_points(model: Model, poses: ArrayLike, point: ArrayLike | None = None) -> FloatArray:
+    """Where a point of the platform is in the base frame at each of (N, 6) poses: (N, 3) [m, B] (the
+    library's platform_point_B). ``point`` [m, P]: None for the observation point A. This is where the
+    platform puts the point for the poses that :func:`forward` finds; its distance to the point at the
+    commanded poses is the observation error."""
+    return _core._platform_points(model, poses, point)
+
+
 def commands(model: Model, poses: ArrayLike, strategy: Strategy = "compensated") -> Commands:
     """Motor-side commands for (N, 6) poses [m, rad], every limit checked (the library's
     motor_commands_batch, each pose bit for bit motor_commands' result). ``strategy``: "compensated"
     (Eq. 12: IK length - offset - twist_gain * twist) or "conventional" (the twist ignored)."""
-    return Commands(**_core._commands(model, poses, strategy))
+    return Commands._of(_core._commands(model, poses, strategy))
 
 
 def motor_command(model: Model, pose: ArrayLike, strategy: Strategy = "compensated") -> FloatArray:
@@ -244,7 +255,7 @@ def forward(model: Model, lengths: ArrayLike, kind: LengthKind = "motor", guess:
     ``BLOCK`` rows starts at home, then from the previous solution: the same numbers on any number of
     threads or Dask chunks that are multiples of BLOCK); a (6,) pose starts every row there, an (N, 6)
     array each row at its own. ``tolerance`` [m] on the length residual."""
-    return ForwardKinematics(**_core._forward(model, lengths, kind, guess, max_iterations, tolerance))
+    return ForwardKinematics._of(_core._forward(model, lengths, kind, guess, max_iterations, tolerance))
 
 
 class FkTracker(_core.FkTracker):
@@ -257,7 +268,7 @@ class FkTracker(_core.FkTracker):
 
     def track(self, lengths: ArrayLike, max_iterations: int = 30, tolerance: float = 1e-12) -> TrackedForwardKinematics:
         """Solves (N, 6) or (6,) leg lengths [m] in order (GIL released)."""
-        return TrackedForwardKinematics(**self._track(lengths, max_iterations, tolerance))
+        return TrackedForwardKinematics._of(self._track(lengths, max_iterations, tolerance))
 
 
 def forward_kinematics_tracked(model: Model, lengths: ArrayLike, kind: LengthKind = "motor",
@@ -278,7 +289,7 @@ class Stream(_core.Stream):
 
     def pose(self, pose: ArrayLike) -> StreamCommand:
         """One input pose [x, y, z m, roll, pitch, yaw rad]: the command to send and why."""
-        return StreamCommand(**self._pose(pose))
+        return StreamCommand._of(self._pose(pose))
 
 
 def axis_range(model: Model, coordinate: Union[int, str], strategy: Strategy = "compensated", *,

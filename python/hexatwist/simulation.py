@@ -13,6 +13,7 @@ from . import _hexatwist as _core
 from ._hexatwist import MAX_TRAJECTORY_SAMPLES
 from .core import ArrayLike, FloatArray, Result, _fields
 from .dynamics import RigLike
+from .kinematics import Strategy
 
 __all__ = [
     "MAX_TRAJECTORY_SAMPLES", "simulate", "study", "study_trajectory", "TimeSeries", "Simulation",
@@ -150,7 +151,7 @@ def _series(d: dict[str, Any]) -> TimeSeries:
 
 
 def simulate(rig: RigLike = None, test: TestName | None = None, poses: ArrayLike | None = None,
-             strategy: Literal["compensated", "conventional"] = "compensated", twist_in_plant: bool = True) -> Simulation:
+             strategy: Strategy = "compensated", twist_in_plant: bool = True) -> Simulation:
     """Closed-loop simulation under the six servo loops (simulation.hpp) of one of the paper's tests
     (``test``: Lz, Lx, Rz, Ry; Rz when neither is given) or of ``poses`` (T, 6) [m, rad], one per control
     period (at most ``MAX_TRAJECTORY_SAMPLES``); both is an InputError. ``twist_in_plant=False``: a
