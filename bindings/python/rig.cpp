@@ -50,8 +50,16 @@ py::dict leg_body(const LegBodySpec& b) {
 
 }  // namespace
 
+// Refuses what is neither a Rig nor what builds one (a Model has no drives, no load, no rates).
+void check_source(const py::handle& src, const char* expected) {
+  if (src.is_none() || py::isinstance<py::str>(src) || py::isinstance(src, py::module_::import("os").attr("PathLike")))
+    return;
+  raise_input(std::string(expected) + ", got " + std::string(py::str(py::type::of(src).attr("__name__"))));
+}
+
 std::shared_ptr<const PyRig> rig_of(const py::handle& src) {
   if (py::isinstance<PyRig>(src)) return src.cast<std::shared_ptr<PyRig>>();
+  check_source(src, "rig: expected a Rig, YAML text, a path or None (the seed)");
   return rig_from_source(py::reinterpret_borrow<py::object>(src));
 }
 
@@ -62,6 +70,8 @@ PlatformSource platform_of(const py::handle& src) {
     p.source = "model";
     return p;
   }
+  if (!py::isinstance<PyRig>(src))
+    check_source(src, "platform: expected a Model, a Rig, YAML text, a path or None (the seed)");
   const std::shared_ptr<const PyRig> rig = rig_of(src);
   p.model = std::shared_ptr<const Model>(rig, &rig->config->rig.model());
   p.study = rig->config->study;

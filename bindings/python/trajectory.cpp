@@ -30,20 +30,22 @@ MotionLimits limits_of(double velocity, double acceleration, double jerk) {
   return MotionLimits{velocity, acceleration, jerk};
 }
 
-// The library's Error of a bad argument as InputError (its message names the field).
+// The library's Error of a bad argument as InputError, after the function's name (its message names
+// the field or the sample).
 template <class F>
-Trajectory checked(F&& make) {
+Trajectory checked(const char* function, F&& make) {
   try {
     return make();
   } catch (const Error& e) {
-    raise_input(e.what());
+    raise_input(std::string(function) + ": " + e.what());
   }
 }
 
 py::dict sweep_py(int coordinate, double amplitude, double velocity, double acceleration, double jerk, double dwell,
                   double dt) {
-  return trajectory_dict(checked(
-      [&] { return sweep_trajectory(coordinate, amplitude, limits_of(velocity, acceleration, jerk), dwell, dt); }));
+  return trajectory_dict(checked("sweep_trajectory", [&] {
+    return sweep_trajectory(coordinate, amplitude, limits_of(velocity, acceleration, jerk), dwell, dt);
+  }));
 }
 
 py::dict waypoints_py(const py::object& waypoints_in, double velocity, double acceleration, double jerk, double dwell,
@@ -51,8 +53,9 @@ py::dict waypoints_py(const py::object& waypoints_in, double velocity, double ac
   const Rows6 rows = rows6(waypoints_in, "waypoints", false);
   std::vector<Vector6d> waypoints(rows.rows);
   for (std::size_t i = 0; i < rows.rows; ++i) waypoints[i] = Eigen::Map<const Vector6d>(rows.data + 6 * i);
-  return trajectory_dict(
-      checked([&] { return waypoint_trajectory(waypoints, limits_of(velocity, acceleration, jerk), dwell, dt); }));
+  return trajectory_dict(checked("waypoint_trajectory", [&] {
+    return waypoint_trajectory(waypoints, limits_of(velocity, acceleration, jerk), dwell, dt);
+  }));
 }
 
 py::dict timed_dict(const TimedPoses& tp) {
@@ -88,7 +91,7 @@ py::dict resample_py(const py::object& times, const py::object& poses_in, double
   tp.t.assign(t.data(), t.data() + q.rows);
   tp.poses.resize(q.rows);
   for (std::size_t i = 0; i < q.rows; ++i) tp.poses[i] = pose_row(q.data, i);
-  return trajectory_dict(checked([&] { return resample(tp, dt); }));
+  return trajectory_dict(checked("resample", [&] { return resample(tp, dt); }));
 }
 
 }  // namespace

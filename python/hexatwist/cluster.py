@@ -10,7 +10,7 @@ from typing import IO, Any, Mapping
 
 import numpy as np
 
-from .distributed import tolerance_on, workspace_map_on, workspace_volume_on
+from .distributed import _tolerance_on, _workspace_map_on, _workspace_volume_on
 
 
 def _write_arrays(out: IO[str], prefix: str, values: Mapping[str, Any]) -> None:
@@ -48,17 +48,17 @@ def main(argv: list[str] | None = None) -> int:
         config = request.get("config")
         if request["job"] == "tolerance":
             poses = np.asarray(request["poses"], dtype=np.float64) if "poses" in request else None
-            chunk, _ = tolerance_on(client, config, poses, request["workspace"], request["sigmas"], request["seed"],
+            chunk, _ = _tolerance_on(client, config, poses, request["workspace"], request["sigmas"], request["seed"],
                                     request["platforms"], request.get("calibration", "none"), True,
                                     request.get("chunk"), linear=False)
             _write_arrays(out, "", chunk)
         elif request["job"] == "workspace":
             model = hexatwist.Rig(config).model
-            volume = workspace_volume_on(client, model, request["orientation"], request["cell"], request["refine"],
+            volume = _workspace_volume_on(client, model, request["orientation"], request["cell"], request["refine"],
                                          request["step"], request["tolerance"], "compensated", request.get("chunk"))
             _write_arrays(out, "volume.", {k: volume[k] for k in ("volume", "coarse_volume", "error", "columns")})
             grid = request.get("map_grid")
-            rows, _ = workspace_map_on(client, model, request["orientation"], None, None, None, grid, None, None,
+            rows, _ = _workspace_map_on(client, model, request["orientation"], None, None, None, grid, None, None,
                                        "compensated", request.get("map_chunk"))
             _write_arrays(out, "map.", rows)  # the library's values: legs as 0-based indices
         else:

@@ -184,7 +184,7 @@ class LimitMargin(Result):
     share: float
     """Smallest share of its range left (1 far, 0 on the limit) [-]."""
     pose: int
-    """The pose where (0-based)."""
+    """The pose where: an index into the evaluated poses (:class:`DesignEvaluation`)."""
 
 
 @dataclass(frozen=True)
@@ -200,7 +200,9 @@ class Margins(Result):
 
 @dataclass(frozen=True)
 class DesignEvaluation(Result):
-    """A configuration over the required workspace."""
+    """A configuration over the required workspace. The poses it evaluates are home, then the required
+    poses the nominal platform reaches, in their order: ``twist_pose`` and the margins' ``pose`` index
+    that list (0 is home)."""
 
     poses: int
     """Poses evaluated."""
@@ -211,7 +213,7 @@ class DesignEvaluation(Result):
     twist_leg: int
     """Its leg, 1 to 6."""
     twist_pose: int
-    """Its pose (0-based)."""
+    """Its pose, an index into the evaluated poses (0: home)."""
     max_length_error: float
     """[m]"""
     max_lead_sensitivity: float
@@ -346,7 +348,7 @@ def workspace_volume(model: Model, orientation: ArrayLike = (0.0, 0.0, 0.0), *, 
     difference to the grid twice as coarse. With a dask ``client`` the cells are computed on the
     workers (``chunk`` cells a task) and only their sums come back."""
     if client is not None:
-        return _volume(_distributed.workspace_volume_on(client, model, orientation, cell, refine, step, tolerance,
+        return _volume(_distributed._workspace_volume_on(client, model, orientation, cell, refine, step, tolerance,
                                                         strategy, chunk))
     return _volume(_core._workspace_volume(model, orientation, cell, refine, step, tolerance, strategy,
                                            get_num_threads()))
@@ -398,7 +400,7 @@ def workspace_map(model: Model, orientation: ArrayLike = (0.0, 0.0, 0.0), plane:
     rows a task): the same arrays, bit for bit."""
     g = None if grid is None else dict(grid)
     if client is not None:
-        rows, g = _distributed.workspace_map_on(client, model, orientation, plane, offset, spacing, g, step, tolerance,
+        rows, g = _distributed._workspace_map_on(client, model, orientation, plane, offset, spacing, g, step, tolerance,
                                                 strategy, chunk)
         return _map(rows, g)
     if g is None:
@@ -447,7 +449,7 @@ def tolerance(platform: PlatformLike = None, poses: ArrayLike | None = None, *, 
     w = _workspace_spec(workspace)
     sig = {k: float(v) for k, v in (sigmas or {}).items()}
     if client is not None:
-        chunk_result, linear = _distributed.tolerance_on(client, platform, poses, w, sig, int(seed), int(platforms),
+        chunk_result, linear = _distributed._tolerance_on(client, platform, poses, w, sig, int(seed), int(platforms),
                                                          calibration, bool(linear_worst), chunk)
     else:
         threads = get_num_threads()

@@ -32,23 +32,21 @@ import math
 import os
 from collections.abc import Iterable, Mapping
 from concurrent.futures import ThreadPoolExecutor
-from typing import TYPE_CHECKING, Any, Literal, TypeVar, overload
+from types import ModuleType
+from typing import Any, Literal, TypeVar, overload
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from types import ModuleType
-
-    from ._hexatwist import Model
-    from .core import ArrayLike, FloatArray, Result
-    from .kinematics import Commands, ForwardKinematics, InverseKinematics, LegLengths, Twist
-    from .simulation import Simulation
+from ._hexatwist import Model
+from .core import ArrayLike, FloatArray, Result
+from .kinematics import Commands, ForwardKinematics, InverseKinematics, LegLengths, Twist
+from .simulation import Simulation
 
 __all__ = ["map_batch", "map_simulations"]
 
 _BATCH = ("inverse_kinematics", "twist", "commands", "forward")
 
-R = TypeVar("R", bound="Result")
+R = TypeVar("R", bound=Result)
 
 
 def _hexatwist() -> ModuleType:
@@ -182,7 +180,7 @@ def _volume_task(model: Model, grid: dict[str, Any], step: float, tolerance: flo
     return _hexatwist()._core._volume_cells(model, grid, step, tolerance, strategy, first, count)
 
 
-def workspace_volume_on(client: Any, model: Model, orientation: ArrayLike, cell: float, refine: int, step: float,
+def _workspace_volume_on(client: Any, model: Model, orientation: ArrayLike, cell: float, refine: int, step: float,
                         tolerance: float, strategy: str, chunk: int | None) -> dict[str, Any]:
     """hexatwist.workspace_volume on the workers: the grid (bounds arithmetic) here, its cells there,
     ``chunk`` cells a task (default: the grid in about 32 tasks of whole rows), their sums here."""
@@ -210,7 +208,7 @@ def _map_task(model: Model, orientation: tuple[float, ...], grid: dict[str, Any]
     return _hexatwist()._core._workspace_map_rows(model, orientation, grid, strategy, first, count)
 
 
-def workspace_map_on(client: Any, model: Model, orientation: ArrayLike, plane: str | None, offset: float | None,
+def _workspace_map_on(client: Any, model: Model, orientation: ArrayLike, plane: str | None, offset: float | None,
                      spacing: float | None, grid: dict[str, Any] | None, step: float | None, tolerance: float | None,
                      strategy: str, chunk: int | None) -> tuple[dict[str, Any], dict[str, Any]]:
     """hexatwist.workspace_map on the workers: the grid (a slice search) in one task, then ``chunk``
@@ -245,7 +243,7 @@ def _linear_task(platform: Any, poses: Any, workspace: dict[str, Any], sigmas: d
 _HISTOGRAMS = ("histogram_point", "histogram_position", "histogram_orientation")
 
 
-def merge_tolerance_chunks(parts: list[dict[str, Any]]) -> dict[str, Any]:
+def _merge_tolerance_chunks(parts: list[dict[str, Any]]) -> dict[str, Any]:
     """One study from its chunks (in platform order): the per-platform arrays concatenated, the
     histograms added (integer counts)."""
     parts = sorted(parts, key=lambda p: int(p["first"]))
@@ -260,7 +258,7 @@ def merge_tolerance_chunks(parts: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def tolerance_on(client: Any, platform: Any, poses: ArrayLike | None, workspace: dict[str, Any],
+def _tolerance_on(client: Any, platform: Any, poses: ArrayLike | None, workspace: dict[str, Any],
                  sigmas: dict[str, float], seed: int, platforms: int, calibration: str, linear_worst: bool,
                  chunk: int | None, linear: bool = True) -> tuple[dict[str, Any], Any]:
     """hexatwist.tolerance on the workers: ``chunk`` platforms a task (default: about 64 tasks), each
@@ -276,5 +274,5 @@ def tolerance_on(client: Any, platform: Any, poses: ArrayLike | None, workspace:
     futures = [client.submit(_tolerance_task, platform_future, poses_future, workspace, sigmas, seed, first, count,
                              calibration, linear_worst, pure=False)
                for first, count in _ranges(platforms, chunk)]
-    return merge_tolerance_chunks(client.gather(futures)), \
+    return _merge_tolerance_chunks(client.gather(futures)), \
         linear_future.result() if linear_future is not None else None

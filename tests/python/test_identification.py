@@ -54,6 +54,9 @@ def test_python_and_the_cli_reach_the_same_estimate_bit_for_bit(log_dir):
     np.testing.assert_array_equal([p["sd"] for p in cli["estimate"]["parameters"]], py.sd)
     assert cli["sigma"] == py.sigma and cli["fit_test"]["z"] == py.fit_z
     assert cli["accuracy"]["median"] == py.accuracy["median"]
+    # The worst stations, numbered from 1 in both.
+    assert [(w["station"], w["points"], w["statistic"]) for w in cli["worst_stations"]] == \
+        [(w.station, w.count, w.statistic) for w in py.worst] and len(py.worst) > 0
     # The corrected configuration: Python writes the CLI's file, byte for byte but for the header
     # comments and the name, which the CLI gives the log's file name.
     def body(text):
