@@ -19,15 +19,6 @@ RequiredWorkspaceSpec required_spec(bool tests, int test_samples, int random, do
   return s;
 }
 
-py::array_t<double> pose_rows(const std::vector<Pose>& poses) {
-  py::array_t<double> a({poses.size(), std::size_t{6}});
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    const Vector6d q = poses[k].to_vector();
-    std::copy(q.data(), q.data() + 6, a.mutable_data() + 6 * k);
-  }
-  return a;
-}
-
 std::vector<Pose> poses_of(const py::handle& obj) {
   const Rows6 r = rows6(obj, "poses", false);
   std::vector<Pose> poses(r.rows);

@@ -78,6 +78,14 @@ void parallel_blocks(std::size_t n, F&& body, std::size_t block = kBlock) {
   for (auto& t : threads) t.join();
 }
 
+/// Poses [m, rad] as a new (N, 6) array.
+py::array_t<double> pose_rows(const std::vector<Pose>& poses);
+/// A trajectory's sample times (T,) [s] and poses (T, 6) [m, rad]: a dict {"t", "poses"}.
+py::dict trajectory_arrays(const Trajectory& trajectory);
+/// Poses (T, 6) at times (T,) [s], as a file gives them; InputError naming `times_name` unless there is
+/// one time per pose.
+TimedPoses timed_poses_of(const py::object& times, const char* times_name, const py::object& poses);
+
 /// The pose of row `i` of an (N, 6) row-major array.
 inline Pose pose_row(const double* data, std::size_t i) noexcept {
   const double* q = data + 6 * i;

@@ -48,20 +48,6 @@ py::dict point_log(const py::object& src, const std::string& time_column, double
   return d;
 }
 
-py::dict run_dict(const Trajectory& tr) {
-  py::array_t<double> t(static_cast<py::ssize_t>(tr.poses.size()));
-  py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
-  for (std::size_t k = 0; k < tr.poses.size(); ++k) {
-    t.mutable_data()[k] = tr.time(k);
-    const Vector6d v = tr.poses[k].to_vector();
-    std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
-  }
-  py::dict d;
-  d["t"] = t;
-  d["poses"] = q;
-  return d;
-}
-
 py::dict stations_run(const py::object& config_src, int count, std::uint64_t seed, const std::string& strategy,
                       double translation, double rotation, const py::object& stations) {
   const auto rig = rig_of(config_src);
@@ -80,27 +66,12 @@ py::dict stations_run(const py::object& config_src, int count, std::uint64_t see
   }
   const Trajectory tr =
       station_run(config.rig.model(), strategy_from(strategy), poses, spec, config.rig.control_period());
-  py::dict d = run_dict(tr);
+  py::dict d = trajectory_arrays(tr);
   py::array_t<double> st({static_cast<py::ssize_t>(poses.size()), py::ssize_t{6}});
   for (std::size_t i = 0; i < poses.size(); ++i)
     std::copy(poses[i].data(), poses[i].data() + 6, st.mutable_data() + 6 * i);
   d["stations"] = st;
   return d;
-}
-
-TimedPoses timed(const py::array& t, const py::array& poses) {
-  std::size_t nt = 0, np = 0;
-  if (!py::isinstance<py::array_t<double>>(t) || t.ndim() != 1) raise_input("t: expected a 1-D float64 array [s]");
-  const Rows6 q = rows6(poses, "poses", false);
-  nt = static_cast<std::size_t>(t.shape(0));
-  np = q.rows;
-  if (nt != np) raise_input("t and poses: expected as many times as poses");
-  py::array tc = py::module_::import("numpy").attr("ascontiguousarray")(t);
-  TimedPoses tp;
-  tp.t.assign(static_cast<const double*>(tc.data()), static_cast<const double*>(tc.data()) + nt);
-  tp.poses.resize(np);
-  for (std::size_t i = 0; i < np; ++i) tp.poses[i] = pose_row(q.data, i);
-  return tp;
 }
 
 py::dict measured_test(const py::object& config_src, const std::string& test) {
@@ -111,16 +82,7 @@ py::dict measured_test(const py::object& config_src, const std::string& test) {
     double end = 0.0;
     const Trajectory tr =
         measured_test_trajectory(config.study, st, CalibrationSpec{}, config.rig.control_period(), end);
-    py::array_t<double> t(static_cast<py::ssize_t>(tr.poses.size()));
-    py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
-    for (std::size_t k = 0; k < tr.poses.size(); ++k) {
-      t.mutable_data()[k] = tr.time(k);
-      const Vector6d v = tr.poses[k].to_vector();
-      std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
-    }
-    py::dict d;
-    d["t"] = t;
-    d["poses"] = q;
+    py::dict d = trajectory_arrays(tr);
     d["calibration_end"] = end;
     return d;
   }
@@ -130,7 +92,7 @@ py::dict measured_test(const py::object& config_src, const std::string& test) {
 py::dict observations(const Model& model, const py::array& t, const py::array& poses, const py::array& stamps,
                       const py::array& points, const py::object& targets, double time_offset,
                       const std::string& strategy, double settle) {
-  const TimedPoses tp = timed(t, poses);
+  const TimedPoses tp = timed_poses_of(t, "t", poses);
   PointLog log;
   std::size_t ns = 0, np = 0;
   if (!py::isinstance<py::array_t<double>>(stamps) || stamps.ndim() != 1)

@@ -175,12 +175,7 @@ void expose_simulation(py::module_& m) {
         const auto rig = rig_of(c);
         const Config& config = *rig->config;
         const Trajectory tr = trajectory_of(config, py::str(test), py::none());
-        py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
-        for (std::size_t k = 0; k < tr.poses.size(); ++k) {
-          const Vector6d v = tr.poses[k].to_vector();
-          std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
-        }
-        return q;
+        return pose_rows(tr.poses);
       },
       py::arg("rig") = py::none(), py::arg("test") = "Rz",
       "Poses (T, 6) [m, rad] of one of the paper's tests (Lz, Lx, Rz, Ry), one per control period.");

@@ -8,20 +8,44 @@ namespace hexatwist::python {
 
 std::pair<std::string, std::string> read_yaml_source(const py::object& path_or_text);
 
+py::array_t<double> pose_rows(const std::vector<Pose>& poses) {
+  py::array_t<double> a({poses.size(), std::size_t{6}});
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    const Vector6d q = poses[k].to_vector();
+    std::copy(q.data(), q.data() + 6, a.mutable_data() + 6 * k);
+  }
+  return a;
+}
+
+py::dict trajectory_arrays(const Trajectory& trajectory) {
+  py::array_t<double> t(static_cast<py::ssize_t>(trajectory.poses.size()));
+  for (std::size_t k = 0; k < trajectory.poses.size(); ++k) t.mutable_data()[k] = trajectory.time(k);
+  py::dict d;
+  d["t"] = t;
+  d["poses"] = pose_rows(trajectory.poses);
+  return d;
+}
+
+TimedPoses timed_poses_of(const py::object& times, const char* times_name, const py::object& poses) {
+  const Rows6 q = rows6(poses, "poses", false);
+  py::array_t<double> t;
+  try {
+    t = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(times);
+  } catch (...) {
+  }
+  if (!t || t.ndim() != 1 || static_cast<std::size_t>(t.shape(0)) != q.rows)
+    raise_input(std::string(times_name) + ": expected a 1-D array of as many times as poses [s]");
+  TimedPoses tp;
+  tp.t.assign(t.data(), t.data() + q.rows);
+  tp.poses.resize(q.rows);
+  for (std::size_t i = 0; i < q.rows; ++i) tp.poses[i] = pose_row(q.data, i);
+  return tp;
+}
+
 namespace {
 
 py::dict trajectory_dict(const Trajectory& tr) {
-  const std::size_t n = tr.poses.size();
-  py::array_t<double> t(static_cast<py::ssize_t>(n));
-  py::array_t<double> q({static_cast<py::ssize_t>(n), py::ssize_t{6}});
-  for (std::size_t k = 0; k < n; ++k) {
-    t.mutable_data()[k] = tr.time(k);
-    const Vector6d v = tr.poses[k].to_vector();
-    std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
-  }
-  py::dict d;
-  d["t"] = t;
-  d["poses"] = q;
+  py::dict d = trajectory_arrays(tr);
   d["dt"] = tr.dt;
   return d;
 }
@@ -59,15 +83,9 @@ py::dict waypoints_py(const py::object& waypoints_in, double velocity, double ac
 }
 
 py::dict timed_dict(const TimedPoses& tp) {
-  const std::size_t n = tp.poses.size();
-  py::array_t<double> q({static_cast<py::ssize_t>(n), py::ssize_t{6}});
-  for (std::size_t k = 0; k < n; ++k) {
-    const Vector6d v = tp.poses[k].to_vector();
-    std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
-  }
   py::dict d;
   d["t"] = py::array_t<double>(static_cast<py::ssize_t>(tp.t.size()), tp.t.data());
-  d["poses"] = q;
+  d["poses"] = pose_rows(tp.poses);
   d["lines"] = py::array_t<int>(static_cast<py::ssize_t>(tp.lines.size()), tp.lines.data());
   return d;
 }
@@ -78,19 +96,8 @@ py::dict read_py(const py::object& path_or_text) {
   return timed_dict(parse_trajectory_csv(text, source));
 }
 
-py::dict resample_py(const py::object& times, const py::object& poses_in, double dt) {
-  const Rows6 q = rows6(poses_in, "poses", false);
-  py::array_t<double> t;
-  try {
-    t = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(times);
-  } catch (...) {
-  }
-  if (!t || t.ndim() != 1 || static_cast<std::size_t>(t.shape(0)) != q.rows)
-    raise_input("t: expected a 1-D array of as many times as poses [s]");
-  TimedPoses tp;
-  tp.t.assign(t.data(), t.data() + q.rows);
-  tp.poses.resize(q.rows);
-  for (std::size_t i = 0; i < q.rows; ++i) tp.poses[i] = pose_row(q.data, i);
+py::dict resample_py(const py::object& times, const py::object& poses, double dt) {
+  const TimedPoses tp = timed_poses_of(times, "t", poses);
   return trajectory_dict(checked("resample", [&] { return resample(tp, dt); }));
 }
 
