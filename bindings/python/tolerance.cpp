@@ -183,10 +183,10 @@ py::dict summary_py(const py::dict& chunk, std::size_t poses, const py::object& 
 }  // namespace
 
 void expose_tolerance(py::module_& m) {
-  m.def("_tolerance_chunk", &chunk_py, py::arg("config"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
+  m.def("_tolerance_chunk", &chunk_py, py::arg("platform"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
         py::arg("seed"), py::arg("first"), py::arg("count"), py::arg("calibration") = "none",
         py::arg("linear_worst") = true, py::arg("threads") = 1);
-  m.def("_tolerance_linear", &linear_py, py::arg("config"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
+  m.def("_tolerance_linear", &linear_py, py::arg("platform"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
         py::arg("threads") = 1);
   m.def("_tolerance_summary", &summary_py, py::arg("chunk"), py::arg("poses"), py::arg("linear"));
   m.attr("HISTOGRAM_BINS") = ErrorHistogram::kBins;

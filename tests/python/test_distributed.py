@@ -6,6 +6,7 @@ import socket
 import subprocess
 import sys
 import time
+from collections.abc import Mapping
 
 import numpy as np
 import pytest
@@ -114,8 +115,8 @@ def test_per_row_keyword_arrays_are_cut_with_the_rows(client, model):
 
 
 def same(a, b):
-    """Equal numbers, NaN equal to NaN, through nested dicts."""
-    if isinstance(a, dict):
+    """Equal numbers, NaN equal to NaN, through nested dicts and typed results."""
+    if isinstance(a, Mapping):
         return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
     if a is None or b is None:  # JSON's null for a number without a value
         return a is None and b is None
