@@ -94,10 +94,7 @@ py::dict chunk_py(const py::object& config, const py::object& poses_in, const py
   o.linear_worst = linear_worst;
   o.threads = threads;
   if (calibration == "perfect") {
-    o.calibration = [](const Model&, const Model& real, std::uint64_t, ModelSpec& controller) {
-      controller = real.spec();
-      return Status::Ok;
-    };
+    o.calibration = perfect_calibration_step();
   } else if (calibration != "none") {
     raise_input("calibration: expected 'none' or 'perfect' (a controller that knows the real platform), got '" +
                 calibration + "'");
