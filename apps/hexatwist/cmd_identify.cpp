@@ -391,13 +391,9 @@ int run_identify(const IdentifyOptions& o) {
                fmt::format("a time shorter than the run ({:g} s): no point can be still for longer [s]",
                            run.test.trajectory.duration()));
   const PointLog log = read_point_log(o.log, format);
-  ObservationSet set;
-  try {
-    set =
-        observations_at_rest(model, run.commanded, log, {o.log.time_offset, o.log.rate}, strategy_of(o.run), o.settle);
-  } catch (const Error& e) {
-    throw ExitError(kExitBadInput, e.what());
-  }
+  // Bad input throws (exit 2, naming the option at fault).
+  const ObservationSet set =
+      observations_at_rest(model, run.commanded, log, {o.log.time_offset, o.log.rate}, strategy_of(o.run), o.settle);
   Identification id;
   const Status status = identify(model, set.observations, id, library_options(o));
   const Report report{o, model, set, log, id, run.test.description};
@@ -452,8 +448,9 @@ int run_identify(const IdentifyOptions& o) {
   }
   std::string text = o.json ? json_report(report, std::string(), true) : text_report(report);
   if (!o.json)
-    text += fmt::format("wrote {}: the corrected configuration (legs form){}\n", o.out,
-                        o.no_figures ? "" : fmt::format(", and the map of its predicted accuracy {}.png/.svg", figure_stem));
+    text += fmt::format(
+        "wrote {}: the corrected configuration (legs form){}\n", o.out,
+        o.no_figures ? "" : fmt::format(", and the map of its predicted accuracy {}.png/.svg", figure_stem));
   files.finish(text);
   return kExitOk;
 }

@@ -71,25 +71,7 @@ int run_measure(const MeasureOptions& o) {
   }
   const PointLog log = read_point_log(o.log, format);
   ReportedMeasurement measured;
-  try {
-    measured.measurement = measure_points(rig.model(), run.commanded, log, mo);
-  } catch (const Error& e) {
-    throw ExitError(kExitBadInput, e.what());
-  }
-  // A point farther from the commanded position than a whole leg is long is not a point of this
-  // run (a typing or export error): its error would be meaningless and swamp the statistics.
-  {
-    const Measurement& mm = measured.measurement;
-    const double absurd = rig.model().spec().limits.length_max;
-    for (std::size_t k = mm.window; k < mm.points.size(); ++k) {
-      const double e = mm.points[k].error_B.norm();
-      if (!(e <= absurd))
-        throw ExitError(kExitBadInput,
-                        fmt::format("--points: {}: line {}: the point is {:.4g} m from where the run puts it, more "
-                                    "than a leg's maximum length ({} m): not a point of this run",
-                                    printable(o.log.points), mm.points[k].line, e, absurd));
-    }
-  }
+  measured.measurement = measure_points(rig.model(), run.commanded, log, mo);  // bad input throws: exit 2
   measured.source = o.log.points;
   measured.strategy = mo.strategy;
   measured.window = window;

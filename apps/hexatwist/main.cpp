@@ -1,6 +1,7 @@
 // hexatwist: twist-aware kinematics of lead-screw Stewart platforms, from the command line.
 // This directory is the only code of the project that reads files and writes to the terminal.
 #include <fmt/format.h>
+#include <algorithm>
 
 #include <cstdio>
 #include <exception>
@@ -79,6 +80,12 @@ int main(int argc, char** argv) {
   } catch (const ExitError& e) {
     print_error("hexatwist: error: ", e.what());
     return e.code();
+  } catch (const hexatwist::ParameterError& e) {
+    // The library names the parameter at fault; the command line names it as its option.
+    std::string option = "--" + e.parameter();
+    std::replace(option.begin(), option.end(), '_', '-');
+    print_error("hexatwist: error: ", fmt::format("{} [{}]", e.what(), option));
+    return kExitBadInput;
   } catch (const hexatwist::Error& e) {
     print_error("hexatwist: error: ", e.what());
     return kExitBadInput;

@@ -141,6 +141,9 @@ void expose_errors(py::module_& m) {
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
+    } catch (const hexatwist::ParameterError& ex) {
+      // The library names the parameter at fault: the keyword argument of the same name.
+      PyErr_SetString(errors().input_error.ptr(), (std::string(ex.what()) + " [" + ex.parameter() + "]").c_str());
     } catch (const hexatwist::Error& ex) {
       PyErr_SetString(errors().config_error.ptr(), ex.what());
     }

@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace hexatwist {
 
@@ -11,6 +12,19 @@ namespace hexatwist {
 class Error : public std::runtime_error {
  public:
   explicit Error(const std::string& message) : std::runtime_error(message) {}
+};
+
+/// An input that is readable but does not fit the rest, blamed on one of the call's parameters:
+/// `parameter` is its name in snake_case ("time_offset", "register_until"), which each front end
+/// turns into its own spelling (the CLI's --time-offset, Python's keyword) when it reports it.
+class ParameterError : public Error {
+ public:
+  ParameterError(const std::string& message, std::string parameter)
+      : Error(message), parameter_(std::move(parameter)) {}
+  [[nodiscard]] const std::string& parameter() const noexcept { return parameter_; }
+
+ private:
+  std::string parameter_;
 };
 
 }  // namespace hexatwist

@@ -30,7 +30,7 @@ enum class Status : int {
                         ///< determinant changed sign)
   InvalidArgument,      ///< an option or argument outside its documented range (check_fk_options, a length <= 0)
   SignUndecided,        ///< an identification: both thread senses explain the measurements about as well
-  ModelMismatch,        ///< an identification: the identified model leaves an error the tracker's noise does not explain
+  ModelMismatch,  ///< an identification: the identified model leaves an error the tracker's noise does not explain
 };
 
 /// The last status: every status is in Ok .. kLastStatus.

@@ -79,9 +79,10 @@ Status pose_sensitivity(const Model& candidate, const ParameterSet& set, const F
                         Eigen::Matrix<double, 6, Eigen::Dynamic>& dx_dtheta) {
   Matrix6d J_f_x;
   if (const Status s = length_jacobian(candidate, fk.legs, LengthKind::Motor, J_f_x); s != Status::Ok) return s;
+  // The twist even where a lead is 0: the lead's own column is the twist (a sense that drove the
+  // lead to its bound still has a determined lead column there).
   Vector6d dtheta = Vector6d::Zero();
-  if (candidate.has_twist())
-    if (const Status s = twist(candidate, fk.legs, dtheta); s != Status::Ok) return s;
+  if (const Status s = twist(candidate, fk.legs, dtheta); s != Status::Ok) return s;
   const int n = set.platform_size();
   Eigen::Matrix<double, 6, Eigen::Dynamic> df(6, n);
   df.setZero();

@@ -38,11 +38,13 @@ std::vector<double> aligned_times(const TimedPoses& commanded, const PointLog& l
   const double front = commanded.t.front(), back = commanded.t.back();
   for (std::size_t k = 0; k < times.size(); ++k) {
     if (!(times[k] >= front - kTimeTolerance && times[k] <= back + kTimeTolerance))
-      throw Error(fmt::format(
-          "{}: point at t = {} s{} is outside the commanded trajectory's time span [{}, {}] s (check the "
-          "time offset{})",
-          point_location(log, k), times[k], log.indexed ? fmt::format(" (index {})", log.stamps[k]) : std::string(),
-          front, back, log.indexed ? " and the sample rate" : ""));
+      throw ParameterError(
+          fmt::format("{}: point at t = {} s{} is outside the commanded trajectory's time span [{}, {}] s (check the "
+                      "time offset{})",
+                      point_location(log, k), times[k],
+                      log.indexed ? fmt::format(" (index {})", log.stamps[k]) : std::string(), front, back,
+                      log.indexed ? " and the sample rate" : ""),
+          "time_offset");
     times[k] = std::clamp(times[k], front, back);
   }
   return times;
@@ -50,7 +52,8 @@ std::vector<double> aligned_times(const TimedPoses& commanded, const PointLog& l
 
 void check_settle(const std::string& source, double settle) {
   if (!(std::isfinite(settle) && settle >= 0.0))
-    throw Error(fmt::format("{}: settle time: expected a finite number >= 0 s, got {}", source, settle));
+    throw ParameterError(fmt::format("{}: settle time: expected a finite number >= 0 s, got {}", source, settle),
+                         "settle");
 }
 
 }  // namespace hexatwist::detail

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include <Eigen/Eigenvalues>
 
@@ -17,6 +18,60 @@ namespace {
 
 // Model points whose spread is below this are at one place [m].
 constexpr double kCoincident = 1e-6;
+
+// The rms distance of points from their mean [m].
+template <class Get, class Range>
+double rms_spread(const Range& range, Get get) {
+  Vector3d mean = Vector3d::Zero();
+  double n = 0.0;
+  for (const auto& x : range) mean += get(x), n += 1.0;
+  if (n == 0.0) return 0.0;
+  mean /= n;
+  double sum = 0.0;
+  for (const auto& x : range) sum += (get(x) - mean).squaredNorm();
+  return std::sqrt(sum / n);
+}
+
+// A registration that cannot bring the log's points onto the model's is of another shape: the
+// log is in other units than its header says, or of another run.
+void check_registration_fit(const std::string& src, const std::string& lines_text, const std::vector<PointPair>& pairs,
+                            const Registration& reg, const MeasurementOptions& options) {
+  const double spread = rms_spread(pairs, [](const PointPair& p) { return p.p_B; });
+  if (reg.rms_residual <= options.max_registration_misfit * spread) return;
+  throw Error(fmt::format(
+      "{}: {}: the log's points do not have the run's shape: the registration leaves {:.4g} mm rms over points that "
+      "spread {:.4g} mm rms (more than {:g} %): a log in other units than its header says (metres labelled _mm?), "
+      "another run's log, or another time offset",
+      src, lines_text, 1e3 * reg.rms_residual, 1e3 * spread, 100.0 * options.max_registration_misfit));
+}
+
+// Evaluated errors the platform cannot have: a point farther off than a leg is long (a typing or
+// export error), or errors comparable to the motion itself (the log of another motion).
+void check_errors_plausible(const Model& model, const PointLog& log, const Measurement& m,
+                            const MeasurementOptions& options) {
+  const double absurd = model.spec().limits.length_max;
+  double sum = 0.0;
+  for (std::size_t k = m.window; k < m.points.size(); ++k) {
+    const double e = m.points[k].error_B.norm();
+    if (!(e <= absurd))
+      throw Error(
+          fmt::format("{}:{}: the point is more than a leg's maximum length ({} m) from where the run puts it "
+                      "({:.4g} m): not a point of this run",
+                      log.source, m.points[k].line, absurd, e));
+    sum += e * e;
+  }
+  const std::size_t evaluated = m.points.size() - m.window;
+  const double rms = std::sqrt(sum / static_cast<double>(evaluated));
+  const auto tail = std::span(m.points).subspan(m.window);
+  const double motion = rms_spread(tail, [](const MeasuredPoint& p) { return p.desired_B; });
+  const double bound = std::max(options.max_error_fraction * motion, options.max_error_floor);
+  if (rms <= bound) return;
+  throw Error(fmt::format(
+      "{}: lines {}-{}: the platform misses the run by {:.4g} mm rms where the observation point moves {:.4g} mm rms "
+      "(at most {:g} % of it, or {:g} mm): the log is of another motion than the run's (another test or trajectory?)",
+      log.source, m.points[m.window].line, m.points.back().line, 1e3 * rms, 1e3 * motion,
+      100.0 * options.max_error_fraction, 1e3 * options.max_error_floor));
+}
 
 }  // namespace
 
@@ -57,13 +112,17 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
     while (m.window < n && times[m.window] <= w.until) ++m.window;
     window_text = fmt::format("the window t <= {} s", w.until);
   }
+  const char* window_parameter = w.first > 0 ? "register_first" : "register_until";
   if (m.window == 0)
-    throw Error(fmt::format("{}: no point in the registration window ({}); the first point is at t = {} s", src,
-                            window_text, times[0]));
+    throw ParameterError(fmt::format("{}: no point in the registration window ({}); the first point is at t = {} s",
+                                     src, window_text, times[0]),
+                         window_parameter);
   const std::string lines_text = fmt::format("lines {}-{}", log.lines[0], log.lines[m.window - 1]);
   if (m.window == n)
-    throw Error(fmt::format("{}: {} ({}) hold every point: no point is left after the registration to evaluate", src,
-                            lines_text, window_text));
+    throw ParameterError(fmt::format("{}: {} ({}) hold every point: no point is left after the registration to "
+                                     "evaluate",
+                                     src, lines_text, window_text),
+                         window_parameter);
   m.window_end = times[m.window - 1];
   check_settle(src, w.settle);
   std::vector<PointPair> pairs;
@@ -78,11 +137,12 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
   const std::string rest_text =
       w.settle > 0.0 ? fmt::format(" at rest (commanded pose unchanged for {} s)", w.settle) : std::string();
   if (used.size() < 3)
-    throw Error(
+    throw ParameterError(
         fmt::format("{}: {}: only {} of the {} points in {} {}{}; registering the tracker frame needs at least "
                     "3 (widen the window, or lower the settle time)",
                     src, lines_text, used.size(), m.window, window_text, used.size() == 1 ? "is" : "are",
-                    rest_text.empty() ? std::string(" usable") : rest_text));
+                    rest_text.empty() ? std::string(" usable") : rest_text),
+        window_parameter);
 
   // Each registration point's model position: where the nominal model puts the observation point
   // for the commands the platform ran (exactly the commanded position with compensation).
@@ -124,6 +184,7 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
         m.registration.condition, options.registration.max_condition));
   }
   if (s != Status::Ok) throw Error(fmt::format("{}: {}: registration failed: {}", src, lines_text, describe(s)));
+  check_registration_fit(src, lines_text, pairs, m.registration, options);
 
   // Errors: every point registered; the statistics over the points after the window.
   std::vector<double> norm, axis[3];
@@ -137,6 +198,7 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
   }
   m.error = error_stats(norm);
   for (int a = 0; a < 3; ++a) m.axes[static_cast<std::size_t>(a)] = error_stats(axis[a]);
+  check_errors_plausible(model, log, m, options);
   return m;
 }
 

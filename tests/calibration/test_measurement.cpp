@@ -336,6 +336,79 @@ TEST(Measurement, BadLogsForTheRunAreOneLineErrors) {
   expect_measure_error(run, log.log, mo, {"no point is left"});
 }
 
+// Errors blamed on an option carry its name, for the CLI's --option and Python's keyword.
+TEST(Measurement, OptionErrorsNameTheirParameter) {
+  const ShortRun run(2, deg2rad(5.0));
+  const SyntheticLog log = synth(run, SynthesisOptions{});
+  const auto parameter_of = [&](const MeasurementOptions& mo) {
+    try {
+      (void)measure_points(run.rig().model(), timed_poses(run.trajectory), log.log, mo);
+    } catch (const ParameterError& e) {
+      return e.parameter();
+    } catch (const Error&) {
+      return std::string("(not a ParameterError)");
+    }
+    return std::string("(no error)");
+  };
+  MeasurementOptions mo;
+  mo.window.until = run.calibration_end;
+  EXPECT_EQ(parameter_of(mo), "(no error)");
+  mo.time.offset = -0.5;
+  EXPECT_EQ(parameter_of(mo), "time_offset");
+  mo.time.offset = 0.0;
+  mo.window.settle = -1.0;
+  EXPECT_EQ(parameter_of(mo), "settle");
+  mo.window.settle = 0.25;
+  mo.window.until = -1.0;
+  EXPECT_EQ(parameter_of(mo), "register_until");
+  mo.window.until = 1e3;
+  EXPECT_EQ(parameter_of(mo), "register_until");
+  mo.window.first = 2;
+  EXPECT_EQ(parameter_of(mo), "register_first");
+}
+
+// A log that is not of this run is refused, not evaluated: its registration misfit or its errors
+// say so, whatever the tracker frame.
+TEST(Measurement, LogsOfAnotherShapeOrMotionAreRefused) {
+  const ShortRun run(2, deg2rad(5.0));
+  SynthesisOptions o;
+  o.seed = 4;
+  const SyntheticLog good = synth(run, o);
+  MeasurementOptions mo;
+  mo.window.until = run.calibration_end;
+  const Measurement m = measure_points(run.rig().model(), timed_poses(run.trajectory), good.log, mo);
+  EXPECT_LT(m.registration.rms_residual, 1e-3);
+
+  // Metres labelled millimetres: every coordinate 1000 times too small.
+  PointLog metres = good.log;
+  for (Vector3d& p : metres.points_T) p *= 1e-3;
+  expect_measure_error(run, metres, mo, {"do not have the run's shape", "metres labelled _mm"});
+
+  // Another motion after the window: half a metre of sway the run does not command.
+  PointLog other = good.log;
+  for (std::size_t k = m.window; k < other.points_T.size(); ++k)
+    other.points_T[k].x() += 0.5 * std::sin(0.01 * static_cast<double>(k));
+  expect_measure_error(run, other, mo, {"misses the run by", "another motion"});
+
+  // One point of another world: 100 m off.
+  PointLog typo = good.log;
+  typo.points_T.back().y() += 100.0;
+  expect_measure_error(run, typo, mo, {":" + std::to_string(typo.lines.back()) + ": the point is", "maximum length"});
+}
+
+// A header whose names carry their units is found by those same names (--columns t_s,x_mm,...).
+TEST(Measurement, ColumnsNamedWithTheirSuffixesAreFound) {
+  PointLogFormat f;
+  f.time_column = "t_s";
+  f.x_column = "x_mm";
+  f.y_column = "y_mm";
+  f.z_column = "z_mm";
+  const PointLog log = parse_point_log("t_s,x_mm,y_mm,z_mm\n0,1,2,3\n0.5,4,5,6\n1,7,8,9\n", "l.csv", f);
+  ASSERT_EQ(log.points_T.size(), 3u);
+  EXPECT_EQ(log.stamps[1], 0.5);
+  EXPECT_LT((log.points_T[2] - Vector3d(0.007, 0.008, 0.009)).norm(), 1e-17);  // 1 ulp per coordinate
+}
+
 TEST(Measurement, SimulatedErrorsAreInterpolatedBetweenTicks) {
   std::vector<SimulationSample> s(3);
   for (int k = 0; k < 3; ++k) {

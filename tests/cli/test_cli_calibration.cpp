@@ -205,106 +205,151 @@ TEST(CliMeasure, TheShippedExampleRecoversItsTruth) {
 
 // ---- identify -----------------------------------------------------------------------------------
 
-// synth of a stations run of a platform with every error identify estimates, then identify: the
-// truth within the issue's bounds, a corrected configuration that loads and explains the log.
+// synth of a stations run of a platform with every error identify estimates (issue 21: joint centres
+// off by up to 1 mm, a 2.5 % longer lead, the other thread hand, offsets, the point, a tracker
+// frame), then identify: the truth within 4 sd, the fit's noise the tracker's, and a corrected
+// configuration that loads to the estimate and keeps the drives' reference (the contract, theory §4).
 TEST(CliIdentify, SynthThenIdentifyRecoversTheTruthAndWritesAConfigThatExplainsTheLog) {
   const std::string log = (temp_dir() / "stations.csv").string();
-  const Outcome s = run({"synth", "--stations", "40", "--station-seed", "3", "--lead-error-pct", "5", "--flip-sign",
-                         "--offsets-mm", "1", "--point-offset-mm", "2,-1.5,3", "--seed", "9", "--out", log});
+  const Outcome s =
+      run({"synth", "--stations", "40", "--station-seed", "3", "--joint-errors-mm", "1", "--lead-error-pct", "2.5",
+           "--flip-sign", "--offsets-mm", "0.5", "--point-offset-mm", "2,-1.5,3", "--seed", "9", "--out", log});
   ASSERT_EQ(s.code, 0) << s.err;
-  const YAML::Node truth = YAML::LoadFile((temp_dir() / "stations.truth.json").string());
+  const YAML::Node real = YAML::LoadFile((temp_dir() / "stations.truth.json").string())["real"];
   const std::string yaml = (temp_dir() / "identified.yaml").string();
-  const Outcome r =
-      run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--out", yaml, "--json"});
+  const Outcome r = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--out", yaml,
+                         "--json", "--no-figures"});
   ASSERT_EQ(r.code, 0) << r.err;
   const YAML::Node j = json(r);
   const YAML::Node e = j["estimate"];
   EXPECT_EQ(j["status"].as<std::string>(), "ok");
+  EXPECT_EQ(j["calibration_model"].as<std::string>(), "geometry");
   EXPECT_EQ(j["lead_effect"].as<std::string>(), "travel");
-  // Measured (40 stations, 3176 points at rest): lead 1.8e-6 relative (sd 0.9e-6), offsets within
-  // 11.9 um (sd 4.4-8.0 um), the point within 2.7 um (sd 1.1-1.5 um). The bounds are the issue's.
-  const double lead = truth["errors"]["lead_real"].as<double>();
-  EXPECT_LT(std::abs(e["lead"].as<double>() / lead - 1.0), 5e-3);
-  EXPECT_LT(std::abs(e["lead"].as<double>() / lead - 1.0), 4 * e["lead_sd"].as<double>() / lead);
-  EXPECT_EQ(e["twist_sign"].as<double>(), truth["errors"]["twist_sign_real"].as<double>());
-  EXPECT_EQ(e["thread"].as<std::string>(), "left");
+  // Every joint coordinate, lead, offset and the point within 4 sd of the truth.
   double worst = 0.0;
-  for (int i = 0; i < 6; ++i)
-    worst =
-        std::max(worst, std::abs(e["length_offsets"][i].as<double>() - truth["errors"]["zero_offset"][i].as<double>()));
-  std::printf("  largest offset error %.3g m\n", worst);
-  EXPECT_LT(worst, 20e-6);
-  EXPECT_NEAR(e["observation_point"][0].as<double>(), 1.2 + 2e-3, 10e-6);
-  EXPECT_NEAR(e["observation_point"][2].as<double>(), 3e-3, 10e-6);
-  EXPECT_NEAR(j["sigma"].as<double>(), 1e-5, 1e-6);
-  EXPECT_GT(j["cost_ratio"].as<double>(), 100.0);
-  EXPECT_GT(j["rms_before"].as<double>(), 1e-3);  // a 5 % lead: centimetres of travel
-  // The corrected configuration loads with exactly the estimate (it cannot be identified again
-  // from this log: the commands the run had came from the nominal model).
+  for (const char* set : {"base_joints", "platform_joints"})
+    for (int i = 0; i < 6; ++i)
+      for (int a = 0; a < 3; ++a) {
+        const double err = e[set][i][a].as<double>() - real[set][i][a].as<double>();
+        const double sd = e[std::string(set) + "_sd"][i][a].as<double>();
+        EXPECT_LT(std::abs(err), 4 * sd) << set << " " << i + 1 << " " << a;
+        worst = std::max(worst, std::abs(err) / sd);
+      }
+  std::printf("  largest joint error %.2f sd\n", worst);
+  const YAML::Node params = e["parameters"];
+  for (std::size_t k = 0; k < params.size(); ++k) {
+    const std::string name = params[k]["name"].as<std::string>();
+    if (name == "lead")
+      EXPECT_LT(std::abs(params[k]["estimate"].as<double>() - real["leads"][0].as<double>()),
+                4 * params[k]["sd"].as<double>());
+    if (name.starts_with("offset "))
+      EXPECT_LT(std::abs(params[k]["estimate"].as<double>() -
+                         real["length_offsets"][std::stoi(name.substr(7)) - 1].as<double>()),
+                4 * params[k]["sd"].as<double>())
+          << name;
+  }
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(e["threads"][i].as<std::string>(), "left");
+  EXPECT_EQ(e["twist_sign"].as<double>(), -1.0);
+  EXPECT_NEAR(e["observation_point"][0].as<double>(), real["targets"][0][0].as<double>(), 100e-6);
+  // The fit's noise is the tracker's (issue 21: within 1.3 times), the test far from its limit.
+  EXPECT_LT(j["noise_ratio"].as<double>(), 1.3);
+  EXPECT_GT(j["noise_ratio"].as<double>(), 0.8);
+  EXPECT_LT(j["fit_test"]["z"].as<double>(), 5.0);
+  EXPECT_GT(j["rms_before"].as<double>(), 1e-3);
+  EXPECT_EQ(j["cross_validation"]["folds"].as<int>(), 5);
+  EXPECT_GT(j["accuracy"]["median"].as<double>(), 0.0);
+  EXPECT_LT(j["accuracy"]["aligned_median"].as<double>(), 15e-6);
+  // The corrected configuration loads with exactly the estimate, and the drives' reference is the
+  // nominal one: the controller's HOME values do not change (hexatwist linuxcnc writes the same).
   const Outcome c = run({"config", "--config", yaml, "--json"});
   ASSERT_EQ(c.code, 0) << c.err;
   const YAML::Node legs = json(c)["legs"];
   for (int i = 0; i < 6; ++i) {
-    EXPECT_EQ(legs[i]["lead"].as<double>(), e["lead"].as<double>());
     EXPECT_EQ(legs[i]["thread"].as<std::string>(), "left");
-    EXPECT_EQ(legs[i]["length_offset"].as<double>(), e["length_offsets"][i].as<double>());
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(legs[i]["base"][a].as<double>(), e["base_joints"][i][a].as<double>());
   }
-  EXPECT_EQ(json(c)["observation_point"][1].as<double>(), e["observation_point"][1].as<double>());
-  EXPECT_NE(read_file(yaml).find("(identified from "), std::string::npos);
+  const std::string text = read_file(yaml);
+  EXPECT_NE(text.find("(identified from "), std::string::npos);
+  EXPECT_NE(text.find("home_commands:"), std::string::npos);
+  EXPECT_NE(text.find("drive_lead: 0.01"), std::string::npos);
+  const auto homes = [&](const std::vector<std::string>& config) {
+    std::vector<std::string> args{"linuxcnc", "--out", (temp_dir() / "machine.ini").string()};
+    args.insert(args.end(), config.begin(), config.end());
+    EXPECT_EQ(run(args).code, 0);
+    std::string found;
+    for (const std::string& line : lines_of(read_file((temp_dir() / "machine.ini").string())))
+      if (line.starts_with("HOME = ") || line.starts_with("HOME_OFFSET = ")) found += line + "\n";
+    return found;
+  };
+  EXPECT_EQ(homes({"--config", yaml}), homes({}));
 }
 
 TEST(CliIdentify, DataThatCannotDetermineTheParametersExitFiveInOneLine) {
-  // The calibration moves and Lz's stations are translations only: the observation point and the
-  // tracker's translation cannot be told apart.
+  // The calibration moves and Lz's stations: too few for the geometry model's 40 parameters; and
+  // for the basic model translations only, so the observation point and the tracker's translation
+  // cannot be told apart.
   const std::string log = (temp_dir() / "lz.csv").string();
   ASSERT_EQ(run({"synth", "--test", "Lz", "--out", log}).code, 0);
   const std::string yaml = (temp_dir() / "lz.yaml").string();
   std::filesystem::remove(yaml);
   expect_error(run({"identify", "--points", log, "--test", "Lz", "--out", yaml}), 5,
-               {"lz.csv: ", "at 8 poses: not identifiable: ", "A x", "translation x", "nothing was written"});
+               {"lz.csv: ", "at 8 stations: not identifiable: ", "stations are needed", "hexatwist stations",
+                "nothing was written"});
+  expect_error(run({"identify", "--points", log, "--test", "Lz", "--model", "basic", "--out", yaml}), 5,
+               {"lz.csv: ", "at 8 stations: not identifiable: ", "A x", "translation x", "nothing was written"});
   EXPECT_FALSE(std::filesystem::exists(yaml));
 }
 
-TEST(CliIdentify, AFitFarNoisierThanTheTrackersScatterAtRestExitsFiveAndWritesNothing) {
+TEST(CliIdentify, AModelThatDoesNotExplainTheDataExitsFiveNamingTheWorstStationAndWritesNothing) {
   // A 5 % lead seen through the twist only (--lead-effect twist) leaves the travel's centimetres
-  // unexplained: the fit's noise is hundreds of times the tracker's 10 um.
+  // unexplained; the basic model on joint errors leaves millimetres: the fit test refuses both.
   const std::string log = (temp_dir() / "lead5.csv").string();
-  ASSERT_EQ(run({"synth", "--stations", "40", "--station-seed", "3", "--lead-error-pct", "5", "--out", log}).code, 0);
+  ASSERT_EQ(run({"synth", "--stations", "40", "--station-seed", "3", "--lead-error-pct", "5", "--joint-errors-mm", "1",
+                 "--out", log})
+                .code,
+            0);
   const std::string yaml = (temp_dir() / "lead5.yaml").string();
   std::filesystem::remove(yaml);
   const Outcome r = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--lead-effect",
                          "twist", "--out", yaml, "--json"});
-  expect_error(
-      r, 5, {"lead5.csv: ", "times the tracker's scatter at rest", "does not explain the data", "nothing was written"});
-  EXPECT_FALSE(std::filesystem::exists(yaml));
-  const YAML::Node j = json(r);
-  EXPECT_EQ(j["status"].as<std::string>(), "failed");
-  EXPECT_NEAR(j["tracker_noise"].as<double>(), 10e-6, 1e-6);
-  EXPECT_TRUE(j["estimate"].IsNull());
-  EXPECT_TRUE(j["corrected_config"].IsNull());
-  EXPECT_GT(j["noise_ratio"].as<double>(), 100.0);  // measured 539
-  // The same log under the right lead model: the fit's noise is the tracker's (measured 1.00).
-  const Outcome ok =
-      run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--out", yaml, "--json"});
-  ASSERT_EQ(ok.code, 0) << ok.err;
-  EXPECT_LT(json(ok)["noise_ratio"].as<double>(), 1.5);
-  EXPECT_GT(json(ok)["noise_ratio"].as<double>(), 0.7);
-}
-
-TEST(CliIdentify, TwoThreadHandsThatFitEquallyWellExitFiveAndWriteNothing) {
-  // 3 mm of tracker noise over 8 stations: the two signs' costs differ by 7 noise variances, 25 needed.
-  const std::string log = (temp_dir() / "tie.csv").string();
-  ASSERT_EQ(run({"synth", "--stations", "8", "--station-seed", "3", "--noise-um", "3000", "--out", log}).code, 0);
-  const std::string yaml = (temp_dir() / "tie.yaml").string();
-  std::filesystem::remove(yaml);
-  const Outcome r =
-      run({"identify", "--points", log, "--stations", "8", "--station-seed", "3", "--out", yaml, "--json"});
   expect_error(r, 5,
-               {"tie.csv: ", "the two thread hands fit the data equally well", "cost ratio 1.0", "not decided",
+               {"lead5.csv: ", "the model does not explain the data", "sigma (at most 5)", "the worst station is",
                 "nothing was written"});
   EXPECT_FALSE(std::filesystem::exists(yaml));
   const YAML::Node j = json(r);
   EXPECT_EQ(j["status"].as<std::string>(), "failed");
+  EXPECT_EQ(j["identification"].as<std::string>(), "model_mismatch");
+  EXPECT_NEAR(j["tracker_noise"].as<double>(), 10e-6, 1e-6);
+  EXPECT_TRUE(j["estimate"].IsNull());
+  EXPECT_TRUE(j["corrected_config"].IsNull());
+  EXPECT_GT(j["fit_test"]["z"].as<double>(), 5.0);
+  EXPECT_GT(j["noise_ratio"].as<double>(), 100.0);
+  EXPECT_GE(j["worst_stations"].size(), 1u);
+  expect_error(
+      run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--model", "basic", "--out", yaml}),
+      5, {"the model does not explain the data", "hint: the joint geometry is off", "--model geometry"});
+  // The same log under the right model: the fit's noise is the tracker's.
+  const Outcome ok = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--out", yaml,
+                          "--json", "--no-figures"});
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  EXPECT_LT(json(ok)["noise_ratio"].as<double>(), 1.3);
+  EXPECT_GT(json(ok)["noise_ratio"].as<double>(), 0.8);
+}
+
+TEST(CliIdentify, TwoThreadSensesThatFitEquallyWellExitFiveAndWriteNothing) {
+  // 3 mm of tracker noise over 10 stations: the two senses' costs differ by a few noise variances, 25 needed.
+  const std::string log = (temp_dir() / "tie.csv").string();
+  ASSERT_EQ(run({"synth", "--stations", "10", "--station-seed", "3", "--noise-um", "3000", "--out", log}).code, 0);
+  const std::string yaml = (temp_dir() / "tie.yaml").string();
+  std::filesystem::remove(yaml);
+  const Outcome r = run({"identify", "--points", log, "--stations", "10", "--station-seed", "3", "--model", "basic",
+                         "--out", yaml, "--json"});
+  expect_error(r, 5,
+               {"tie.csv: ", "the two thread senses fit the data equally well", "not decided", "nothing was written"});
+  EXPECT_FALSE(std::filesystem::exists(yaml));
+  const YAML::Node j = json(r);
+  EXPECT_EQ(j["status"].as<std::string>(), "failed");
+  EXPECT_EQ(j["identification"].as<std::string>(), "sign_undecided");
   EXPECT_TRUE(j["estimate"].IsNull());
   EXPECT_LT(j["cost_ratio"].as<double>(), 1.1);  // the fit's numbers say why; the estimate is refused
   EXPECT_FALSE(j["sigma"].IsNull());
@@ -326,7 +371,7 @@ TEST(CliIdentify, BadRunsAndLogsAreOneLineErrors) {
                     "--stations", "40", "--station-seed", "3"}),
                2, {"five.csv: only 5 of the 5 points are at rest", "at least 6"});
   expect_error(run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--settle", "5"}), 5,
-               {"at rest at 1 pose: not identifiable: ", "coincident"});
+               {"at rest at 1 station: not identifiable: ", "stations are needed"});
   // Stamps out of order; a missing unit; an unknown lead model.
   std::swap(rows[5], rows[6]);
   expect_error(run({"identify", "--points", write_file("swapped.csv", joined(rows)), "--stations", "40"}), 2,
@@ -341,32 +386,35 @@ TEST(CliIdentify, BadRunsAndLogsAreOneLineErrors) {
 TEST(CliIdentify, TheRunWrittenBySynthIdentifiesAsTheStationsDo) {
   // A real platform is driven through the file synth writes; identify then reads it as the run.
   const std::string log = (temp_dir() / "five.csv").string(), file = (temp_dir() / "five-run.csv").string();
-  ASSERT_EQ(
-      run({"synth", "--stations", "8", "--lead-error-pct", "1", "--offsets-mm", "0.5", "--out", log, "--run-out", file})
-          .code,
-      0);
+  ASSERT_EQ(run({"synth", "--stations", "20", "--lead-error-pct", "1", "--offsets-mm", "0.5", "--joint-errors-mm",
+                 "0.5", "--out", log, "--run-out", file})
+                .code,
+            0);
   const std::vector<std::string> rows = lines_of(read_file(file));
   EXPECT_EQ(rows[0], "t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad");
-  const Outcome by_stations =
-      run({"identify", "--points", log, "--stations", "8", "--json", "--out", (temp_dir() / "a.yaml").string()});
-  const Outcome by_file =
-      run({"identify", "--points", log, "--trajectory", file, "--json", "--out", (temp_dir() / "b.yaml").string()});
+  const Outcome by_stations = run({"identify", "--points", log, "--stations", "20", "--json", "--no-figures", "--out",
+                                   (temp_dir() / "a.yaml").string()});
+  const Outcome by_file = run({"identify", "--points", log, "--trajectory", file, "--json", "--no-figures", "--out",
+                               (temp_dir() / "b.yaml").string()});
   ASSERT_EQ(by_stations.code, 0) << by_stations.err;
   ASSERT_EQ(by_file.code, 0) << by_file.err;
   const YAML::Node a = json(by_stations), b = json(by_file);
   // The rests are the same in both up to a tracker sample at the start of a rest (the file's
   // samples are 10 ms apart, and a rest there starts at the first sample that holds it), and so are
   // the estimates, to a small part of their standard deviations.
-  EXPECT_NEAR(a["observations"].as<int>(), b["observations"].as<int>(), 10);
-  EXPECT_EQ(a["poses"].as<int>(), 10);
-  EXPECT_EQ(b["poses"].as<int>(), 10);
-  const YAML::Node ea = a["estimate"], eb = b["estimate"];
-  std::printf("  lead difference %.3g sd\n",
-              std::abs(ea["lead"].as<double>() - eb["lead"].as<double>()) / ea["lead_sd"].as<double>());
-  EXPECT_LT(std::abs(ea["lead"].as<double>() - eb["lead"].as<double>()), 0.2 * ea["lead_sd"].as<double>());
-  for (int i = 0; i < 6; ++i)
-    EXPECT_LT(std::abs(ea["length_offsets"][i].as<double>() - eb["length_offsets"][i].as<double>()),
-              0.2 * ea["length_offsets_sd"][i].as<double>());
+  EXPECT_NEAR(a["observations"].as<int>(), b["observations"].as<int>(), 25);
+  EXPECT_EQ(a["stations"].as<int>(), 22);
+  EXPECT_EQ(b["stations"].as<int>(), 22);
+  const YAML::Node pa = a["estimate"]["parameters"], pb = b["estimate"]["parameters"];
+  ASSERT_EQ(pa.size(), pb.size());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < pa.size(); ++k) {
+    const double d =
+        std::abs(pa[k]["estimate"].as<double>() - pb[k]["estimate"].as<double>()) / pa[k]["sd"].as<double>();
+    worst = std::max(worst, d);
+    EXPECT_LT(d, 0.3) << pa[k]["name"].as<std::string>();
+  }
+  std::printf("  largest difference %.3g sd\n", worst);
 }
 
 TEST(CliIdentify, JsonStatusAgreesWithTheExitCodeWhenTheConfigurationCannotBeWritten) {
@@ -374,8 +422,8 @@ TEST(CliIdentify, JsonStatusAgreesWithTheExitCodeWhenTheConfigurationCannotBeWri
   if (!std::filesystem::exists(log)) {
     ASSERT_EQ(run({"synth", "--stations", "40", "--station-seed", "3", "--out", log}).code, 0);
   }
-  const Outcome r = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--json", "--out",
-                         "/proc/hexatwist-x.yaml"});
+  const Outcome r = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--json",
+                         "--no-figures", "--out", "/proc/hexatwist-x.yaml"});
   expect_error(r, 4, {"hexatwist-x.yaml"});
   const YAML::Node j = json(r);
   EXPECT_EQ(j["status"].as<std::string>(), "failed");
@@ -446,7 +494,7 @@ TEST(CliMeasure, AnAbsurdPointAfterTheWindowIsRefusedNamingItsLine) {
   const std::string bad = write_file("absurd-bad.csv", joined(rows));
   const std::filesystem::path out = temp_dir() / "absurd-out";
   expect_error(run({"measure", "--points", bad, "--trajectory", traj, "--register-until", "8", "--out", out.string()}),
-               2, {"--points", "line 1001", "not a point of this run"});
+               2, {"absurd-bad.csv:1001", "maximum length", "not a point of this run"});
   EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
 }
 

@@ -149,13 +149,13 @@ TEST(CliOutputs, AFailedRunLeavesEveryEarlierFileByteForByte) {
 
 TEST(CliOutputs, AFailedIdentifyLeavesAHandMadeConfigurationAsItWas) {
   const std::string log = (temp_dir() / "keep-stations.csv").string();
-  ASSERT_EQ(run({"synth", "--stations", "12", "--station-seed", "3", "--out", log}).code, 0);
+  ASSERT_EQ(run({"synth", "--stations", "20", "--station-seed", "3", "--out", log}).code, 0);
   const std::string keep = write_file("keep.yaml", "# my own configuration\n" + hexatwist::test::kSymmetricYaml);
-  const Outcome ok = run({"identify", "--points", log, "--stations", "12", "--station-seed", "3", "--out", keep});
+  const Outcome ok = run({"identify", "--points", log, "--stations", "20", "--station-seed", "3", "--out", keep});
   if (ok.code != 0) GTEST_SKIP() << "this log does not identify: " << ok.err;  // the run must reach its write
   std::ofstream(keep) << "# my own configuration\n" << hexatwist::test::kSymmetricYaml;
   expect_error(
-      run_to_full_disk({"identify", "--points", log, "--stations", "12", "--station-seed", "3", "--out", keep}), 4,
+      run_to_full_disk({"identify", "--points", log, "--stations", "20", "--station-seed", "3", "--out", keep}), 4,
       {"standard output"});
   EXPECT_EQ(read_file(keep), "# my own configuration\n" + hexatwist::test::kSymmetricYaml);
 }

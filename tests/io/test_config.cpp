@@ -581,7 +581,6 @@ TEST(Config, RigSectionErrorsNameLineAndField) {
   EXPECT_NE(config_error(test::replace_line(base, 9, "  lead: 0")).find("needs a lead screw"), std::string::npos);
 }
 
-
 // ---- every numeric field of the schema (#22) -------------------------------------------------
 
 // A number's place in a document: the keys (and list indices) from the top.

@@ -40,6 +40,16 @@ struct MeasurementOptions {
   /// the twist's known error for the conventional ones, so that the registration does not absorb it.
   Strategy strategy = Strategy::Compensated;
   RegistrationOptions registration;
+  /// A log whose registration leaves an rms residual above this fraction of the registration
+  /// points' rms spread does not have the run's shape (a log in metres labelled _mm, another
+  /// run's log): refused. A platform that is millimetres off its drawing leaves well under 5 %
+  /// over calibration moves that span decimetres.
+  double max_registration_misfit = 0.2;
+  /// A log whose evaluated errors have an rms above both this fraction of the observation point's
+  /// commanded motion (rms about its mean over the evaluated points) and `max_error_floor` is of
+  /// another motion than the run's (the log of one test measured as another): refused.
+  double max_error_fraction = 0.25;
+  double max_error_floor = 0.01;  ///< [m]
 };
 
 /// One measured point.
@@ -76,7 +86,11 @@ struct Measurement {
 /// line naming the log (and its line and column where one point is at fault) for: a point
 /// outside the trajectory's time span, a registration window with fewer than 3 points at rest or
 /// with no point after it, a commanded pose in the window outside a limit or whose forward
-/// kinematics fails, and a degenerate registration (collinear or coincident points).
+/// kinematics fails, a degenerate registration (collinear or coincident points), and a log that
+/// is not of this run: a registration misfit above `max_registration_misfit`, a point farther from
+/// where the run puts it than the legs' maximum length, or evaluated errors above
+/// `max_error_fraction` of the motion (and `max_error_floor`). Errors blamed on an option are
+/// ParameterError (time_offset, register_until, register_first, settle).
 Measurement measure_points(const Model& model, const TimedPoses& commanded, const PointLog& log,
                            const MeasurementOptions& options);
 
