@@ -37,6 +37,7 @@ struct ToleranceCommandOptions {
   double tracker_noise_um = 10.0;
   int points_per_station = 50;
   std::string calibration_frames = "tracker";
+  std::string station_plan;
   std::string out = "tolerance-out";
   std::string scheduler;
   bool json = false;
@@ -81,18 +82,45 @@ CalibrationChoice calibration_of(const ToleranceCommandOptions& o) {
                o.points_per_station, fmt::format("1 to {} points", kMaxPointsPerStation));
   c.points = o.points_per_station;
   c.frames = o.calibration_frames == "joints" ? CalibratedFrames::Joints : CalibratedFrames::Tracker;
+  if (!o.station_plan.empty()) {
+    if (o.calibration != "none" && o.calibration != "plan")
+      throw ExitError(kExitBadInput, fmt::format("--station-plan: a plan is its own calibration; --calibration is "
+                                                 "'{}' (leave it out, or give plan)",
+                                                 printable(o.calibration)));
+    const std::string text = read_text_file(o.station_plan, "--station-plan", "stations run CSV file", kMaxDataBytes);
+    try {
+      c.plan = run_stations(parse_trajectory_csv(text, o.station_plan));
+    } catch (const Error& e) {
+      throw ExitError(kExitBadInput, fmt::format("--station-plan: {}", e.what()));
+    }
+    if (c.plan.empty())
+      throw ExitError(kExitBadInput,
+                      fmt::format("--station-plan: {} holds no pose for two samples in a row (no station)",
+                                  printable(o.station_plan)));
+    c.name = "plan";
+  }
   return c;
 }
 
-bool tracker_calibration(const ToleranceCommandOptions& o) { return o.calibration.starts_with("stations:"); }
+bool tracker_calibration(const CalibrationChoice& c) { return c.name == "plan" || c.name.starts_with("stations:"); }
 
 void tracker_json(JsonWriter& j, const ToleranceCommandOptions& o, const CalibrationChoice& c) {
-  if (!tracker_calibration(o)) {
+  if (!tracker_calibration(c)) {
     j.null();
     return;
   }
   j.begin_object().field("noise", c.tracker_noise).field("points_per_station", c.points);
-  j.field("frames", o.calibration_frames).end_object();
+  j.field("frames", o.calibration_frames);
+  if (c.name == "plan") {  // the stations read [m, rad from home]
+    j.key("plan").begin_array();
+    for (const Vector6d& q : c.plan) {
+      j.begin_array();
+      for (int k = 0; k < 6; ++k) j.value(q[k]);
+      j.end_array();
+    }
+    j.end_array();
+  }
+  j.end_object();
 }
 
 // The Monte Carlo on the cluster: platforms sampled and evaluated on the workers, their summaries here.
@@ -118,7 +146,7 @@ ToleranceChunk chunk_on_cluster(const ToleranceCommandOptions& o, const Required
   sigmas_json(j, s);
   j.field("seed", o.seed);
   j.field("platforms", o.platforms);
-  j.field("calibration", o.calibration);
+  j.field("calibration", calibration.name);
   j.key("tracker");
   tracker_json(j, o, calibration);
   j.field("timeout", 10);
@@ -165,7 +193,7 @@ std::string summary_json(const Model& model, const ToleranceCommandOptions& o, c
   j.field("platforms", static_cast<std::uint64_t>(sm.platforms));
   j.field("poses", static_cast<std::uint64_t>(sm.poses));
   j.field("seed", o.seed);
-  j.field("calibration", o.calibration);
+  j.field("calibration", calibration.name);
   j.key("tracker");
   tracker_json(j, o, calibration);
   j.field("failures", sm.failures);
@@ -273,8 +301,7 @@ Figure figure(const std::string& stem, const ToleranceChunk& c, const ToleranceL
   Panel worst("Each platform's largest point A error over the workspace", "largest point A error [" + mm + "]",
               "share of platforms [-]");
   worst.series.push_back(sorted_series("Monte Carlo", c.max_point, scale, Series::Style::Solid));
-  worst.series.push_back(
-      sorted_series("linear model, same errors", c.max_point_linear, scale, Series::Style::Dashed));
+  worst.series.push_back(sorted_series("linear model, same errors", c.max_point_linear, scale, Series::Style::Dashed));
   f.panels.push_back(std::move(worst));
   return f;
 }
@@ -287,13 +314,13 @@ std::string row(const char* what, const ErrorQuantiles& mc, const ErrorQuantiles
 
 // Who drives the platforms, for the report.
 std::string controller_text(const ToleranceCommandOptions& o, const CalibrationChoice& c) {
-  if (o.calibration == "none") return "the nominal compensated commands";
-  if (o.calibration == "perfect") return "a perfectly calibrated controller's compensated commands";
+  if (c.name == "none") return "the nominal compensated commands";
+  if (c.name == "perfect") return "a perfectly calibrated controller's compensated commands";
   return fmt::format(
       "the compensated commands of each platform's controller after a tracker calibration ({}; {:g} um noise, {} "
       "points a station; errors in the {} frames)",
-      o.calibration, 1e6 * c.tracker_noise, c.points,
-      o.calibration_frames == "joints" ? "joints' least-squares" : "tracker's");
+      c.name == "plan" ? fmt::format("{} stations of {}", c.plan.size(), printable(o.station_plan)) : c.name,
+      1e6 * c.tracker_noise, c.points, o.calibration_frames == "joints" ? "joints' least-squares" : "tracker's");
 }
 
 // The platforms whose calibration failed, by status.
@@ -319,16 +346,16 @@ std::string report_text(const Model& model, const ToleranceCommandOptions& o, co
       "manufacturing errors (standard deviations, every leg): joint centres {:g} um (base), {:g} um (platform) per "
       "axis; U-joint axes {:g} deg; lead {:g} ppm; zero offsets {:g} um\n",
       1e6 * s.base_joint, 1e6 * s.platform_joint, rad2deg(s.base_axis), 1e6 * s.lead, 1e6 * s.offset);
-  out += fmt::format("{} platforms (seed {}) x {} poses, driven by {}{} in {:.1f} s\n", sm.platforms, o.seed, sm.poses,
-                     controller_text(o, c),
-                     workers > 0 ? fmt::format(" on {} Dask workers ({})", workers, printable(o.scheduler)) : "",
-                     seconds);
+  out +=
+      fmt::format("{} platforms (seed {}) x {} poses, driven by {}{} in {:.1f} s\n", sm.platforms, o.seed, sm.poses,
+                  controller_text(o, c),
+                  workers > 0 ? fmt::format(" on {} Dask workers ({})", workers, printable(o.scheduler)) : "", seconds);
   out += calibration_failures(sm);
   if (sm.failures > 0)
     out += fmt::format("failures: {} (platform, pose) pairs without an error (refused or forward kinematics failed)\n",
                        sm.failures);
   // After a tracker calibration the errors are micrometres.
-  const bool um = tracker_calibration(o);
+  const bool um = tracker_calibration(c);
   const double scale = um ? 1e6 : 1e3;
   const char* length = um ? "um" : "mm";
   out += fmt::format("\n{:<24}{:>30}   {:>20}   {:>14}\n", "", "Monte Carlo", "linearised", "MC / linear");
@@ -356,6 +383,7 @@ int run_tolerance(const ToleranceCommandOptions& o) {
   OutputFiles set("tolerance");
   set.input("--config", o.model.config);
   for (const std::string& t : o.required.trajectories) set.input("--trajectory", t);
+  if (!o.station_plan.empty()) set.input("--station-plan", o.station_plan);
   set.folder("--out", o.out);
   const RequiredPoses req = required_poses(config, o.required);
 
@@ -366,12 +394,7 @@ int run_tolerance(const ToleranceCommandOptions& o) {
   to.seed = o.seed;
   to.threads = 0;
   ToleranceLinear linear;
-  Status prepared;
-  try {
-    prepared = prepare_calibration(model, req.poses, calibration, to, linear);
-  } catch (const Error& e) {
-    throw ExitError(kExitBadInput, fmt::format("--{}", e.what()));  // "calibration: ..."
-  }
+  const Status prepared = prepare_calibration(model, req.poses, calibration, to, linear);  // names its option
   if (prepared != Status::Ok)
     throw ExitError(kExitOutOfLimit,
                     fmt::format("the linear model failed: {} ({})", describe(prepared), to_string(prepared)));
@@ -390,7 +413,7 @@ int run_tolerance(const ToleranceCommandOptions& o) {
   if (!o.no_csv) names.push_back("platforms.csv");
   std::vector<Figure> figs;
   if (!o.no_figures) {
-    figs.push_back(figure((dir / "tolerance").string(), chunk, linear, sm, tracker_calibration(o)));
+    figs.push_back(figure((dir / "tolerance").string(), chunk, linear, sm, tracker_calibration(calibration)));
     names.insert(names.end(), {"tolerance.png", "tolerance.svg"});
   }
   names.push_back("summary.json");
@@ -437,13 +460,18 @@ Command make_tolerance_command(CLI::App& root) {
       ->capture_default_str();
   app->add_option("--sigma-offset-um", o->offset_um, "Zero offsets, the legs' lengths at the drives' reference [um]")
       ->capture_default_str();
-  app->add_option("--calibration", o->calibration,
-                  "none: the controller runs the nominal configuration; perfect: it runs each real platform's own "
-                  "(the floor); stations:N[,SEED]: each platform calibrated as identify does (geometry model, a lead "
-                  "per leg) from a tracker's points at home, N random stations (+-0.25 m, +-15 deg; seed SEED, "
-                  "default 1: the stations of synth --stations N --station-seed SEED) and home, the controller "
-                  "running the corrected configuration; the linearised answer from the identification's covariance")
+  app->add_option(
+         "--calibration", o->calibration,
+         "none: the controller runs the nominal configuration; perfect: it runs each real platform's own "
+         "(the floor); stations:N[,SEED]: each platform calibrated as identify does (geometry model, a lead "
+         "per leg) from a tracker's points at home, N random stations (+-0.25 m, +-15 deg; seed SEED, "
+         "default 1: the stations of synth --stations N --station-seed SEED) and home, the controller "
+         "running the corrected configuration, the linearised answer from the identification's covariance, errors "
+         "reported in um and urad; plan: the stations of --station-plan")
       ->capture_default_str();
+  app->add_option("--station-plan", o->station_plan,
+                  "A stations run CSV (synth --run-out): each platform calibrated from a tracker's points at the "
+                  "poses the run holds (the plan calibration; with --calibration none or plan)");
   app->add_option("--tracker-noise-um", o->tracker_noise_um,
                   "The calibration's tracker: Gaussian noise per coordinate [um]")
       ->capture_default_str();

@@ -388,8 +388,8 @@ Status tolerance_chunk(const Model& nominal, const std::vector<Pose>& poses, con
   out = ToleranceChunk{};
   out.first = first;
   const std::size_t np = poses.size();
-  if (o.linear_worst && (linear == nullptr || (linear->point.size() != np &&
-                                                (linear->point_factor.size() != np || !linear->draw))))
+  if (o.linear_worst &&
+      (linear == nullptr || (linear->point.size() != np && (linear->point_factor.size() != np || !linear->draw))))
     return Status::NonFiniteInput;
   // The nominal commands, once for every platform that has no calibration of its own.
   StudyPoses sp{poses, std::vector<Vector6d>(np), std::vector<Placement>(np)};
@@ -574,7 +574,8 @@ ToleranceSummary summarize_tolerance(const ToleranceChunk& c, std::size_t poses,
   s.platforms = c.size();
   s.poses = poses;
   for (const std::uint32_t f : c.failures) s.failures += f;
-  for (const std::uint8_t status : c.calibration) ++s.calibration[std::min<std::size_t>(status, s.calibration.size() - 1)];
+  for (const std::uint8_t status : c.calibration)
+    ++s.calibration[std::min<std::size_t>(status, s.calibration.size() - 1)];
   const auto pooled = [](const ErrorHistogram& h, const std::vector<double>& worst) {
     ErrorQuantiles q;
     q.median = h.quantile(0.5);

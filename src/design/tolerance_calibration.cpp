@@ -33,7 +33,8 @@ Status plan_observations(const Model& nominal, const TrackerCalibration& c, std:
     const Pose pose = Pose::from_vector(q);
     Observation o;
     LimitReport limit;
-    if (const Status s = motor_commands(nominal, pose, Strategy::Compensated, o.motor, limit); s != Status::Ok) return s;
+    if (const Status s = motor_commands(nominal, pose, Strategy::Compensated, o.motor, limit); s != Status::Ok)
+      return s;
     o.p_T = platform_point_B(nominal, placement_from_pose(pose), nominal.spec().observation_P);
     out.insert(out.end(), static_cast<std::size_t>(c.points), o);
   }
@@ -61,20 +62,25 @@ IdentificationOptions study_identification_options() {
 }
 
 void check_tracker_calibration(const TrackerCalibration& c) {
-  if (c.stations.empty()) throw Error("calibration: the station plan has no station");
+  if (c.stations.empty()) throw ParameterError("calibration: the station plan has no station", "station_plan");
   for (std::size_t s = 0; s < c.stations.size(); ++s)
-    if (!c.stations[s].allFinite()) throw Error(fmt::format("calibration: station {} holds NaN or inf", s + 1));
+    if (!c.stations[s].allFinite())
+      throw ParameterError(fmt::format("calibration: station {} holds NaN or inf", s + 1), "station_plan");
   if (!(std::isfinite(c.noise) && c.noise > 0.0))
-    throw Error(fmt::format("calibration: the tracker's noise must be finite and > 0 m, got {}", c.noise));
+    throw ParameterError(fmt::format("calibration: the tracker's noise must be finite and > 0 m, got {}", c.noise),
+                         "tracker_noise");
   if (c.points < 1 || c.points > kMaxPointsPerStation)
-    throw Error(fmt::format("calibration: expected 1 to {} points per station, got {}", kMaxPointsPerStation,
-                            c.points));
+    throw ParameterError(
+        fmt::format("calibration: expected 1 to {} points per station, got {}", kMaxPointsPerStation, c.points),
+        "points_per_station");
   if (c.identification.model != CalibrationModel::Geometry)
-    throw Error("calibration: the identification must fit the geometry model (the joints the study moves)");
+    throw ParameterError("calibration: the identification must fit the geometry model (the joints the study moves)",
+                         "identification");
   if (c.points == 1 && std::isnan(c.identification.tracker_noise))
-    throw Error(
+    throw ParameterError(
         "calibration: one point per station has no scatter to measure the tracker's noise by; record two or more, or "
-        "give identification.tracker_noise");
+        "give identification.tracker_noise",
+        "points_per_station");
 }
 
 std::vector<Vector6d> random_station_plan(const Model& nominal, const StationsSpec& spec) {
@@ -138,7 +144,8 @@ Status tracker_observations(const Model& nominal, const Model& real, const Track
     const Pose pose = Pose::from_vector(q);
     Observation o;
     LimitReport limit;
-    if (const Status s = motor_commands(nominal, pose, Strategy::Compensated, o.motor, limit); s != Status::Ok) return s;
+    if (const Status s = motor_commands(nominal, pose, Strategy::Compensated, o.motor, limit); s != Status::Ok)
+      return s;
     // Where the held commands put the real platform, and its observation point there.
     if (const Status s = forward_kinematics(real, o.motor, LengthKind::Motor, placement_from_pose(pose), fk);
         s != Status::Ok)
@@ -175,7 +182,7 @@ CalibrationStep tracker_calibration_step(const TrackerCalibration& calibration) 
     // The real base in the identification's: through the tracker (its real placement, then the
     // identified one), or the real base joints' own frame.
     out.X_CB = c.frames == CalibratedFrames::Tracker ? compose(id.X_BT, inverse(sample_tracker_frame(c, index)))
-                                                      : inverse(X_BJ);
+                                                     : inverse(X_BJ);
     return Status::Ok;
   };
 }
@@ -192,8 +199,8 @@ struct PlanModel {
   ParameterSet every;
   std::vector<Eigen::Index> fitted, left;
   std::vector<int> left_axes;  // the axis (0..11) of each pair of left columns
-  Eigen::VectorXd left_sd;  // the left axes' manufacturing standard deviations [rad]
-  Eigen::MatrixXd J_all;    // the plan's weighted Jacobian in every's columns
+  Eigen::VectorXd left_sd;     // the left axes' manufacturing standard deviations [rad]
+  Eigen::MatrixXd J_all;       // the plan's weighted Jacobian in every's columns
   ObservationGroups groups;
   double noise = 0.0;  // the tracker's noise the covariance assumes [m]
 };
@@ -301,7 +308,7 @@ std::function<void(std::uint64_t, Eigen::VectorXd&)> same_errors(const Model& no
   std::vector<std::array<Vector3d, 2>> across;  // the two directions across each left axis
   for (const int a : m.left_axes) across.push_back(m.every.axis_directions(a));
   return [nominal, study, c, M, groups = m.groups, sd = m.left_sd, across, axes = m.left_axes](std::uint64_t index,
-                                                                                             Eigen::VectorXd& z) {
+                                                                                               Eigen::VectorXd& z) {
     const std::vector<Vector3d> noise_T = tracker_noise(c, index);
     const Matrix3d R_BT = sample_tracker_frame(c, index).R;
     Eigen::VectorXd e = Eigen::VectorXd::Zero(M.cols());
@@ -404,10 +411,13 @@ std::vector<Vector6d> chosen_plan(const Model& nominal, const CalibrationChoice&
     if (n.ec == std::errc() && n.ptr == count.data() + count.size() && s.ec == std::errc() &&
         s.ptr == seed.data() + seed.size() && !seed.empty() && spec.count >= 1 && spec.count <= kMaxStations)
       return random_station_plan(nominal, spec);
-    throw Error(fmt::format("calibration: expected stations:N[,SEED] with N from 1 to {} and a whole seed, got '{}'",
-                            kMaxStations, name));
+    throw ParameterError(
+        fmt::format("calibration: expected stations:N[,SEED] with N from 1 to {} and a whole seed, got '{}'",
+                    kMaxStations, name),
+        "calibration");
   }
-  throw Error(fmt::format("calibration: expected none, perfect, stations:N[,SEED] or plan, got '{}'", name));
+  throw ParameterError(fmt::format("calibration: expected none, perfect, stations:N[,SEED] or plan, got '{}'", name),
+                       "calibration");
 }
 
 }  // namespace
@@ -416,7 +426,8 @@ Status prepare_calibration(const Model& nominal, const std::vector<Pose>& poses,
                            ToleranceOptions& options, ToleranceLinear& linear) {
   options.calibration = nullptr;
   const std::vector<Vector6d> plan = chosen_plan(nominal, choice);
-  if (plan.empty() && choice.name == "plan") throw Error("calibration: the plan has no station");
+  if (plan.empty() && choice.name == "plan")
+    throw ParameterError("calibration: plan needs a station plan (none given)", "station_plan");
   if (plan.empty()) {
     if (choice.name == "perfect") options.calibration = perfect_calibration_step();
     return tolerance_linear(nominal, poses, options.sigmas, linear, options.threads);

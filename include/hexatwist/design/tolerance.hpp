@@ -99,15 +99,15 @@ struct ErrorHistogram {
 /// over the poses, and the pooled histograms of every (platform, pose) error. Platform k's numbers
 /// depend only on (seed, k) and the poses: chunks concatenate to the whole study bit for bit.
 struct ToleranceChunk {
-  std::uint64_t first = 0;                      ///< index of the first platform
-  std::vector<double> max_point;                ///< largest |point A error| over the poses [m]
-  std::vector<double> rms_point;                ///< its RMS over the poses [m]
-  std::vector<double> max_position;             ///< largest |pivot position error| [m]
-  std::vector<double> max_orientation;          ///< largest orientation error (rotation angle) [rad]
+  std::uint64_t first = 0;              ///< index of the first platform
+  std::vector<double> max_point;        ///< largest |point A error| over the poses [m]
+  std::vector<double> rms_point;        ///< its RMS over the poses [m]
+  std::vector<double> max_position;     ///< largest |pivot position error| [m]
+  std::vector<double> max_orientation;  ///< largest orientation error (rotation angle) [rad]
   /// Largest |point A error| of the linear model, same errors [m] (after a calibration, the same
   /// tracker noise: ToleranceLinear::draw)
   std::vector<double> max_point_linear;
-  std::vector<std::uint32_t> failures;  ///< poses where the controller refused or the FK failed (all: no controller)
+  std::vector<std::uint32_t> failures;    ///< poses where the controller refused or the FK failed (all: no controller)
   std::vector<std::uint8_t> calibration;  ///< the status of each platform's calibration (Ok without one)
   ErrorHistogram point, position, orientation;  ///< pooled over platforms and poses [m, m, rad]
   std::size_t size() const noexcept { return max_point.size(); }
@@ -174,7 +174,7 @@ struct ToleranceSummary {
   std::uint64_t failures = 0;  ///< (platform, pose) pairs without an error (refused, FK or calibration failed)
   /// Platforms by the status of their calibration (index: the Status; all Ok without one)
   std::array<std::uint64_t, static_cast<std::size_t>(kLastStatus) + 1> calibration{};
-  ErrorQuantiles point, position, orientation;  ///< Monte Carlo, pooled over platforms and poses
+  ErrorQuantiles point, position, orientation;                       ///< Monte Carlo, pooled over platforms and poses
   ErrorQuantiles point_linear, position_linear, orientation_linear;  ///< the covariance answer (no max)
   ErrorQuantiles worst_point;         ///< per platform, the largest point error over the poses: Monte Carlo
   ErrorQuantiles worst_point_linear;  ///< the same with the linear model and the same errors

@@ -46,7 +46,7 @@ struct TrackerCalibration {
 /// Most points per station a TrackerCalibration takes.
 inline constexpr int kMaxPointsPerStation = 100000;
 
-/// Throws hexatwist::Error naming the field when `calibration` is unusable: no station, a station
+/// Throws hexatwist::ParameterError naming the field when `calibration` is unusable: no station, a station
 /// that is not finite, a noise that is not finite and > 0, points outside 1..kMaxPointsPerStation,
 /// a single point per station without identification.tracker_noise (the scatter needs two), an
 /// identification of another model than Geometry (the study's errors move the joints).
@@ -125,7 +125,7 @@ struct CalibrationChoice {
   /// none (the nominal controller), perfect (perfect_calibration_step), stations:N[,SEED]
   /// (random_station_plan of N stations, their seed SEED, 1 by default) or plan (`plan` below)
   std::string name = "none";
-  std::vector<Vector6d> plan;  ///< for "plan": the stations [m, rad from home]
+  std::vector<Vector6d> plan;    ///< for "plan": the stations [m, rad from home]
   double tracker_noise = 10e-6;  ///< the tracker's noise per coordinate [m]
   int points = 50;  ///< points per station; one: the identification is given the tracker's noise (no scatter)
   CalibratedFrames frames = CalibratedFrames::Tracker;
@@ -133,9 +133,9 @@ struct CalibrationChoice {
 
 /// Prepares a study for `choice`: options.calibration (empty for none), and the linear model for
 /// its summary and max_point_linear: tolerance_linear, or after a tracker calibration (seeded with
-/// options.seed) calibrated_linear. Throws hexatwist::Error starting "calibration: " for a name it
-/// does not know, a station count outside 1..kMaxStations, and as check_tracker_calibration and
-/// random_stations. Returns the linear model's status.
+/// options.seed) calibrated_linear. Throws hexatwist::ParameterError ("calibration", "station_plan")
+/// starting "calibration: " for a name it does not know, plan without stations, a station count
+/// outside 1..kMaxStations, and as check_tracker_calibration and random_stations. Returns the linear model's status.
 [[nodiscard]] Status prepare_calibration(const Model& nominal, const std::vector<Pose>& poses,
                                          const CalibrationChoice& choice, ToleranceOptions& options,
                                          ToleranceLinear& linear);
