@@ -112,7 +112,7 @@ void tracker_json(JsonWriter& j, const ToleranceCommandOptions& o, const Calibra
   j.begin_object().field("noise", c.tracker_noise).field("points_per_station", c.points);
   j.field("frames", o.calibration_frames);
   if (c.name == "plan") {  // the stations read [m, rad from home]
-    j.key("plan").begin_array();
+    j.key("stations").begin_array();
     for (const Vector6d& q : c.plan) {
       j.begin_array();
       for (int k = 0; k < 6; ++k) j.value(q[k]);

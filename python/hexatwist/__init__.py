@@ -524,15 +524,20 @@ def design_axes(config=None, poses=None, *, objective: str = "twist", symmetry: 
 
 
 def tolerance(config=None, poses=None, *, platforms: int = 1000, seed: int = 1, sigmas: dict | None = None,
-              calibration: str = "none", linear_worst: bool = True, client=None, chunk: int | None = None,
-              **workspace) -> Result:
+              calibration: str = "none", tracker: dict | None = None, linear_worst: bool = True, client=None,
+              chunk: int | None = None, **workspace) -> Result:
     """Tolerance analysis (tolerance.hpp): ``platforms`` platforms with manufacturing errors
     (``sigmas``: base_joint, platform_joint [m per coordinate], base_axis, platform_axis [rad], lead
     [relative], offset [m]; per leg), each driven by the compensated commands of its controller (the
-    nominal model; ``calibration="perfect"``: one that knows the real platform) over the required
-    workspace (``poses``, or the :func:`required_workspace` settings in ``workspace``). Returns per
+    nominal model; ``calibration="perfect"``: one that knows the real platform; ``"stations:N[,SEED]"``
+    or ``"plan"``: the configuration identify finds from a simulated tracker log of that platform at N
+    random stations or at ``tracker["stations"]``, (K, 6) [m, rad from home], errors then in the frames
+    the tracker sees; ``tracker``: ``noise`` [m per coordinate, default 10e-6], ``points_per_station``
+    [default 50], ``frames`` "tracker" or "joints") over the required workspace (``poses``, or the :func:`required_workspace` settings in ``workspace``). Returns per
     platform ``max_point``, ``rms_point``, ``max_position`` [m], ``max_orientation`` [rad],
-    ``max_point_linear`` (the linear model, same errors) and ``failures``; the pooled histograms
+    ``max_point_linear`` (the linear model, same errors; after a tracker calibration from the
+    identification's covariance and the sample's own tracker noise), ``failures`` and ``calibration``
+    (each platform's calibration status); the pooled histograms
     ``histogram_point`` ...; ``linear`` (the covariance answer: median and p95 of the point, position
     and orientation errors); and ``summary``: Monte Carlo and linearised quantiles side by side. With
     a dask ``client`` the platforms are sampled and evaluated on the workers (``chunk`` platforms a
@@ -541,12 +546,12 @@ def tolerance(config=None, poses=None, *, platforms: int = 1000, seed: int = 1, 
     sig = {k: float(v) for k, v in (sigmas or {}).items()}
     if client is not None:
         chunk_result, linear = _distributed.tolerance_on(client, config, poses, w, sig, int(seed), int(platforms),
-                                                         calibration, bool(linear_worst), chunk)
+                                                         calibration, bool(linear_worst), chunk, tracker=tracker)
     else:
         threads = get_num_threads()
         chunk_result = _core._tolerance_chunk(config, poses, w, sig, int(seed), 0, int(platforms), calibration,
-                                              bool(linear_worst), threads)
-        linear = _core._tolerance_linear(config, poses, w, sig, threads)
+                                              bool(linear_worst), threads, tracker)
+        linear = _core._tolerance_linear(config, poses, w, sig, threads, calibration, tracker, int(seed))
     r = Result(chunk_result)
     r["linear"] = linear
     r["summary"] = _core._tolerance_summary(chunk_result, linear["poses"], linear)

@@ -173,15 +173,16 @@ def workspace_map_on(client, model, orientation, plane, offset, spacing, grid, s
     return hexatwist._map_result(r, grid)
 
 
-def _tolerance_task(config, poses, workspace, sigmas, seed, first, count, calibration, linear_worst):
+def _tolerance_task(config, poses, workspace, sigmas, seed, first, count, calibration, linear_worst, tracker):
     hexatwist = _hexatwist()
     return hexatwist._core._tolerance_chunk(config, poses, workspace, sigmas, seed, first, count, calibration,
-                                            linear_worst, hexatwist.get_num_threads())
+                                            linear_worst, hexatwist.get_num_threads(), tracker)
 
 
-def _linear_task(config, poses, workspace, sigmas):
+def _linear_task(config, poses, workspace, sigmas, calibration, tracker, seed):
     hexatwist = _hexatwist()
-    return hexatwist._core._tolerance_linear(config, poses, workspace, sigmas, hexatwist.get_num_threads())
+    return hexatwist._core._tolerance_linear(config, poses, workspace, sigmas, hexatwist.get_num_threads(),
+                                             calibration, tracker, seed)
 
 
 _HISTOGRAMS = ("histogram_point", "histogram_position", "histogram_orientation")
@@ -203,17 +204,18 @@ def merge_tolerance_chunks(parts):
 
 
 def tolerance_on(client, config, poses, workspace, sigmas, seed, platforms, calibration, linear_worst, chunk,
-                 linear=True):
+                 linear=True, tracker=None):
     """hexatwist.tolerance on the workers: ``chunk`` platforms a task (default: about 64 tasks), each
     sampling its platforms from (seed, index) and generating the poses from ``workspace`` (``poses``,
-    when given, are scattered once); one task for the covariance answer (``linear``). Returns (chunk,
-    linear or None)."""
+    when given, are scattered once), a tracker calibration's noise from (seed, index) too; one task for
+    the covariance answer (``linear``). Returns (chunk, linear or None)."""
     chunk = int(chunk) if chunk else max(1, math.ceil(platforms / 64))
     config_future = client.scatter(config, broadcast=True) if config is not None else None
     poses_future = client.scatter(np.ascontiguousarray(poses, dtype=np.float64), broadcast=True) \
         if poses is not None else None
-    linear = client.submit(_linear_task, config_future, poses_future, workspace, sigmas, pure=False) if linear else None
+    linear = client.submit(_linear_task, config_future, poses_future, workspace, sigmas, calibration, tracker, seed,
+                           pure=False) if linear else None
     futures = [client.submit(_tolerance_task, config_future, poses_future, workspace, sigmas, seed, first, count,
-                             calibration, linear_worst, pure=False)
+                             calibration, linear_worst, tracker, pure=False)
                for first, count in _ranges(platforms, chunk)]
     return merge_tolerance_chunks(client.gather(futures)), linear.result() if linear is not None else None
