@@ -77,7 +77,7 @@ CalibrationChoice calibration_of(const ToleranceCommandOptions& o) {
   c.name = o.calibration;
   check_option(o.tracker_noise_um > 0.0 && o.tracker_noise_um <= 1e4, "--tracker-noise-um", o.tracker_noise_um,
                "a standard deviation above 0 and up to 1e4 um");
-  c.tracker_noise = 1e-6 * o.tracker_noise_um;
+  c.tracker_noise = o.tracker_noise_um / 1e6;  // correctly rounded: 20 um is 20e-6 m
   check_option(o.points_per_station >= 1 && o.points_per_station <= kMaxPointsPerStation, "--points-per-station",
                o.points_per_station, fmt::format("1 to {} points", kMaxPointsPerStation));
   c.points = o.points_per_station;

@@ -25,17 +25,29 @@ namespace {
 constexpr std::uint64_t kTrackerStream = 0x3c6ef372fe94f82bULL;
 constexpr std::uint64_t kNoiseStream = 0x510e527fade682d1ULL;
 
+// The nominal model's compensated commands for each station of the plan, held there.
+Status station_commands(const Model& nominal, const TrackerCalibration& c, std::vector<Vector6d>& out) {
+  out.resize(c.stations.size());
+  LimitReport limit;
+  for (std::size_t k = 0; k < c.stations.size(); ++k)
+    if (const Status s =
+            motor_commands(nominal, Pose::from_vector(c.stations[k]), Strategy::Compensated, out[k], limit);
+        s != Status::Ok)
+      return s;
+  return Status::Ok;
+}
+
 // The plan's observations of the nominal platform without noise, the tracker frame at B: the
 // points of a station repeated, so that its group weighs as many points as the tracker records.
 Status plan_observations(const Model& nominal, const TrackerCalibration& c, std::vector<Observation>& out) {
   out.clear();
-  for (const Vector6d& q : c.stations) {
-    const Pose pose = Pose::from_vector(q);
+  std::vector<Vector6d> commands;
+  if (const Status s = station_commands(nominal, c, commands); s != Status::Ok) return s;
+  for (std::size_t k = 0; k < c.stations.size(); ++k) {
     Observation o;
-    LimitReport limit;
-    if (const Status s = motor_commands(nominal, pose, Strategy::Compensated, o.motor, limit); s != Status::Ok)
-      return s;
-    o.p_T = platform_point_B(nominal, placement_from_pose(pose), nominal.spec().observation_P);
+    o.motor = commands[k];
+    o.p_T =
+        platform_point_B(nominal, placement_from_pose(Pose::from_vector(c.stations[k])), nominal.spec().observation_P);
     out.insert(out.end(), static_cast<std::size_t>(c.points), o);
   }
   return Status::Ok;
@@ -139,17 +151,15 @@ Status tracker_observations(const Model& nominal, const Model& real, const Track
   const RigidTransform X_TB = inverse(sample_tracker_frame(c, index));
   const std::vector<Vector3d> noise = tracker_noise(c, index);
   auto next = noise.begin();
+  std::vector<Vector6d> commands;
+  if (const Status s = station_commands(nominal, c, commands); s != Status::Ok) return s;
   FkResult fk;
-  for (const Vector6d& q : c.stations) {
-    const Pose pose = Pose::from_vector(q);
+  for (std::size_t station = 0; station < c.stations.size(); ++station) {
     Observation o;
-    LimitReport limit;
-    if (const Status s = motor_commands(nominal, pose, Strategy::Compensated, o.motor, limit); s != Status::Ok)
-      return s;
+    o.motor = commands[station];
     // Where the held commands put the real platform, and its observation point there.
-    if (const Status s = forward_kinematics(real, o.motor, LengthKind::Motor, placement_from_pose(pose), fk);
-        s != Status::Ok)
-      return s;
+    const Placement guess = placement_from_pose(Pose::from_vector(c.stations[station]));
+    if (const Status s = forward_kinematics(real, o.motor, LengthKind::Motor, guess, fk); s != Status::Ok) return s;
     const Vector3d p_T = apply(X_TB, platform_point_B(real, fk.placement, real.spec().observation_P));
     for (int k = 0; k < c.points; ++k) {
       o.p_T = p_T + *next++;
