@@ -95,7 +95,7 @@ def test_tolerance_does_not_depend_on_threads_and_a_perfect_calibration_leaves_n
 
 
 def test_a_tracker_calibration_leaves_micrometres_and_its_linear_answer_agrees():
-    # The seed platform, 40 random stations, 10 um tracker noise, 4 platforms x 110 poses: measured
+    # The seed platform, 40 random stations, 10 um tracker noise, 4 platforms x 76 poses: measured
     # median point error 1.94 um after, 0.275 mm with the nominal controller (142x); per platform MC
     # vs linear within 0.25 %; pooled median MC / linear 1.04.
     settings = dict(platforms=4, random=60, test_samples=5)
