@@ -50,7 +50,7 @@ def main(argv: list[str] | None = None) -> int:
             poses = np.asarray(request["poses"], dtype=np.float64) if "poses" in request else None
             chunk, _ = _tolerance_on(client, config, poses, request["workspace"], request["sigmas"], request["seed"],
                                     request["platforms"], request.get("calibration", "none"), True,
-                                    request.get("chunk"), linear=False)
+                                    request.get("chunk"), linear=False, tracker=request.get("tracker"))
             _write_arrays(out, "", chunk)
         elif request["job"] == "workspace":
             model = hexatwist.Rig(config).model

@@ -305,6 +305,8 @@ class Tolerance(Result):
     max_point_linear: FloatArray
     """The linear model's, the same errors [m]."""
     failures: npt.NDArray[np.uint32]
+    calibration: npt.NDArray[np.uint8]
+    """Each platform's calibration status (0: ok; a tracker calibration that failed: its status code)."""
     histogram_point: npt.NDArray[np.uint64]
     histogram_position: npt.NDArray[np.uint64]
     histogram_orientation: npt.NDArray[np.uint64]
@@ -436,26 +438,33 @@ def _quantiles(d: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def tolerance(platform: PlatformLike = None, poses: ArrayLike | None = None, *, platforms: int = 1000, seed: int = 1,
-              sigmas: Mapping[str, float] | None = None, calibration: Literal["none", "perfect"] = "none",
-              linear_worst: bool = True, client: Any = None, chunk: int | None = None,
-              **workspace: Any) -> Tolerance:
+              sigmas: Mapping[str, float] | None = None, calibration: str = "none",
+              tracker: Mapping[str, Any] | None = None, linear_worst: bool = True, client: Any = None,
+              chunk: int | None = None, **workspace: Any) -> Tolerance:
     """Tolerance analysis (tolerance.hpp): ``platforms`` platforms with manufacturing errors (``sigmas``:
     base_joint, platform_joint [m per coordinate], base_axis, platform_axis [rad], lead [relative], offset
     [m]; per leg), each driven by the compensated commands of its controller (the nominal model;
-    ``calibration="perfect"``: one that knows the real platform) over the required workspace (``poses``,
-    or the :func:`required_workspace` settings in ``workspace``). With a dask ``client`` the platforms
+    ``calibration="perfect"``: one that knows the real platform; ``"stations:N[,SEED]"`` or ``"plan"``: the
+    configuration identify finds from a simulated tracker log of that platform at N random stations or at
+    ``tracker["stations"]``, (K, 6) [m, rad from home], errors then in the frames the tracker sees;
+    ``tracker``: ``noise`` [m per coordinate, default 10e-6], ``points_per_station`` [default 50],
+    ``frames`` "tracker" or "joints") over the required workspace (``poses``, or the
+    :func:`required_workspace` settings in ``workspace``). ``max_point_linear`` after a tracker calibration
+    comes from the identification's covariance and the sample's own tracker noise. With a dask ``client`` the platforms
     are sampled and evaluated on the workers (``chunk`` platforms a task, poses generated there) and
     only their summaries come back: the same numbers, bit for bit."""
     w = _workspace_spec(workspace)
     sig = {k: float(v) for k, v in (sigmas or {}).items()}
     if client is not None:
         chunk_result, linear = _distributed._tolerance_on(client, platform, poses, w, sig, int(seed), int(platforms),
-                                                         calibration, bool(linear_worst), chunk)
+                                                         calibration, bool(linear_worst), chunk,
+                                                         tracker=None if tracker is None else dict(tracker))
     else:
         threads = get_num_threads()
+        t = None if tracker is None else dict(tracker)
         chunk_result = _core._tolerance_chunk(platform, poses, w, sig, int(seed), 0, int(platforms), calibration,
-                                              bool(linear_worst), threads)
-        linear = _core._tolerance_linear(platform, poses, w, sig, threads)
+                                              bool(linear_worst), threads, t)
+        linear = _core._tolerance_linear(platform, poses, w, sig, threads, calibration, t, int(seed))
     summary = _core._tolerance_summary(chunk_result, linear["poses"], linear)
     per_platform = {k: v for k, v in chunk_result.items() if k != "first"}
     return Tolerance(**per_platform, linear=LinearTolerance(**_quantiles(linear)),

@@ -229,15 +229,17 @@ def _workspace_map_on(client: Any, model: Model, orientation: ArrayLike, plane: 
 
 
 def _tolerance_task(platform: Any, poses: Any, workspace: dict[str, Any], sigmas: dict[str, float], seed: int,
-                    first: int, count: int, calibration: str, linear_worst: bool) -> Any:
+                    first: int, count: int, calibration: str, linear_worst: bool, tracker: Any) -> Any:
     hexatwist = _hexatwist()
     return hexatwist._core._tolerance_chunk(platform, poses, workspace, sigmas, seed, first, count, calibration,
-                                            linear_worst, hexatwist.get_num_threads())
+                                            linear_worst, hexatwist.get_num_threads(), tracker)
 
 
-def _linear_task(platform: Any, poses: Any, workspace: dict[str, Any], sigmas: dict[str, float]) -> Any:
+def _linear_task(platform: Any, poses: Any, workspace: dict[str, Any], sigmas: dict[str, float], calibration: str,
+                 tracker: Any, seed: int) -> Any:
     hexatwist = _hexatwist()
-    return hexatwist._core._tolerance_linear(platform, poses, workspace, sigmas, hexatwist.get_num_threads())
+    return hexatwist._core._tolerance_linear(platform, poses, workspace, sigmas, hexatwist.get_num_threads(),
+                                             calibration, tracker, seed)
 
 
 _HISTOGRAMS = ("histogram_point", "histogram_position", "histogram_orientation")
@@ -260,19 +262,19 @@ def _merge_tolerance_chunks(parts: list[dict[str, Any]]) -> dict[str, Any]:
 
 def _tolerance_on(client: Any, platform: Any, poses: ArrayLike | None, workspace: dict[str, Any],
                  sigmas: dict[str, float], seed: int, platforms: int, calibration: str, linear_worst: bool,
-                 chunk: int | None, linear: bool = True) -> tuple[dict[str, Any], Any]:
+                 chunk: int | None, linear: bool = True, tracker: Any = None) -> tuple[dict[str, Any], Any]:
     """hexatwist.tolerance on the workers: ``chunk`` platforms a task (default: about 64 tasks), each
     sampling its platforms from (seed, index) and generating the poses from ``workspace`` (``poses``,
-    when given, are scattered once); one task for the covariance answer (``linear``). Returns (chunk,
-    linear or None)."""
+    when given, are scattered once), a tracker calibration's noise from (seed, index) too; one task for
+    the covariance answer (``linear``). Returns (chunk, linear or None)."""
     chunk = int(chunk) if chunk else max(1, math.ceil(platforms / 64))
     platform_future = client.scatter(platform, broadcast=True) if platform is not None else None
     poses_future = client.scatter(np.ascontiguousarray(poses, dtype=np.float64), broadcast=True) \
         if poses is not None else None
-    linear_future = client.submit(_linear_task, platform_future, poses_future, workspace, sigmas, pure=False) \
-        if linear else None
+    linear_future = client.submit(_linear_task, platform_future, poses_future, workspace, sigmas, calibration, tracker,
+                                  seed, pure=False) if linear else None
     futures = [client.submit(_tolerance_task, platform_future, poses_future, workspace, sigmas, seed, first, count,
-                             calibration, linear_worst, pure=False)
+                             calibration, linear_worst, tracker, pure=False)
                for first, count in _ranges(platforms, chunk)]
     return _merge_tolerance_chunks(client.gather(futures)), \
         linear_future.result() if linear_future is not None else None
