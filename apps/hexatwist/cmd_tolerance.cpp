@@ -34,6 +34,10 @@ struct ToleranceCommandOptions {
   double lead_ppm = 50.0;
   double offset_um = 100.0;
   std::string calibration = "none";
+  double tracker_noise_um = 10.0;
+  int points_per_station = 50;
+  std::string calibration_frames = "tracker";
+  std::string station_plan;
   std::string out = "tolerance-out";
   std::string scheduler;
   bool json = false;
@@ -67,9 +71,61 @@ void sigmas_json(JsonWriter& j, const ToleranceSigmas& s) {
   j.end_object();
 }
 
+// The calibration the options name (its name checked by the library's prepare_calibration).
+CalibrationChoice calibration_of(const ToleranceCommandOptions& o) {
+  CalibrationChoice c;
+  c.name = o.calibration;
+  check_option(o.tracker_noise_um > 0.0 && o.tracker_noise_um <= 1e4, "--tracker-noise-um", o.tracker_noise_um,
+               "a standard deviation above 0 and up to 1e4 um");
+  c.tracker_noise = o.tracker_noise_um / 1e6;  // correctly rounded: 20 um is 20e-6 m
+  check_option(o.points_per_station >= 1 && o.points_per_station <= kMaxPointsPerStation, "--points-per-station",
+               o.points_per_station, fmt::format("1 to {} points", kMaxPointsPerStation));
+  c.points = o.points_per_station;
+  c.frames = o.calibration_frames == "joints" ? CalibratedFrames::Joints : CalibratedFrames::Tracker;
+  if (!o.station_plan.empty()) {
+    if (o.calibration != "none" && o.calibration != "plan")
+      throw ExitError(kExitBadInput, fmt::format("--station-plan: a plan is its own calibration; --calibration is "
+                                                 "'{}' (leave it out, or give plan)",
+                                                 printable(o.calibration)));
+    const std::string text = read_text_file(o.station_plan, "--station-plan", "stations run CSV file", kMaxDataBytes);
+    try {
+      c.plan = run_stations(parse_trajectory_csv(text, o.station_plan));
+    } catch (const Error& e) {
+      throw ExitError(kExitBadInput, fmt::format("--station-plan: {}", e.what()));
+    }
+    if (c.plan.empty())
+      throw ExitError(kExitBadInput,
+                      fmt::format("--station-plan: {} holds no pose for two samples in a row (no station)",
+                                  printable(o.station_plan)));
+    c.name = "plan";
+  }
+  return c;
+}
+
+bool tracker_calibration(const CalibrationChoice& c) { return c.name == "plan" || c.name.starts_with("stations:"); }
+
+void tracker_json(JsonWriter& j, const ToleranceCommandOptions& o, const CalibrationChoice& c) {
+  if (!tracker_calibration(c)) {
+    j.null();
+    return;
+  }
+  j.begin_object().field("noise", c.tracker_noise).field("points_per_station", c.points);
+  j.field("frames", o.calibration_frames);
+  if (c.name == "plan") {  // the stations read [m, rad from home]
+    j.key("stations").begin_array();
+    for (const Vector6d& q : c.plan) {
+      j.begin_array();
+      for (int k = 0; k < 6; ++k) j.value(q[k]);
+      j.end_array();
+    }
+    j.end_array();
+  }
+  j.end_object();
+}
+
 // The Monte Carlo on the cluster: platforms sampled and evaluated on the workers, their summaries here.
 ToleranceChunk chunk_on_cluster(const ToleranceCommandOptions& o, const RequiredPoses& req, const ToleranceSigmas& s,
-                                int& workers) {
+                                const CalibrationChoice& calibration, int& workers) {
   JsonWriter j;
   j.begin_object();
   j.field("job", "tolerance");
@@ -90,7 +146,9 @@ ToleranceChunk chunk_on_cluster(const ToleranceCommandOptions& o, const Required
   sigmas_json(j, s);
   j.field("seed", o.seed);
   j.field("platforms", o.platforms);
-  j.field("calibration", o.calibration);
+  j.field("calibration", calibration.name);
+  j.key("tracker");
+  tracker_json(j, o, calibration);
   j.field("timeout", 10);
   j.end_object();
   const ClusterArrays a = run_cluster_job(o.scheduler, j.str());
@@ -104,6 +162,7 @@ ToleranceChunk chunk_on_cluster(const ToleranceCommandOptions& o, const Required
   c.max_orientation = cluster_array(a, "max_orientation", n);
   c.max_point_linear = cluster_array(a, "max_point_linear", n);
   for (const double f : cluster_array(a, "failures", n)) c.failures.push_back(static_cast<std::uint32_t>(f));
+  for (const double f : cluster_array(a, "calibration", n)) c.calibration.push_back(static_cast<std::uint8_t>(f));
   const auto histogram = [&](const char* name, ErrorHistogram& h) {
     const auto& v = cluster_array(a, name, static_cast<std::size_t>(ErrorHistogram::kBins));
     for (std::size_t k = 0; k < v.size(); ++k) h.counts[k] = static_cast<std::uint64_t>(v[k]);
@@ -119,8 +178,8 @@ void quantiles_json(JsonWriter& j, const ErrorQuantiles& q) {
 }
 
 std::string summary_json(const Model& model, const ToleranceCommandOptions& o, const RequiredPoses& req,
-                         const ToleranceSigmas& s, const ToleranceSummary& sm, int workers, double seconds,
-                         const std::vector<std::string>& files) {
+                         const ToleranceSigmas& s, const CalibrationChoice& calibration, const ToleranceSummary& sm,
+                         int workers, double seconds, const std::vector<std::string>& files) {
   JsonWriter j;
   j.begin_object();
   j.field("command", "tolerance");
@@ -134,8 +193,14 @@ std::string summary_json(const Model& model, const ToleranceCommandOptions& o, c
   j.field("platforms", static_cast<std::uint64_t>(sm.platforms));
   j.field("poses", static_cast<std::uint64_t>(sm.poses));
   j.field("seed", o.seed);
-  j.field("calibration", o.calibration);
+  j.field("calibration", calibration.name);
+  j.key("tracker");
+  tracker_json(j, o, calibration);
   j.field("failures", sm.failures);
+  j.key("calibration_failures").begin_object();  // platforms by the status of their calibration
+  for (std::size_t k = 1; k < sm.calibration.size(); ++k)
+    if (sm.calibration[k] > 0) j.field(std::string(to_string(static_cast<Status>(k))), sm.calibration[k]);
+  j.end_object();
   // Each group of quantiles an object of its errors.
   const auto group = [&](const char* name, std::initializer_list<std::pair<const char*, const ErrorQuantiles*>> items) {
     j.key(name).begin_object();
@@ -154,8 +219,9 @@ std::string summary_json(const Model& model, const ToleranceCommandOptions& o, c
                                {"orientation", &sm.worst_orientation}});
   j.field("definitions",
           "pooled over every (platform, pose): the point A, pivot position and orientation (rotation angle) errors of "
-          "the sampled platform driven by its controller's compensated commands; linearised: the same from the "
-          "covariance of the linear model; worst_per_platform: each platform's largest error over the poses");
+          "the sampled platform driven by its controller's compensated commands (after a tracker calibration: in the "
+          "frames tracker.frames names); linearised: the same from the covariance of the linear model; "
+          "worst_per_platform: each platform's largest error over the poses");
   j.key("cluster");
   if (o.scheduler.empty())
     j.null();
@@ -170,11 +236,13 @@ std::string summary_json(const Model& model, const ToleranceCommandOptions& o, c
 }
 
 std::string platforms_csv(const ToleranceChunk& c) {
-  std::string out = "platform,max_point_m,rms_point_m,max_position_m,max_orientation_rad,max_point_linear_m,failures\n";
+  std::string out =
+      "platform,max_point_m,rms_point_m,max_position_m,max_orientation_rad,max_point_linear_m,failures,calibration\n";
   auto it = std::back_inserter(out);
   for (std::size_t k = 0; k < c.size(); ++k)
-    fmt::format_to(it, "{},{},{},{},{},{},{}\n", c.first + k, c.max_point[k], c.rms_point[k], c.max_position[k],
-                   c.max_orientation[k], c.max_point_linear[k], c.failures[k]);
+    fmt::format_to(it, "{},{},{},{},{},{},{},{}\n", c.first + k, c.max_point[k], c.rms_point[k], c.max_position[k],
+                   c.max_orientation[k], c.max_point_linear[k], c.failures[k],
+                   to_string(static_cast<Status>(c.calibration[k])));
   return out;
 }
 
@@ -217,18 +285,23 @@ Series sorted_series(std::string label, std::vector<double> v, double scale, Ser
   return s;
 }
 
-Figure figure(const std::string& stem, const ToleranceChunk& c, const ToleranceLinear& lin,
-              const ToleranceSummary& sm) {
-  Figure f{
-      stem, fmt::format("Accuracy with manufacturing errors: {} platforms x {} poses", sm.platforms, sm.poses), {}};
-  f.panels.push_back(
-      cdf_panel("Error of point A over the workspace", "point A error [mm]", 1e3, c.point, lin.point_covariance));
-  f.panels.push_back(cdf_panel("Orientation error over the workspace", "orientation error [mrad]", 1e3, c.orientation,
-                               lin.orientation_covariance));
-  Panel worst("Each platform's largest point A error over the workspace", "largest point A error [mm]",
+// The figure; after a tracker calibration in micrometres and microradians.
+Figure figure(const std::string& stem, const ToleranceChunk& c, const ToleranceLinear& lin, const ToleranceSummary& sm,
+              bool calibrated) {
+  Figure f{stem,
+           fmt::format("Accuracy with manufacturing errors{}: {} platforms x {} poses",
+                       calibrated ? ", after a tracker calibration" : "", sm.platforms, sm.poses),
+           {}};
+  const double scale = calibrated ? 1e6 : 1e3;
+  const std::string mm = calibrated ? "um" : "mm", mrad = calibrated ? "urad" : "mrad";
+  f.panels.push_back(cdf_panel("Error of point A over the workspace", "point A error [" + mm + "]", scale, c.point,
+                               lin.point_covariance));
+  f.panels.push_back(cdf_panel("Orientation error over the workspace", "orientation error [" + mrad + "]", scale,
+                               c.orientation, lin.orientation_covariance));
+  Panel worst("Each platform's largest point A error over the workspace", "largest point A error [" + mm + "]",
               "share of platforms [-]");
-  worst.series.push_back(sorted_series("Monte Carlo", c.max_point, 1e3, Series::Style::Solid));
-  worst.series.push_back(sorted_series("linear model, same errors", c.max_point_linear, 1e3, Series::Style::Dashed));
+  worst.series.push_back(sorted_series("Monte Carlo", c.max_point, scale, Series::Style::Solid));
+  worst.series.push_back(sorted_series("linear model, same errors", c.max_point_linear, scale, Series::Style::Dashed));
   f.panels.push_back(std::move(worst));
   return f;
 }
@@ -239,8 +312,34 @@ std::string row(const char* what, const ErrorQuantiles& mc, const ErrorQuantiles
                      mc.median / lin.median, mc.p95 / lin.p95);
 }
 
+// Who drives the platforms, for the report.
+std::string controller_text(const ToleranceCommandOptions& o, const CalibrationChoice& c) {
+  if (c.name == "none") return "the nominal compensated commands";
+  if (c.name == "perfect") return "a perfectly calibrated controller's compensated commands";
+  return fmt::format(
+      "the compensated commands of each platform's controller after a tracker calibration ({}; {:g} um noise, {} "
+      "points a station; errors in the {} frames)",
+      c.name == "plan" ? fmt::format("{} stations of {}", c.plan.size(), printable(o.station_plan)) : c.name,
+      1e6 * c.tracker_noise, c.points, o.calibration_frames == "joints" ? "joints' least-squares" : "tracker's");
+}
+
+// The platforms whose calibration failed, by status.
+std::string calibration_failures(const ToleranceSummary& sm) {
+  std::uint64_t failed = 0;
+  std::string by;
+  for (std::size_t k = 1; k < sm.calibration.size(); ++k)
+    if (sm.calibration[k] > 0) {
+      failed += sm.calibration[k];
+      by += fmt::format("{}{} {}", by.empty() ? "" : ", ", to_string(static_cast<Status>(k)), sm.calibration[k]);
+    }
+  if (failed == 0) return {};
+  return fmt::format("calibration failed on {} of {} platforms ({}): all their poses count as failures\n", failed,
+                     sm.platforms, by);
+}
+
 std::string report_text(const Model& model, const ToleranceCommandOptions& o, const RequiredPoses& req,
-                        const ToleranceSigmas& s, const ToleranceSummary& sm, int workers, double seconds) {
+                        const ToleranceSigmas& s, const CalibrationChoice& c, const ToleranceSummary& sm, int workers,
+                        double seconds) {
   std::string out = fmt::format("hexatwist tolerance on {}: {}\n", model_source(o.model), model.spec().name);
   out += fmt::format("required workspace: {}\n", req.description);
   out += fmt::format(
@@ -248,23 +347,29 @@ std::string report_text(const Model& model, const ToleranceCommandOptions& o, co
       "axis; U-joint axes {:g} deg; lead {:g} ppm; zero offsets {:g} um\n",
       1e6 * s.base_joint, 1e6 * s.platform_joint, rad2deg(s.base_axis), 1e6 * s.lead, 1e6 * s.offset);
   out +=
-      fmt::format("{} platforms (seed {}) x {} poses, driven by {} compensated commands{} in {:.1f} s\n", sm.platforms,
-                  o.seed, sm.poses, o.calibration == "perfect" ? "a perfectly calibrated controller's" : "the nominal",
+      fmt::format("{} platforms (seed {}) x {} poses, driven by {}{} in {:.1f} s\n", sm.platforms, o.seed, sm.poses,
+                  controller_text(o, c),
                   workers > 0 ? fmt::format(" on {} Dask workers ({})", workers, printable(o.scheduler)) : "", seconds);
+  out += calibration_failures(sm);
   if (sm.failures > 0)
     out += fmt::format("failures: {} (platform, pose) pairs without an error (refused or forward kinematics failed)\n",
                        sm.failures);
+  // After a tracker calibration the errors are micrometres.
+  const bool um = tracker_calibration(c);
+  const double scale = um ? 1e6 : 1e3;
+  const char* length = um ? "um" : "mm";
   out += fmt::format("\n{:<24}{:>30}   {:>20}   {:>14}\n", "", "Monte Carlo", "linearised", "MC / linear");
   out += fmt::format("{:<24}{:>10}{:>10}{:>10}   {:>10}{:>10}   {:>7}{:>7}\n", "error", "median", "p95", "max",
                      "median", "p95", "median", "p95");
-  out += row("point A [mm]", sm.point, sm.point_linear, 1e3);
-  out += row("pivot position [mm]", sm.position, sm.position_linear, 1e3);
-  out += row("orientation [mrad]", sm.orientation, sm.orientation_linear, 1e3);
+  out += row(fmt::format("point A [{}]", length).c_str(), sm.point, sm.point_linear, scale);
+  out += row(fmt::format("pivot position [{}]", length).c_str(), sm.position, sm.position_linear, scale);
+  out += row(um ? "orientation [urad]" : "orientation [mrad]", sm.orientation, sm.orientation_linear, scale);
   out += fmt::format(
-      "worst over the workspace, per platform: point A {:.4f} mm median, {:.4f} mm p95, {:.4f} mm max (the linear "
-      "model with the same errors: {:.4f}, {:.4f}, {:.4f} mm)\n",
-      1e3 * sm.worst_point.median, 1e3 * sm.worst_point.p95, 1e3 * sm.worst_point.max,
-      1e3 * sm.worst_point_linear.median, 1e3 * sm.worst_point_linear.p95, 1e3 * sm.worst_point_linear.max);
+      "worst over the workspace, per platform: point A {:.4f} {} median, {:.4f} {} p95, {:.4f} {} max (the linear "
+      "model with the same errors: {:.4f}, {:.4f}, {:.4f} {})\n",
+      scale * sm.worst_point.median, length, scale * sm.worst_point.p95, length, scale * sm.worst_point.max, length,
+      scale * sm.worst_point_linear.median, scale * sm.worst_point_linear.p95, scale * sm.worst_point_linear.max,
+      length);
   return out;
 }
 
@@ -278,29 +383,27 @@ int run_tolerance(const ToleranceCommandOptions& o) {
   OutputFiles set("tolerance");
   set.input("--config", o.model.config);
   for (const std::string& t : o.required.trajectories) set.input("--trajectory", t);
+  if (!o.station_plan.empty()) set.input("--station-plan", o.station_plan);
   set.folder("--out", o.out);
   const RequiredPoses req = required_poses(config, o.required);
 
-  // The linear model (no sample in it) here; the samples here or on the cluster.
+  // The calibration and the linear model (no sample in it) here; the samples here or on the cluster.
+  const CalibrationChoice calibration = calibration_of(o);
+  ToleranceOptions to;
+  to.sigmas = sigmas;
+  to.seed = o.seed;
+  to.threads = 0;
   ToleranceLinear linear;
-  if (const Status s = tolerance_linear(model, req.poses, sigmas, linear, 0); s != Status::Ok)
-    throw ExitError(kExitOutOfLimit, fmt::format("the linear model failed: {} ({})", describe(s), to_string(s)));
+  const Status prepared = prepare_calibration(model, req.poses, calibration, to, linear);  // names its option
+  if (prepared != Status::Ok)
+    throw ExitError(kExitOutOfLimit,
+                    fmt::format("the linear model failed: {} ({})", describe(prepared), to_string(prepared)));
   int workers = 0;
   ToleranceChunk chunk;
   if (!o.scheduler.empty()) {
-    chunk = chunk_on_cluster(o, req, sigmas, workers);
-  } else {
-    ToleranceOptions to;
-    to.sigmas = sigmas;
-    to.seed = o.seed;
-    to.threads = 0;
-    if (o.calibration == "perfect")
-      to.calibration = [](const Model&, const Model& real, std::uint64_t, ModelSpec& controller) {
-        controller = real.spec();
-        return Status::Ok;
-      };
-    if (const Status s = tolerance_chunk(model, req.poses, to, 0, o.platforms, chunk, &linear); s != Status::Ok)
-      throw ExitError(kExitOutOfLimit, fmt::format("the study failed: {} ({})", describe(s), to_string(s)));
+    chunk = chunk_on_cluster(o, req, sigmas, calibration, workers);
+  } else if (const Status s = tolerance_chunk(model, req.poses, to, 0, o.platforms, chunk, &linear); s != Status::Ok) {
+    throw ExitError(kExitOutOfLimit, fmt::format("the study failed: {} ({})", describe(s), to_string(s)));
   }
   const ToleranceSummary sm = summarize_tolerance(chunk, req.poses.size(), &linear, 0);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -310,18 +413,18 @@ int run_tolerance(const ToleranceCommandOptions& o) {
   if (!o.no_csv) names.push_back("platforms.csv");
   std::vector<Figure> figs;
   if (!o.no_figures) {
-    figs.push_back(figure((dir / "tolerance").string(), chunk, linear, sm));
+    figs.push_back(figure((dir / "tolerance").string(), chunk, linear, sm, tracker_calibration(calibration)));
     names.insert(names.end(), {"tolerance.png", "tolerance.svg"});
   }
   names.push_back("summary.json");
   if (!o.no_csv) set.add((dir / "platforms.csv").string(), platforms_csv(chunk));
-  const std::string json = summary_json(model, o, req, sigmas, sm, workers, seconds, names);
+  const std::string json = summary_json(model, o, req, sigmas, calibration, sm, workers, seconds, names);
   set.add((dir / "summary.json").string(), json);
   set.stage();
   for (Figure& f : figs) f.stem = set.external(f.stem, {".png", ".svg"});
   if (!figs.empty()) write_figures(figs);
   set.commit();
-  std::string text = o.json ? json : report_text(model, o, req, sigmas, sm, workers, seconds);
+  std::string text = o.json ? json : report_text(model, o, req, sigmas, calibration, sm, workers, seconds);
   if (!o.json) text += fmt::format("\n{} files written to {}\n", set.paths().size(), o.out);
   set.finish(text);
   return kExitOk;
@@ -357,10 +460,30 @@ Command make_tolerance_command(CLI::App& root) {
       ->capture_default_str();
   app->add_option("--sigma-offset-um", o->offset_um, "Zero offsets, the legs' lengths at the drives' reference [um]")
       ->capture_default_str();
-  app->add_option("--calibration", o->calibration,
-                  "none: the controller runs the nominal configuration; perfect: it runs each real platform's own "
-                  "(the floor a calibration reaches; the calibration subsystem plugs in here)")
-      ->check(CLI::IsMember({"none", "perfect"}))
+  app->add_option(
+         "--calibration", o->calibration,
+         "none: the controller runs the nominal configuration; perfect: it runs each real platform's own "
+         "(the floor); stations:N[,SEED]: each platform calibrated as identify does (geometry model, a lead "
+         "per leg) from a tracker's points at home, N random stations (+-0.25 m, +-15 deg; seed SEED, "
+         "default 1: the stations of synth --stations N --station-seed SEED) and home, the controller "
+         "running the corrected configuration, the linearised answer from the identification's covariance, errors "
+         "reported in um and urad; plan: the stations of --station-plan")
+      ->capture_default_str();
+  app->add_option("--station-plan", o->station_plan,
+                  "A stations run CSV (synth --run-out): each platform calibrated from a tracker's points at the "
+                  "poses the run holds (the plan calibration; with --calibration none or plan)");
+  app->add_option("--tracker-noise-um", o->tracker_noise_um,
+                  "The calibration's tracker: Gaussian noise per coordinate [um]")
+      ->capture_default_str();
+  app->add_option("--points-per-station", o->points_per_station,
+                  "The calibration's tracker: points recorded at each station (the noise from their scatter; 1: "
+                  "the identification is told --tracker-noise-um)")
+      ->capture_default_str();
+  app->add_option("--calibration-frames", o->calibration_frames,
+                  "After a tracker calibration, the frames of the errors: tracker (the base as the tracker sees it "
+                  "through the identified tracker frame: what a tracker check of the calibrated machine measures) or "
+                  "joints (the least-squares frames of the real joints, the identification's gauge)")
+      ->check(CLI::IsMember({"tracker", "joints"}))
       ->capture_default_str();
   app->add_option("--out", o->out, "Output folder (created if missing), written as a set: all files or none (exit 4)")
       ->capture_default_str();

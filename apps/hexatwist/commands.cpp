@@ -1,6 +1,8 @@
 // Every subcommand of the tool, registered in the order `--help` lists them.
 #include <charconv>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
 
 #include "cli_common.hpp"
 
@@ -19,6 +21,19 @@ const CLI::Validator kWholeNumber(
     },
     "", "whole number");
 
+// No floating-point option means anything at NaN or an infinity (and an option whose absence is
+// NaN would take a typed "nan" for absent): every one takes a finite number, or is refused naming
+// itself.
+const CLI::Validator kFiniteNumber(
+    [](std::string& text) {
+      char* end = nullptr;
+      const double v = std::strtod(text.c_str(), &end);
+      if (!text.empty() && end == text.c_str() + text.size() && !std::isfinite(v))
+        return std::string("expected a finite number, got '") + printable(text) + "'";
+      return std::string();
+    },
+    "", "finite number");
+
 }  // namespace
 
 // Where to measure (cmd_stations.cpp).
@@ -36,7 +51,10 @@ std::vector<Command> add_commands(CLI::App& app) {
       make_fk_command(app),      make_config_command(app),    make_linuxcnc_command(app), make_mjcf_command(app)};
   for (const Command& c : commands)
     for (CLI::Option* opt : c.app->get_options())
-      if (opt->get_type_name() == "UINT") opt->check(kWholeNumber);
+      if (opt->get_type_name() == "UINT")
+        opt->check(kWholeNumber);
+      else if (opt->get_type_name() == "FLOAT")
+        opt->check(kFiniteNumber);
   return commands;
 }
 

@@ -19,15 +19,6 @@ RequiredWorkspaceSpec required_spec(bool tests, int test_samples, int random, do
   return s;
 }
 
-py::array_t<double> pose_rows(const std::vector<Pose>& poses) {
-  py::array_t<double> a({poses.size(), std::size_t{6}});
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    const Vector6d q = poses[k].to_vector();
-    std::copy(q.data(), q.data() + 6, a.mutable_data() + 6 * k);
-  }
-  return a;
-}
-
 std::vector<Pose> poses_of(const py::handle& obj) {
   const Rows6 r = rows6(obj, "poses", false);
   std::vector<Pose> poses(r.rows);
@@ -92,7 +83,7 @@ py::dict evaluation_dict(const DesignEvaluation& e) {
   d["poses"] = e.poses;
   d["reached"] = e.reached;
   d["max_twist"] = e.max_twist;
-  d["twist_leg"] = e.twist_leg;
+  d["twist_leg"] = leg_number(e.twist_leg);
   d["twist_pose"] = e.twist_pose;
   d["max_length_error"] = e.max_length_error;
   d["max_lead_sensitivity"] = e.max_lead_sensitivity;
@@ -169,10 +160,10 @@ py::dict design_py(const py::object& config, const py::object& poses_in, const p
 void expose_axis_design(py::module_& m) {
   const RequiredWorkspaceSpec w;
   const DesignOptions o;
-  m.def("_required_workspace", &required_py, py::arg("config"), py::arg("tests") = w.tests,
+  m.def("_required_workspace", &required_py, py::arg("platform"), py::arg("tests") = w.tests,
         py::arg("test_samples") = w.test_samples, py::arg("random") = w.random, py::arg("linear") = w.linear,
         py::arg("angular") = w.angular, py::arg("seed") = w.seed, py::arg("strategy") = "compensated");
-  m.def("_design_axes", &design_py, py::arg("config"), py::arg("poses"), py::arg("required"),
+  m.def("_design_axes", &design_py, py::arg("platform"), py::arg("poses"), py::arg("required"),
         py::arg("objective") = "twist", py::arg("symmetry") = "symmetric", py::arg("tilt") = o.tilt,
         py::arg("max_tilt") = o.max_tilt, py::arg("grid_step") = o.grid_step, py::arg("fine_step") = o.fine_step,
         py::arg("clearance") = o.clearance, py::arg("max_volume_loss") = o.max_volume_loss,

@@ -29,7 +29,7 @@ py::dict commands_batch(const Model& model, const py::object& poses_in, const st
       for (std::size_t i = 0; i < m; ++i) {
         const LimitReport& r = reports[i];
         ps[first + i] = static_cast<std::int8_t>(r.status);
-        pg[first + i] = static_cast<std::int8_t>(r.leg);
+        pg[first + i] = static_cast<std::int8_t>(leg_number(r.leg));
         pv[first + i] = r.value;
         pb[first + i] = r.bound;
       }
@@ -72,9 +72,7 @@ py::array_t<double> motor_command(const Model& model, const py::object& pose_in,
   LimitReport r;
   const Status s = motor_commands(model, pose, strategy, c, r);
   if (s == Status::NonFiniteInput) raise_input("pose: holds NaN or inf");
-  if (s != Status::Ok)
-    raise_status(s, "pose outside a limit (leg " + std::to_string(r.leg + 1) + ", value " + std::to_string(r.value) +
-                        ", bound " + std::to_string(r.bound) + ")");
+  if (s != Status::Ok) raise_status(s, "pose outside a limit (" + limit_text(r) + ")");
   py::array_t<double> out(6);
   std::copy(c.data(), c.data() + 6, out.mutable_data());
   return out;

@@ -78,6 +78,14 @@ void parallel_blocks(std::size_t n, F&& body, std::size_t block = kBlock) {
   for (auto& t : threads) t.join();
 }
 
+/// Poses [m, rad] as a new (N, 6) array.
+py::array_t<double> pose_rows(const std::vector<Pose>& poses);
+/// A trajectory's sample times (T,) [s] and poses (T, 6) [m, rad]: a dict {"t", "poses"}.
+py::dict trajectory_arrays(const Trajectory& trajectory);
+/// Poses (T, 6) at times (T,) [s], as a file gives them; InputError naming `times_name` unless there is
+/// one time per pose.
+TimedPoses timed_poses_of(const py::object& times, const char* times_name, const py::object& poses);
+
 /// The pose of row `i` of an (N, 6) row-major array.
 inline Pose pose_row(const double* data, std::size_t i) noexcept {
   const double* q = data + 6 * i;
@@ -99,8 +107,6 @@ struct PyRig {
 };
 /// The Rig of a `config` argument: a Rig itself, or one built from YAML text, a path or None (seed).
 std::shared_ptr<const PyRig> rig_of(const py::handle& src);
-/// A copy of that configuration.
-Config python_config(const py::object& src);
 
 /// A platform argument of the design functions: a Model, or a config (Rig, YAML text, path, None
 /// for the seed) with its study section and its text (empty for a Model).
@@ -121,8 +127,15 @@ WorkspaceOptions search_options(double step, double tolerance, const std::string
 WorkspaceSlice slice_of(const Model& model, const py::object& orientation, const std::string& plane, double offset,
                         double spacing, double step, double tolerance, const std::string& strategy, const char* what);
 
-/// A limit report as a dict: status (name), leg (0-based), value, bound.
+/// The leg number the package reports for a library leg index: 1 to 6, and 0 for none (the
+/// library's -1: no limit, or the platform Jacobian's condition). Every `leg` field and array of
+/// the Python package is numbered so, as the command line's messages and JSON are.
+constexpr int leg_number(int index) noexcept { return index + 1; }
+
+/// A limit report as a dict: status (name), leg (1 to 6; 0 for none), value, bound.
 py::dict limit_dict(const LimitReport& r);
+/// "leg 2, value 2.5, bound 2.45" (no leg for a limit of the whole platform), for messages.
+std::string limit_text(const LimitReport& r);
 
 /// A (6,) float64 vector argument (lists accepted); InputError naming it otherwise, or for NaN/inf.
 Vector6d vector6(const py::handle& obj, const char* name);
@@ -148,6 +161,7 @@ void expose_measurement(py::module_& m);
 void expose_identification(py::module_& m);
 void expose_station_plan(py::module_& m);
 void expose_stream(py::module_& m);
+void expose_trajectory(py::module_& m);
 void expose_rig(py::module_& m);
 void expose_mechanism(py::module_& m);
 void expose_motor_sizing(py::module_& m);

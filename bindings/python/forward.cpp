@@ -142,8 +142,9 @@ void expose_forward(py::module_& m) {
       .def("set", &tracker_set, py::arg("pose"),
            "Sets the tracker to a known pose [x, y, z m, roll, pitch, yaw rad] (after homing) and its assembly "
            "mode. Raises StatusError where the pose has no inverse kinematics or a singular Jacobian.")
-      .def("track", &tracker_track, py::arg("lengths"), py::arg("max_iterations") = 30, py::arg("tolerance") = 1e-12,
-           "Solves (N, 6) or (6,) leg lengths [m] in order (GIL released). Returns a dict: poses (N, 6) [m, rad] "
+      .def("_track", &tracker_track, py::arg("lengths"), py::arg("max_iterations") = 30, py::arg("tolerance") = 1e-12,
+           "Solves (N, 6) or (6,) leg lengths [m] in order (GIL released); hexatwist.FkTracker.track types the "
+           "result. Returns a dict: poses (N, 6) [m, rad] "
            "(NaN unless ok), status (N,) int8 (ok, assembly_mode_changed, platform_singularity, no_convergence, "
            "...), iterations (N,) int32, residual (N,) [m], condition (N,) [-] and det_sign (N,) [-].")
       .def_property_readonly(

@@ -7,8 +7,6 @@
 
 namespace hexatwist::python {
 
-std::pair<std::string, std::string> read_config_source(const py::object& path_or_text);
-
 // Per-observation target indices (None: every observation is target 0).
 std::vector<int> targets_of(const py::object& targets, std::size_t n) {
   std::vector<int> out(n, 0);
@@ -106,7 +104,7 @@ py::dict corrected_dict(const ModelSpec& c) {
   py::dict d;
   LegVectors base, platform, base_axes, platform_axes;
   Vector6d leads, offsets, homes, drives;
-  py::list threads;
+  py::list hands;
   for (int i = 0; i < kLegs; ++i) {
     const LegSpec& leg = c.legs[static_cast<std::size_t>(i)];
     base.row(i) = leg.base_B.transpose();
@@ -117,14 +115,14 @@ py::dict corrected_dict(const ModelSpec& c) {
     offsets[i] = leg.length_offset;
     homes[i] = leg.home_command;
     drives[i] = leg.drive_lead;
-    threads.append(leg.thread == ThreadSense::Right ? "right" : "left");
+    hands.append(leg.thread == ThreadSense::Right ? "right" : "left");
   }
   d["base_joints"] = legs3(base);
   d["platform_joints"] = legs3(platform);
   d["base_axes"] = legs3(base_axes);
   d["platform_axes"] = legs3(platform_axes);
   d["leads"] = array(leads);
-  d["threads"] = py::tuple(threads);
+  d["thread_hands"] = py::tuple(hands);
   d["length_offsets"] = array(offsets);
   d["home_commands"] = array(homes);
   d["drive_leads"] = array(drives);
@@ -185,7 +183,7 @@ py::dict result(const Identification& id, Status s) {
   py::list worst;
   for (const StationResidual& w : id.worst) {
     py::dict r;
-    r["station"] = w.station;
+    r["station"] = w.station + 1;  // 1-based, as the command line reports it
     r["target"] = w.target;
     r["first"] = w.first;
     r["count"] = w.count;
@@ -254,10 +252,10 @@ py::dict identify_py(const Model& model, const py::object& motor, const py::obje
   return result(id, s);
 }
 
+// The configuration of a Rig (its text), YAML text, a path or None (the seed) with its platform replaced.
 std::string corrected_config_py(const py::object& config, const Model& corrected, const std::string& header) {
-  auto [text, source] =
-      config.is_none() ? std::pair{std::string(seed_config_yaml()), std::string("seed")} : read_config_source(config);
-  return platform_config_yaml(text, source, corrected.spec(), header, true);
+  const auto rig = rig_of(config);
+  return platform_config_yaml(rig->yaml, rig->source, corrected.spec(), header, true);
 }
 
 }  // namespace
@@ -267,7 +265,7 @@ void expose_identification(py::module_& m) {
         py::arg("targets") = py::none(), py::arg("calibration") = "geometry", py::arg("lead_effect") = "travel",
         py::arg("axes") = "auto", py::arg("tracker_noise") = py::none(), py::arg("folds") = 5,
         py::arg("accuracy_poses") = 1000);
-  m.def("_corrected_config", &corrected_config_py, py::arg("config"), py::arg("corrected"), py::arg("header") = "");
+  m.def("_corrected_config", &corrected_config_py, py::arg("rig"), py::arg("corrected"), py::arg("header") = "");
 }
 
 }  // namespace hexatwist::python

@@ -1,5 +1,7 @@
 // Batch inverse kinematics and twist over (N, 6) poses: leg lengths, unit axes, U-joint bends,
-// twist relative to home and the length error it causes (Eq. 1-10).
+// twist relative to home and the length error it causes (Eq. 1-10); where a platform point is.
+#include <cmath>
+
 #include "common.hpp"
 
 namespace hexatwist::python {
@@ -107,11 +109,30 @@ py::dict twist_batch(const Model& model, const py::object& poses_in) {
   return d;
 }
 
+// Where a platform point (given in P) is in the base frame at each pose: platform_point_B.
+py::array_t<double> platform_points(const Model& model, const py::object& poses_in, const py::object& point_in) {
+  const Rows6 poses = rows6(poses_in, "poses");
+  const Vector3d p_P = point_in.is_none() ? model.spec().observation_P : vector3(point_in, "point");
+  const std::size_t n = poses.rows;
+  for (std::size_t i = 0; i < 6 * n; ++i)
+    if (!std::isfinite(poses.data[i])) raise_input("poses: row " + std::to_string(i / 6) + " holds NaN or inf");
+  auto out = new_rows(n, 3, poses.single);
+  double* po = out.mutable_data();
+  parallel_blocks(n, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vector3d p_B = platform_point_B(model, placement_from_pose(pose_row(poses.data, i)), p_P);
+      for (int k = 0; k < 3; ++k) po[3 * i + k] = p_B[k];
+    }
+  });
+  return out;
+}
+
 }  // namespace
 
 void expose_kinematics(py::module_& m) {
   m.def("_ik", &ik_batch, py::arg("model"), py::arg("poses"), py::arg("lengths_only") = false);
   m.def("_twist", &twist_batch, py::arg("model"), py::arg("poses"));
+  m.def("_platform_points", &platform_points, py::arg("model"), py::arg("poses"), py::arg("point") = py::none());
 }
 
 }  // namespace hexatwist::python

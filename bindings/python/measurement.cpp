@@ -7,7 +7,6 @@
 namespace hexatwist::python {
 
 std::pair<std::string, std::string> read_yaml_source(const py::object& path_or_text);
-Config python_config(const py::object& src);
 
 std::vector<int> targets_of(const py::object& targets, std::size_t n);
 
@@ -49,23 +48,10 @@ py::dict point_log(const py::object& src, const std::string& time_column, double
   return d;
 }
 
-py::dict run_dict(const Trajectory& tr) {
-  py::array_t<double> t(static_cast<py::ssize_t>(tr.poses.size()));
-  py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
-  for (std::size_t k = 0; k < tr.poses.size(); ++k) {
-    t.mutable_data()[k] = tr.time(k);
-    const Vector6d v = tr.poses[k].to_vector();
-    std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
-  }
-  py::dict d;
-  d["t"] = t;
-  d["poses"] = q;
-  return d;
-}
-
 py::dict stations_run(const py::object& config_src, int count, std::uint64_t seed, const std::string& strategy,
                       double translation, double rotation, const py::object& stations) {
-  const Config config = python_config(config_src);
+  const auto rig = rig_of(config_src);
+  const Config& config = *rig->config;
   StationsSpec spec;
   spec.count = count;
   spec.seed = seed;
@@ -80,7 +66,7 @@ py::dict stations_run(const py::object& config_src, int count, std::uint64_t see
   }
   const Trajectory tr =
       station_run(config.rig.model(), strategy_from(strategy), poses, spec, config.rig.control_period());
-  py::dict d = run_dict(tr);
+  py::dict d = trajectory_arrays(tr);
   py::array_t<double> st({static_cast<py::ssize_t>(poses.size()), py::ssize_t{6}});
   for (std::size_t i = 0; i < poses.size(); ++i)
     std::copy(poses[i].data(), poses[i].data() + 6, st.mutable_data() + 6 * i);
@@ -88,38 +74,15 @@ py::dict stations_run(const py::object& config_src, int count, std::uint64_t see
   return d;
 }
 
-TimedPoses timed(const py::array& t, const py::array& poses) {
-  std::size_t nt = 0, np = 0;
-  if (!py::isinstance<py::array_t<double>>(t) || t.ndim() != 1) raise_input("t: expected a 1-D float64 array [s]");
-  const Rows6 q = rows6(poses, "poses", false);
-  nt = static_cast<std::size_t>(t.shape(0));
-  np = q.rows;
-  if (nt != np) raise_input("t and poses: expected as many times as poses");
-  py::array tc = py::module_::import("numpy").attr("ascontiguousarray")(t);
-  TimedPoses tp;
-  tp.t.assign(static_cast<const double*>(tc.data()), static_cast<const double*>(tc.data()) + nt);
-  tp.poses.resize(np);
-  for (std::size_t i = 0; i < np; ++i) tp.poses[i] = pose_row(q.data, i);
-  return tp;
-}
-
 py::dict measured_test(const py::object& config_src, const std::string& test) {
-  const Config config = python_config(config_src);
+  const auto rig = rig_of(config_src);
+  const Config& config = *rig->config;
   for (const StudyTest& st : seed_tests(config.study)) {
     if (st.name != test) continue;
     double end = 0.0;
     const Trajectory tr =
         measured_test_trajectory(config.study, st, CalibrationSpec{}, config.rig.control_period(), end);
-    py::array_t<double> t(static_cast<py::ssize_t>(tr.poses.size()));
-    py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
-    for (std::size_t k = 0; k < tr.poses.size(); ++k) {
-      t.mutable_data()[k] = tr.time(k);
-      const Vector6d v = tr.poses[k].to_vector();
-      std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
-    }
-    py::dict d;
-    d["t"] = t;
-    d["poses"] = q;
+    py::dict d = trajectory_arrays(tr);
     d["calibration_end"] = end;
     return d;
   }
@@ -129,7 +92,7 @@ py::dict measured_test(const py::object& config_src, const std::string& test) {
 py::dict observations(const Model& model, const py::array& t, const py::array& poses, const py::array& stamps,
                       const py::array& points, const py::object& targets, double time_offset,
                       const std::string& strategy, double settle) {
-  const TimedPoses tp = timed(t, poses);
+  const TimedPoses tp = timed_poses_of(t, "t", poses);
   PointLog log;
   std::size_t ns = 0, np = 0;
   if (!py::isinstance<py::array_t<double>>(stamps) || stamps.ndim() != 1)
@@ -163,7 +126,7 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
   d["points"] = pts;
   d["targets"] = tg;
   d["index"] = py::cast(set.points);
-  d["poses"] = set.poses;
+  d["stations"] = set.poses;
   return d;
 }
 
@@ -172,10 +135,10 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
 void expose_measurement(py::module_& m) {
   m.def("_read_point_log", &point_log, py::arg("path_or_text"), py::arg("time_column") = "t",
         py::arg("length_unit") = 0.0, py::arg("indexed") = false, py::arg("target_column") = "");
-  m.def("_stations_run", &stations_run, py::arg("config") = py::none(), py::arg("count") = 40, py::arg("seed") = 1,
+  m.def("_stations_run", &stations_run, py::arg("rig") = py::none(), py::arg("count") = 40, py::arg("seed") = 1,
         py::arg("strategy") = "compensated", py::arg("translation") = 0.25, py::arg("rotation") = deg2rad(15.0),
         py::arg("stations") = py::none());
-  m.def("_measured_test", &measured_test, py::arg("config") = py::none(), py::arg("test") = "Rz");
+  m.def("_measured_test", &measured_test, py::arg("rig") = py::none(), py::arg("test") = "Rz");
   m.def("_observations_at_rest", &observations, py::arg("model"), py::arg("t"), py::arg("poses"), py::arg("stamps"),
         py::arg("points"), py::arg("targets") = py::none(), py::arg("time_offset") = 0.0,
         py::arg("strategy") = "compensated", py::arg("settle") = 0.25);

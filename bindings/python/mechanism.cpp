@@ -121,7 +121,7 @@ void check(Status s, const char* what) {
 }  // namespace
 
 void expose_mechanism(py::module_& m) {
-  m.def("_inverse_dynamics", &inverse_dynamics_batch, py::arg("config"), py::arg("poses"), py::arg("pose_rates"),
+  m.def("_inverse_dynamics", &inverse_dynamics_batch, py::arg("rig"), py::arg("poses"), py::arg("pose_rates"),
         py::arg("pose_accelerations"));
   m.def("_platform_motion", &platform_motion_batch, py::arg("poses"), py::arg("pose_rates"),
         py::arg("pose_accelerations"));
@@ -133,7 +133,7 @@ void expose_mechanism(py::module_& m) {
         check(mechanism_mass_matrix(rig->config->rig, placement_of(pose), M), "mass_matrix");
         return matrix6(M);
       },
-      py::arg("config"), py::arg("pose"),
+      py::arg("rig"), py::arg("pose"),
       "The mechanism's mass matrix M (6, 6) at `pose` [m, rad], every body included: kinetic energy = "
       "1/2 x'^T M x' with x' = [v of the pivot [m/s, B]; w [rad/s, B]]; units kg, kg m, kg m^2 by block. "
       "Raises StatusError where the pose has no inverse kinematics or twist.");
@@ -145,7 +145,7 @@ void expose_mechanism(py::module_& m) {
         check(mechanism_bias(rig->config->rig, placement_of(pose), vector6(velocity, "velocity"), b), "bias");
         return array6(b);
       },
-      py::arg("config"), py::arg("pose"), py::arg("velocity"),
+      py::arg("rig"), py::arg("pose"), py::arg("velocity"),
       "Generalised force of everything but the motors and friction at zero acceleration (velocity products "
       "minus gravity) (6,) [N; N m, B], so that M x'' + bias = J_phi^T (torque - friction). `velocity` = "
       "[v of the pivot m/s; w rad/s, B].");
@@ -159,7 +159,7 @@ void expose_mechanism(py::module_& m) {
               "forward_dynamics");
         return array6(a);
       },
-      py::arg("config"), py::arg("pose"), py::arg("velocity"), py::arg("torque"),
+      py::arg("rig"), py::arg("pose"), py::arg("velocity"), py::arg("torque"),
       "Platform acceleration x'' (6,) [v' m/s^2; w' rad/s^2, B] for the net motor torques `torque` (6,) [N m] "
       "at the shafts (friction not included: pass torque - friction), from M x'' = J_phi^T torque - bias, at "
       "`pose` [m, rad] moving with `velocity` [v of the pivot m/s; w rad/s, B].");
@@ -171,7 +171,7 @@ void expose_mechanism(py::module_& m) {
         check(kinetic_energy(rig->config->rig, placement_of(pose), vector6(velocity, "velocity"), e), "kinetic_energy");
         return e;
       },
-      py::arg("config"), py::arg("pose"), py::arg("velocity"),
+      py::arg("rig"), py::arg("pose"), py::arg("velocity"),
       "Kinetic energy of every body [J] at `pose` [m, rad] moving with `velocity` [v of the pivot m/s; w rad/s, B].");
   m.def(
       "potential_energy",
@@ -181,7 +181,7 @@ void expose_mechanism(py::module_& m) {
         check(potential_energy(rig->config->rig, placement_of(pose), e), "potential_energy");
         return e;
       },
-      py::arg("config"), py::arg("pose"), "Potential energy in gravity of every body, zero at home [J].");
+      py::arg("rig"), py::arg("pose"), "Potential energy in gravity of every body, zero at home [J].");
   m.def(
       "motor_angles",
       [](const py::object& config, const py::object& pose) {
@@ -190,8 +190,7 @@ void expose_mechanism(py::module_& m) {
         check(motor_angles(rig->config->rig, placement_of(pose), a), "motor_angles");
         return array6(a);
       },
-      py::arg("config"), py::arg("pose"),
-      "Motor angles relative to home (6,) [rad] at `pose` [m, rad] (twist included).");
+      py::arg("rig"), py::arg("pose"), "Motor angles relative to home (6,) [rad] at `pose` [m, rad] (twist included).");
   m.def(
       "motor_jacobian",
       [](const py::object& config, const py::object& pose) {
@@ -203,7 +202,7 @@ void expose_mechanism(py::module_& m) {
         check(motor_jacobian(r, legs, J), "motor_jacobian");
         return matrix6(J);
       },
-      py::arg("config"), py::arg("pose"),
+      py::arg("rig"), py::arg("pose"),
       "Jacobian J_phi (6, 6) of the motor angles: phi' = J_phi x', x' = [v of the pivot m/s; w rad/s, B] "
       "[rad/m | rad/rad].");
   m.def(
@@ -212,7 +211,7 @@ void expose_mechanism(py::module_& m) {
         if (!std::isfinite(speed)) raise_input("speed: expected a finite motor speed [rad/s]");
         return peak_torque_at(rig_of(config)->config->rig.servo(), speed);
       },
-      py::arg("config"), py::arg("speed"),
+      py::arg("rig"), py::arg("speed"),
       "The motor's intermittent torque envelope at `speed` [rad/s] (its magnitude is used) [N m].");
 }
 

@@ -7,7 +7,7 @@ namespace hexatwist::python {
 void expose_mjcf(py::module_& m) {
   m.def(
       "mjcf", [](const py::object& config) { return mjcf_model(rig_of(config)->config->rig); },
-      py::arg("config") = py::none(),
+      py::arg("rig") = py::none(),
       "The MJCF XML text (MuJoCo 2.2.2 or later) of a configuration (a Rig, YAML text, a path or None for the "
       "seed): base, six legs of housing, rotor, screw, rod and rod end, the platform with its payload; actuators "
       "'motorN' whose force is the motor torque [N m] (positive lengthens the leg). SI units, frame B as the "

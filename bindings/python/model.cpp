@@ -68,7 +68,25 @@ Vector3d read3(const py::handle& obj, const char* name) {
 ThreadSense thread_from(const std::string& s) {
   if (s == "right") return ThreadSense::Right;
   if (s == "left") return ThreadSense::Left;
-  raise_input("thread: expected 'right' or 'left', got '" + s + "'");
+  raise_input("thread_hand: expected 'right' or 'left', got '" + s + "'");
+}
+
+// One hand for every leg ("right" | "left") or six, legs 1 to 6 in order.
+PerLeg<ThreadSense> thread_hands_from(const py::object& obj) {
+  PerLeg<ThreadSense> hands;
+  if (py::isinstance<py::str>(obj)) {
+    hands.fill(thread_from(obj.cast<std::string>()));
+    return hands;
+  }
+  std::vector<std::string> names;
+  try {
+    names = obj.cast<std::vector<std::string>>();
+  } catch (const py::cast_error&) {
+  }
+  if (names.size() != static_cast<std::size_t>(kLegs))
+    raise_input("thread_hand: expected 'right' or 'left', or 6 of them (legs 1 to 6)");
+  for (std::size_t i = 0; i < hands.size(); ++i) hands[i] = thread_from(names[i]);
+  return hands;
 }
 DrivenSide driven_from(const std::string& s) {
   if (s == "base") return DrivenSide::Base;
@@ -78,7 +96,7 @@ DrivenSide driven_from(const std::string& s) {
 
 ModelPtr from_arrays(const py::object& base, const py::object& platform, const py::object& base_axes,
                      const py::object& platform_axes, double home_height, const py::object& lead,
-                     const std::string& thread, const std::string& driven_side, const py::object& length_offsets,
+                     const py::object& thread_hand, const std::string& driven_side, const py::object& length_offsets,
                      double length_min, double length_max, double bend_max, double singularity_margin,
                      double jacobian_condition_max, const py::object& observation_point, const py::object& pivot,
                      const std::string& name) {
@@ -90,12 +108,12 @@ ModelPtr from_arrays(const py::object& base, const py::object& platform, const p
   read_rows3(platform_axes, "platform_axes", spec.legs, &LegSpec::axis_platform_P);
   const Vector6d leads = read6(lead, "lead");
   const Vector6d offsets = read6(length_offsets, "length_offsets");
-  const ThreadSense t = thread_from(thread);
+  const PerLeg<ThreadSense> hands = thread_hands_from(thread_hand);
   const DrivenSide d = driven_from(driven_side);
   for (int i = 0; i < kLegs; ++i) {
     LegSpec& leg = spec.legs[static_cast<std::size_t>(i)];
     leg.lead = leads[i];
-    leg.thread = t;
+    leg.thread = hands[static_cast<std::size_t>(i)];
     leg.driven = d;
     leg.length_offset = offsets[i];
   }
@@ -197,17 +215,18 @@ void expose_model(py::module_& m) {
       "frame (B translated by home_height along z at home). Build with default_model(), load_model(), or "
       "Model.from_arrays(); pickles exactly.");
   c.def_static("from_arrays", &from_arrays, py::arg("base"), py::arg("platform"), py::arg("base_axes"),
-               py::arg("platform_axes"), py::arg("home_height"), py::arg("lead") = 0.010, py::arg("thread") = "right",
-               py::arg("driven_side") = "base", py::arg("length_offsets") = 0.0, py::arg("length_min"),
-               py::arg("length_max"), py::arg("bend_max"), py::arg("singularity_margin"),
-               py::arg("jacobian_condition_max") = kDefaultJacobianConditionMax,
+               py::arg("platform_axes"), py::arg("home_height"), py::arg("lead") = 0.010,
+               py::arg("thread_hand") = "right", py::arg("driven_side") = "base", py::arg("length_offsets") = 0.0,
+               py::kw_only(), py::arg("length_min"), py::arg("length_max"), py::arg("bend_max"),
+               py::arg("singularity_margin"), py::arg("jacobian_condition_max") = kDefaultJacobianConditionMax,
                py::arg("observation_point") = py::make_tuple(0.0, 0.0, 0.0),
                py::arg("pivot") = py::make_tuple(0.0, 0.0, 0.0), py::arg("name") = "",
                "Model from arrays: base (6, 3) base joint centres [m, B]; platform (6, 3) platform joint centres "
                "[m, P]; base_axes, platform_axes (6, 3) fixed U-joint axes ja [B], jd [P]; home_height [m]; lead "
-               "[m] (one or 6); thread 'right'|'left'; driven_side 'base'|'platform'; length_offsets [m] (one or "
-               "6); length_min, length_max [m]; bend_max, singularity_margin [rad]; jacobian_condition_max [-]; "
-               "observation_point, pivot [m, P]. Raises ConfigError naming the leg and field at fault.");
+               "[m] (one or 6); thread_hand 'right'|'left' (one or 6); driven_side 'base'|'platform'; "
+               "length_offsets [m] (one or 6); keyword-only: the limits length_min, length_max [m], bend_max, "
+               "singularity_margin [rad], jacobian_condition_max [-]; observation_point, pivot [m, P]; name. Rows and "
+               "entries are legs 1 to 6 in order. Raises ConfigError naming the leg and field at fault.");
   c.def_property_readonly("name", [](const Model& x) { return x.spec().name; });
   c.def_property_readonly(
       "home_height", [](const Model& x) { return x.spec().home_height; }, "[m]");
@@ -232,13 +251,13 @@ void expose_model(py::module_& m) {
       },
       "Screw lead per leg (6,) [m].");
   c.def_property_readonly(
-      "threads",
+      "thread_hands",
       [](const Model& x) {
         py::list l;
         for (const Leg& g : x.legs()) l.append(g.thread == ThreadSense::Right ? "right" : "left");
         return py::tuple(l);
       },
-      "Thread hand per leg.");
+      "Hand of each leg's screw thread, 'right' or 'left' (legs 1 to 6).");
   c.def_property_readonly(
       "length_offsets",
       [](const Model& x) {

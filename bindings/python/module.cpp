@@ -1,5 +1,6 @@
 // The hexatwist Python extension module (_hexatwist): one layer over the library, one file per
-// concept. The public API and its docstrings are in python/hexatwist/__init__.py.
+// concept. The public API, its typed results and docstrings are in python/hexatwist/ (one module per
+// subsystem); python/hexatwist/_hexatwist.pyi types this module.
 #include "common.hpp"
 
 PYBIND11_MODULE(_hexatwist, m) {
@@ -15,6 +16,7 @@ PYBIND11_MODULE(_hexatwist, m) {
   expose_identification(m);
   expose_station_plan(m);
   expose_stream(m);
+  expose_trajectory(m);
   expose_rig(m);
   expose_mechanism(m);
   expose_motor_sizing(m);

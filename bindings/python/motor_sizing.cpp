@@ -21,7 +21,7 @@ py::object violation_of(const EnvelopeViolation& v) {
   if (v.check == EnvelopeCheck::None) return py::none();
   py::dict d;
   d["check"] = std::string(to_string(v.check));
-  d["leg"] = v.leg;
+  d["leg"] = leg_number(v.leg);
   d["index"] = v.index;
   d["time"] = v.time;
   d["value"] = v.value;
@@ -70,18 +70,7 @@ Trajectory trajectory_from(const Config& config, const py::object& csv, const py
     if (!std::isfinite(q.data[i])) raise_input("poses: row " + std::to_string(i / 6) + " holds NaN or inf");
   if (!times.is_none()) {
     if (!dt_in.is_none()) raise_input("size_motors: give times or dt, not both");
-    py::array_t<double> t;
-    try {
-      t = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(times);
-    } catch (...) {
-    }
-    if (!t || t.ndim() != 1 || static_cast<std::size_t>(t.shape(0)) != q.rows)
-      raise_input("times: expected a 1-D array of as many times as poses [s]");
-    TimedPoses tp;
-    tp.t.assign(t.data(), t.data() + q.rows);
-    tp.poses.resize(q.rows);
-    for (std::size_t i = 0; i < q.rows; ++i) tp.poses[i] = pose_row(q.data, i);
-    return resample(tp, period);
+    return resample(timed_poses_of(times, "times", poses_in), period);
   }
   Trajectory tr;
   tr.t0 = t0;
@@ -125,14 +114,9 @@ py::dict size_motors_py(const py::object& config_src, const py::object& csv, con
     put(power, x.power);
     for (int t = 0; t < kTorqueTerms; ++t) put(terms[t], x.terms[t]);
   }
-  py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
-  for (std::size_t k = 0; k < tr.poses.size(); ++k) {
-    const Vector6d v = tr.poses[k].to_vector();
-    std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
-  }
   py::dict d;
   d["time"] = time;
-  d["poses"] = q;
+  d["poses"] = pose_rows(tr.poses);
   d["torque"] = torque;
   d["speed"] = speed;
   d["power"] = power;
@@ -142,7 +126,7 @@ py::dict size_motors_py(const py::object& config_src, const py::object& csv, con
   summary["status"] = std::string(to_string(status));
   summary["failed_index"] = s.failed_index;
   summary["failed_time"] = s.failed_time;
-  summary["limit_leg"] = s.limit.leg;
+  summary["limit_leg"] = leg_number(s.limit.leg);
   summary["limit_value"] = s.limit.value;
   summary["limit_bound"] = s.limit.bound;
   summary["samples"] = n;
@@ -182,7 +166,7 @@ py::dict size_motors_py(const py::object& config_src, const py::object& csv, con
 }  // namespace
 
 void expose_motor_sizing(py::module_& m) {
-  m.def("_size_motors", &size_motors_py, py::arg("config") = py::none(), py::arg("trajectory") = py::none(),
+  m.def("_size_motors", &size_motors_py, py::arg("rig") = py::none(), py::arg("trajectory") = py::none(),
         py::arg("times") = py::none(), py::arg("poses") = py::none(), py::arg("dt") = py::none(), py::arg("t0") = 0.0,
         py::arg("envelope_points") = 64);
   py::list names;

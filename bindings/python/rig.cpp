@@ -50,12 +50,18 @@ py::dict leg_body(const LegBodySpec& b) {
 
 }  // namespace
 
-std::shared_ptr<const PyRig> rig_of(const py::handle& src) {
-  if (py::isinstance<PyRig>(src)) return src.cast<std::shared_ptr<PyRig>>();
-  return rig_from_source(py::reinterpret_borrow<py::object>(src));
+// Refuses what is neither a Rig nor what builds one (a Model has no drives, no load, no rates).
+void check_source(const py::handle& src, const char* expected) {
+  if (src.is_none() || py::isinstance<py::str>(src) || py::isinstance(src, py::module_::import("os").attr("PathLike")))
+    return;
+  raise_input(std::string(expected) + ", got " + std::string(py::str(py::type::of(src).attr("__name__"))));
 }
 
-Config python_config(const py::object& src) { return *rig_of(src)->config; }
+std::shared_ptr<const PyRig> rig_of(const py::handle& src) {
+  if (py::isinstance<PyRig>(src)) return src.cast<std::shared_ptr<PyRig>>();
+  check_source(src, "rig: expected a Rig, YAML text, a path or None (the seed)");
+  return rig_from_source(py::reinterpret_borrow<py::object>(src));
+}
 
 PlatformSource platform_of(const py::handle& src) {
   PlatformSource p;
@@ -64,6 +70,8 @@ PlatformSource platform_of(const py::handle& src) {
     p.source = "model";
     return p;
   }
+  if (!py::isinstance<PyRig>(src))
+    check_source(src, "platform: expected a Model, a Rig, YAML text, a path or None (the seed)");
   const std::shared_ptr<const PyRig> rig = rig_of(src);
   p.model = std::shared_ptr<const Model>(rig, &rig->config->rig.model());
   p.study = rig->config->study;
@@ -87,10 +95,15 @@ Vector3d vector3(const py::handle& obj, const char* name) {
 py::dict limit_dict(const LimitReport& r) {
   py::dict d;
   d["status"] = std::string(to_string(r.status));
-  d["leg"] = r.leg;
+  d["leg"] = leg_number(r.leg);
   d["value"] = r.value;
   d["bound"] = r.bound;
   return d;
+}
+
+std::string limit_text(const LimitReport& r) {
+  return (r.leg >= 0 ? "leg " + std::to_string(leg_number(r.leg)) + ", " : std::string()) + "value " +
+         std::to_string(r.value) + ", bound " + std::to_string(r.bound);
 }
 
 void expose_rig(py::module_& m) {

@@ -11,8 +11,6 @@ std::pair<std::string, std::string> read_yaml_source(const py::object& path_or_t
 
 namespace {
 
-Config config_of(const py::object& src) { return python_config(src); }
-
 py::dict samples_dict(const std::vector<SimulationSample>& s) {
   const std::size_t n = s.size();
   py::array_t<double> time(static_cast<py::ssize_t>(n)), error(static_cast<py::ssize_t>(n)),
@@ -56,7 +54,7 @@ py::dict issue_dict(Status s, const SimulationIssue& issue) {
   d["status"] = std::string(to_string(s));
   d["index"] = issue.index;
   d["time"] = issue.time;
-  d["leg"] = issue.limit.leg;
+  d["leg"] = leg_number(issue.limit.leg);
   d["value"] = issue.limit.value;
   d["bound"] = issue.limit.bound;
   return d;
@@ -88,7 +86,8 @@ Trajectory trajectory_of(const Config& config, const py::object& test, const py:
 
 py::dict simulate_py(const py::object& config_src, const py::object& test, const py::object& poses,
                      const std::string& strategy, bool twist_in_plant) {
-  const Config config = config_of(config_src);
+  const auto rig = rig_of(config_src);  // built once: a Rig argument is not parsed again
+  const Config& config = *rig->config;
   const Trajectory tr = trajectory_of(config, test, poses);
   SimulationOptions options;
   options.strategy = strategy_from(strategy);
@@ -135,7 +134,8 @@ py::dict strategy_summary(const Rig& rig, const StrategyRun& r) {
 }
 
 py::dict study_py(const py::object& config_src, const py::object& test, const py::object& poses) {
-  const Config config = config_of(config_src);
+  const auto rig = rig_of(config_src);  // built once: a Rig argument is not parsed again
+  const Config& config = *rig->config;
   const Trajectory tr = trajectory_of(config, test, poses);
   TestRun run;
   SimulationIssue issue;
@@ -163,26 +163,21 @@ py::dict study_py(const py::object& config_src, const py::object& test, const py
 
 void expose_simulation(py::module_& m) {
   m.attr("MAX_TRAJECTORY_SAMPLES") = kMaxTrajectorySamples;
-  m.def("_simulate", &simulate_py, py::arg("config") = py::none(), py::arg("test") = py::none(),
+  m.def("_simulate", &simulate_py, py::arg("rig") = py::none(), py::arg("test") = py::none(),
         py::arg("poses") = py::none(), py::arg("strategy") = "compensated", py::arg("twist_in_plant") = true);
-  m.def("_study", &study_py, py::arg("config") = py::none(), py::arg("test") = py::none(),
-        py::arg("poses") = py::none());
+  m.def("_study", &study_py, py::arg("rig") = py::none(), py::arg("test") = py::none(), py::arg("poses") = py::none());
   m.def(
-      "control_period", [](const py::object& c) { return config_of(c).rig.control_period(); },
-      py::arg("config") = py::none(), "The configuration's control period [s] (poses of simulate are this far apart).");
+      "control_period", [](const py::object& c) { return rig_of(c)->config->rig.control_period(); },
+      py::arg("rig") = py::none(), "The configuration's control period [s] (poses of simulate are this far apart).");
   m.def(
       "study_trajectory",
       [](const py::object& c, const std::string& test) {
-        const Config config = config_of(c);
+        const auto rig = rig_of(c);
+        const Config& config = *rig->config;
         const Trajectory tr = trajectory_of(config, py::str(test), py::none());
-        py::array_t<double> q({static_cast<py::ssize_t>(tr.poses.size()), py::ssize_t{6}});
-        for (std::size_t k = 0; k < tr.poses.size(); ++k) {
-          const Vector6d v = tr.poses[k].to_vector();
-          std::copy(v.data(), v.data() + 6, q.mutable_data() + 6 * k);
-        }
-        return q;
+        return pose_rows(tr.poses);
       },
-      py::arg("config") = py::none(), py::arg("test") = "Rz",
+      py::arg("rig") = py::none(), py::arg("test") = "Rz",
       "Poses (T, 6) [m, rad] of one of the paper's tests (Lz, Lx, Rz, Ry), one per control period.");
 }
 

@@ -8,7 +8,7 @@
 namespace hexatwist::python {
 namespace {
 
-py::array_t<double> rows_of(const std::vector<Vector6d>& q) {
+py::array_t<double> station_rows(const std::vector<Vector6d>& q) {
   py::array_t<double> a({static_cast<py::ssize_t>(q.size()), py::ssize_t{6}});
   for (std::size_t i = 0; i < q.size(); ++i) std::copy(q[i].data(), q[i].data() + 6, a.mutable_data() + 6 * i);
   return a;
@@ -18,7 +18,7 @@ py::dict quality_dict(const StationsQuality& q) {
   py::dict d;
   d["status"] = std::string(to_string(q.status));
   d["reason"] = q.reason;
-  d["stations"] = rows_of(q.stations);
+  d["stations"] = station_rows(q.stations);
   d["criterion"] = q.criterion;
   d["sd_geometric"] = q.sd_geometric;
   d["condition"] = q.condition;
@@ -37,6 +37,8 @@ py::dict quality_dict(const StationsQuality& q) {
   a["max"] = q.accuracy.max;
   a["aligned_median"] = q.accuracy.aligned_median;
   a["aligned_max"] = q.accuracy.aligned_max;
+  a["range_low"] = py::array_t<double>(6, q.accuracy.range_low.data());
+  a["range_high"] = py::array_t<double>(6, q.accuracy.range_high.data());
   d["accuracy"] = a;
   return d;
 }
@@ -44,8 +46,8 @@ py::dict quality_dict(const StationsQuality& q) {
 py::dict plan_stations_py(const py::object& config_src, int count, std::uint64_t seed, const std::string& strategy,
                           double translation, double rotation, int candidates, const std::string& calibration,
                           double noise, int points_per_station, int accuracy_poses) {
-  const Config config = python_config(config_src);
-  const Model& model = config.rig.model();
+  const auto rig = rig_of(config_src);
+  const Model& model = rig->config->rig.model();
   const Strategy s = strategy_from(strategy);
   StationPlanSpec spec;
   if (calibration == "basic")
@@ -80,14 +82,14 @@ py::dict plan_stations_py(const py::object& config_src, int count, std::uint64_t
   d["replaced"] = plan.replaced;
   d["planned"] = quality_dict(plan.planned);
   d["random"] = quality_dict(plan.random);
-  d["stations"] = rows_of(plan.planned.stations);
+  d["stations"] = station_rows(plan.planned.stations);
   return d;
 }
 
 }  // namespace
 
 void expose_station_plan(py::module_& m) {
-  m.def("_plan_stations", &plan_stations_py, py::arg("config") = py::none(), py::arg("count") = 20, py::arg("seed") = 1,
+  m.def("_plan_stations", &plan_stations_py, py::arg("rig") = py::none(), py::arg("count") = 20, py::arg("seed") = 1,
         py::arg("strategy") = "compensated", py::arg("translation") = 0.25, py::arg("rotation") = deg2rad(15.0),
         py::arg("candidates") = 3000, py::arg("calibration") = "geometry", py::arg("noise") = 10e-6,
         py::arg("points_per_station") = 75, py::arg("accuracy_poses") = 1000);

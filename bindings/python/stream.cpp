@@ -54,7 +54,7 @@ void expose_stream(py::module_& m) {
           },
           py::arg("pose"), "Starts the stream at a pose the platform stands at [m, rad] (e.g. home).")
       .def(
-          "pose",
+          "_pose",
           [](PyStream& s, const py::object& pose) {
             StreamOutput out;
             const Status st = stream_pose(*s.model, s.settings, pose_of(pose), *s.state, out);
@@ -65,13 +65,14 @@ void expose_stream(py::module_& m) {
             d["rate_limited"] = out.rate_limited;
             d["command"] = out.action == CommandAction::None ? py::object(py::none())
                                                              : py::object(py::array_t<double>(6, out.command.data()));
-            d["leg"] = out.limit.leg;
+            d["leg"] = leg_number(out.limit.leg);
             d["value"] = out.limit.value;
             d["bound"] = out.limit.bound;
             return d;
           },
           py::arg("pose"),
-          "One input pose [x, y, z m, roll, pitch, yaw rad]: dict with input, status, action "
+          "One input pose [x, y, z m, roll, pitch, yaw rad] (hexatwist.Stream.pose types the result): dict with "
+          "input, status, action "
           "('new'|'held'|'none'), rate_limited, command (6,) [m] or None, and leg/value/bound of a limit.");
 }
 

@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 
 #include "common.hpp"
+#include "hexatwist/design/tolerance_calibration.hpp"
 
 namespace hexatwist::python {
 
@@ -47,6 +48,7 @@ py::dict chunk_dict(const ToleranceChunk& c) {
   d["max_orientation"] = array_of(c.max_orientation);
   d["max_point_linear"] = array_of(c.max_point_linear);
   d["failures"] = array_of(c.failures);
+  d["calibration"] = array_of(c.calibration);
   d["histogram_point"] = array_of(c.point.counts);
   d["histogram_position"] = array_of(c.position.counts);
   d["histogram_orientation"] = array_of(c.orientation.counts);
@@ -69,12 +71,14 @@ ToleranceChunk chunk_of(const py::dict& d) {
   c.max_orientation = vector_of<double>(d["max_orientation"], "max_orientation");
   c.max_point_linear = vector_of<double>(d["max_point_linear"], "max_point_linear");
   c.failures = vector_of<std::uint32_t>(d["failures"], "failures");
+  c.calibration = d.contains("calibration") ? vector_of<std::uint8_t>(d["calibration"], "calibration")
+                                            : std::vector<std::uint8_t>(c.failures.size(), 0);
   c.point.counts = vector_of<std::uint64_t>(d["histogram_point"], "histogram_point");
   c.position.counts = vector_of<std::uint64_t>(d["histogram_position"], "histogram_position");
   c.orientation.counts = vector_of<std::uint64_t>(d["histogram_orientation"], "histogram_orientation");
   const std::size_t n = c.max_point.size();
   if (c.rms_point.size() != n || c.max_position.size() != n || c.max_orientation.size() != n ||
-      c.max_point_linear.size() != n || c.failures.size() != n)
+      c.max_point_linear.size() != n || c.failures.size() != n || c.calibration.size() != n)
     raise_input("chunk: the per-platform arrays differ in length");
   for (const auto* h : {&c.point.counts, &c.position.counts, &c.orientation.counts})
     if (h->size() != static_cast<std::size_t>(ErrorHistogram::kBins))
@@ -82,10 +86,42 @@ ToleranceChunk chunk_of(const py::dict& d) {
   return c;
 }
 
+// The calibration `calibration` names, its tracker from `tracker` (noise [m], points_per_station,
+// frames "tracker" or "joints", stations: the plan's poses (N, 6) [m, rad from home]).
+CalibrationChoice choice_of(const std::string& calibration, const py::object& tracker) {
+  CalibrationChoice c;
+  c.name = calibration;
+  if (tracker.is_none()) return c;
+  const py::dict t = tracker;
+  for (const auto& kv : t) {
+    const std::string k = kv.first.cast<std::string>();
+    if (k != "noise" && k != "points_per_station" && k != "frames" && k != "stations")
+      raise_input("tracker: unknown key '" + k + "'; expected noise [m], points_per_station, frames, stations");
+  }
+  if (t.contains("noise")) c.tracker_noise = t["noise"].cast<double>();
+  if (t.contains("points_per_station")) c.points = t["points_per_station"].cast<int>();
+  if (t.contains("frames")) {
+    const std::string f = t["frames"].cast<std::string>();
+    if (f != "tracker" && f != "joints") raise_input("tracker: frames must be 'tracker' or 'joints', got '" + f + "'");
+    c.frames = f == "joints" ? CalibratedFrames::Joints : CalibratedFrames::Tracker;
+  }
+  if (t.contains("stations") && !t["stations"].is_none()) {
+    const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(t["stations"]);
+    if (!a || a.ndim() != 2 || a.shape(1) != 6) raise_input("tracker: stations must be an (N, 6) array [m, rad]");
+    for (py::ssize_t r = 0; r < a.shape(0); ++r) c.plan.push_back(Eigen::Map<const Vector6d>(a.data(r, 0)));
+  }
+  return c;
+}
+
+[[noreturn]] void raise_study_status(Status s) {
+  raise_status(s, s == Status::NotIdentifiable ? "tolerance: the station plan does not determine the parameters"
+                                               : "tolerance: a pose outside the nominal workspace");
+}
+
 // Platforms [first, first + count) of the study.
 py::dict chunk_py(const py::object& config, const py::object& poses_in, const py::dict& required,
                   const py::dict& sigmas, std::uint64_t seed, std::uint64_t first, std::size_t count,
-                  const std::string& calibration, bool linear_worst, int threads) {
+                  const std::string& calibration, bool linear_worst, int threads, const py::object& tracker) {
   const PlatformSource p = platform_of(config);
   const std::vector<Pose> poses = design_poses(p, poses_in, required);
   ToleranceOptions o;
@@ -93,24 +129,17 @@ py::dict chunk_py(const py::object& config, const py::object& poses_in, const py
   o.seed = seed;
   o.linear_worst = linear_worst;
   o.threads = threads;
-  if (calibration == "perfect") {
-    o.calibration = [](const Model&, const Model& real, std::uint64_t, ModelSpec& controller) {
-      controller = real.spec();
-      return Status::Ok;
-    };
-  } else if (calibration != "none") {
-    raise_input("calibration: expected 'none' or 'perfect' (a controller that knows the real platform), got '" +
-                calibration + "'");
-  }
+  const CalibrationChoice choice = choice_of(calibration, tracker);
   ToleranceLinear linear;
   ToleranceChunk c;
   Status s = Status::Ok;
   {
     py::gil_scoped_release release;
-    if (linear_worst) s = tolerance_linear(*p.model, poses, o.sigmas, linear, threads);
+    // The calibration step and its linear model (prepare_calibration throws for a bad choice).
+    s = prepare_calibration(*p.model, poses, choice, o, linear);
     if (s == Status::Ok) s = tolerance_chunk(*p.model, poses, o, first, count, c, linear_worst ? &linear : nullptr);
   }
-  if (s != Status::Ok) raise_status(s, "tolerance: a pose outside the nominal workspace");
+  if (s != Status::Ok) raise_study_status(s);
   return chunk_dict(c);
 }
 
@@ -124,19 +153,24 @@ py::dict quantiles_dict(const ErrorQuantiles& q) {
 
 // The covariance answer: median and p95 of point, position and orientation errors.
 py::dict linear_py(const py::object& config, const py::object& poses_in, const py::dict& required,
-                   const py::dict& sigmas, int threads) {
+                   const py::dict& sigmas, int threads, const std::string& calibration, const py::object& tracker,
+                   std::uint64_t seed) {
   const PlatformSource p = platform_of(config);
   const std::vector<Pose> poses = design_poses(p, poses_in, required);
-  const ToleranceSigmas s = sigmas_of(sigmas);
+  ToleranceOptions o;
+  o.sigmas = sigmas_of(sigmas);
+  o.seed = seed;
+  o.threads = threads;
+  const CalibrationChoice choice = choice_of(calibration, tracker);
   ToleranceLinear linear;
   ToleranceSummary summary;
   Status st;
   {
     py::gil_scoped_release release;
-    st = tolerance_linear(*p.model, poses, s, linear, threads);
+    st = prepare_calibration(*p.model, poses, choice, o, linear);
     if (st == Status::Ok) linear_quantiles(linear, summary, threads);
   }
-  if (st != Status::Ok) raise_status(st, "tolerance: a pose outside the nominal workspace");
+  if (st != Status::Ok) raise_study_status(st);
   py::dict d;
   d["point"] = quantiles_dict(summary.point_linear);
   d["position"] = quantiles_dict(summary.position_linear);
@@ -183,11 +217,11 @@ py::dict summary_py(const py::dict& chunk, std::size_t poses, const py::object& 
 }  // namespace
 
 void expose_tolerance(py::module_& m) {
-  m.def("_tolerance_chunk", &chunk_py, py::arg("config"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
+  m.def("_tolerance_chunk", &chunk_py, py::arg("platform"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
         py::arg("seed"), py::arg("first"), py::arg("count"), py::arg("calibration") = "none",
-        py::arg("linear_worst") = true, py::arg("threads") = 1);
-  m.def("_tolerance_linear", &linear_py, py::arg("config"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
-        py::arg("threads") = 1);
+        py::arg("linear_worst") = true, py::arg("threads") = 1, py::arg("tracker") = py::none());
+  m.def("_tolerance_linear", &linear_py, py::arg("platform"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
+        py::arg("threads") = 1, py::arg("calibration") = "none", py::arg("tracker") = py::none(), py::arg("seed") = 1);
   m.def("_tolerance_summary", &summary_py, py::arg("chunk"), py::arg("poses"), py::arg("linear"));
   m.attr("HISTOGRAM_BINS") = ErrorHistogram::kBins;
 }

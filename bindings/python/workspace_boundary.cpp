@@ -60,7 +60,7 @@ py::dict slice_py(const Model& model, const py::object& orientation, const std::
       outside.mutable_data()[3 * k + c] = p.outside[c];
     }
     status.mutable_data()[k] = static_cast<std::int8_t>(p.limit.status);
-    leg.mutable_data()[k] = static_cast<std::int8_t>(p.limit.leg);
+    leg.mutable_data()[k] = static_cast<std::int8_t>(leg_number(p.limit.leg));
     value.mutable_data()[k] = p.limit.value;
     bound.mutable_data()[k] = p.limit.bound;
     along.mutable_data()[k] = static_cast<std::int8_t>(p.along);
@@ -99,7 +99,7 @@ py::dict orientation_py(const Model& model, const py::object& position, const st
       if (t == 0) azimuth.mutable_data()[j] = r.azimuth;
       tilt.mutable_data()[t * nd + j] = r.tilt;
       status.mutable_data()[t * nd + j] = static_cast<std::int8_t>(r.limit.status);
-      leg.mutable_data()[t * nd + j] = static_cast<std::int8_t>(r.limit.leg);
+      leg.mutable_data()[t * nd + j] = static_cast<std::int8_t>(leg_number(r.limit.leg));
       value.mutable_data()[t * nd + j] = r.limit.value;
       bound.mutable_data()[t * nd + j] = r.limit.bound;
     }

@@ -34,7 +34,9 @@ py::dict map_grid_py(const Model& model, const py::object& orientation, const st
       slice_of(model, orientation, plane, offset, spacing, step, tolerance, strategy, "workspace_map"), spacing));
 }
 
-// Rows [first, first + count) of the map as arrays (count, nu).
+// Rows [first, first + count) of the map as arrays (count, nu), with the library's values: legs as
+// 0-based indices, -1 for none. They are what `python3 -m hexatwist.cluster` hands the command line;
+// hexatwist.design.workspace_map numbers the legs 1 to 6 (0: none) as every other result does.
 py::dict map_rows_py(const Model& model, const py::object& orientation, const py::dict& grid_in,
                      const std::string& strategy, int first, int count) {
   const MapGrid g = grid_of(grid_in);

@@ -41,6 +41,7 @@
 #include "hexatwist/design/axis_design.hpp"
 #include "hexatwist/design/required_workspace.hpp"
 #include "hexatwist/design/tolerance.hpp"
+#include "hexatwist/design/tolerance_calibration.hpp"
 #include "hexatwist/design/workspace_boundary.hpp"
 #include "hexatwist/design/workspace_map.hpp"
 #include "hexatwist/design/workspace_volume.hpp"

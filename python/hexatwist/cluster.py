@@ -6,13 +6,14 @@ from __future__ import annotations
 
 import json
 import sys
+from typing import IO, Any, Mapping
 
 import numpy as np
 
-from .distributed import tolerance_on, workspace_map_on, workspace_volume_on
+from .distributed import _tolerance_on, _workspace_map_on, _workspace_volume_on
 
 
-def _write_arrays(out, prefix, values):
+def _write_arrays(out: IO[str], prefix: str, values: Mapping[str, Any]) -> None:
     """Lines "name count v1 v2 ..." with floats as exact hexadecimal and integers in decimal."""
     for key, value in values.items():
         if isinstance(value, dict):
@@ -26,7 +27,7 @@ def _write_arrays(out, prefix, values):
         out.write(f"{prefix}{key} {a.size} {items}\n")
 
 
-def main(argv=None) -> int:
+def main(argv: list[str] | None = None) -> int:
     """Runs one request of the command line on a cluster: JSON on standard input with ``job``
     ("tolerance" or "workspace"), ``scheduler`` and the job's settings; the merged summaries on
     standard output. Exit 2 when the scheduler cannot be reached, 3 when the job fails (the reason on
@@ -47,19 +48,19 @@ def main(argv=None) -> int:
         config = request.get("config")
         if request["job"] == "tolerance":
             poses = np.asarray(request["poses"], dtype=np.float64) if "poses" in request else None
-            chunk, _ = tolerance_on(client, config, poses, request["workspace"], request["sigmas"], request["seed"],
+            chunk, _ = _tolerance_on(client, config, poses, request["workspace"], request["sigmas"], request["seed"],
                                     request["platforms"], request.get("calibration", "none"), True,
-                                    request.get("chunk"), linear=False)
+                                    request.get("chunk"), linear=False, tracker=request.get("tracker"))
             _write_arrays(out, "", chunk)
         elif request["job"] == "workspace":
             model = hexatwist.Rig(config).model
-            volume = workspace_volume_on(client, model, request["orientation"], request["cell"], request["refine"],
+            volume = _workspace_volume_on(client, model, request["orientation"], request["cell"], request["refine"],
                                          request["step"], request["tolerance"], "compensated", request.get("chunk"))
             _write_arrays(out, "volume.", {k: volume[k] for k in ("volume", "coarse_volume", "error", "columns")})
             grid = request.get("map_grid")
-            m = workspace_map_on(client, model, request["orientation"], None, None, None, grid, None, None,
-                                 "compensated", request.get("map_chunk"))
-            _write_arrays(out, "map.", {k: v for k, v in m.items() if k not in ("grid", "u", "v")})
+            rows, _ = _workspace_map_on(client, model, request["orientation"], None, None, None, grid, None, None,
+                                       "compensated", request.get("map_chunk"))
+            _write_arrays(out, "map.", rows)  # the library's values: legs as 0-based indices
         else:
             print(f"unknown job '{request['job']}'", file=sys.stderr)
             return 3

@@ -117,7 +117,8 @@ void axis_observability(const Model& nominal, const IdentificationOptions& optio
                         std::array<double, 2 * kLegs>& axis_sd) {
   AxisSelection all;
   all.fill(true);
-  const ParameterSet every(nominal, CalibrationModel::Geometry, options.lead_effect, all, fitted.targets());
+  const ParameterSet every(nominal, CalibrationModel::Geometry, options.lead_effect, all, fitted.targets(),
+                           options.leads);
   // The estimate in the larger layout: the same values, the axes at zero.
   Eigen::VectorXd theta = Eigen::VectorXd::Zero(every.size());
   theta.head(fitted.axis_index()) = id.estimate.head(fitted.axis_index());
@@ -304,7 +305,8 @@ Status fit_both_senses(const Model& nominal, ParameterSet& set, std::span<const 
       any = any || chosen[a];
     }
     if (any) {
-      ParameterSet with_axes(nominal, CalibrationModel::Geometry, options.lead_effect, chosen, set.targets());
+      ParameterSet with_axes(nominal, CalibrationModel::Geometry, options.lead_effect, chosen, set.targets(),
+                             options.leads);
       Eigen::VectorXd theta = Eigen::VectorXd::Zero(with_axes.size());
       theta.head(set.axis_index()) = out.estimate.head(set.axis_index());
       theta.tail(with_axes.size() - with_axes.target_index()) = out.estimate.tail(set.size() - set.target_index());
@@ -333,7 +335,8 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
   out.stations = groups.stations;
   out.groups = static_cast<int>(groups.station.size());
   // The axes, if any, are added once the rest is fitted (fit_both_senses).
-  ParameterSet set(nominal, options.model, options.lead_effect, AxisSelection{}, std::max(groups.targets, 1));
+  ParameterSet set(nominal, options.model, options.lead_effect, AxisSelection{}, std::max(groups.targets, 1),
+                   options.leads);
   out.parameters = set;
   const auto fail = [&](Status s, std::string reason = {}, std::string hint = {}) {
     if (!reason.empty()) out.reason = std::move(reason);

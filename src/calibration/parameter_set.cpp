@@ -23,7 +23,7 @@ Eigen::MatrixXd gauge_basis(const LegVectors& points) {
 }
 
 ParameterSet::ParameterSet(const Model& nominal, CalibrationModel model, LeadEffect lead_effect,
-                           const AxisSelection& axes, int targets)
+                           const AxisSelection& axes, int targets, LeadFit leads)
     : nominal_(nominal.spec()), model_(model), lead_effect_(lead_effect), targets_(std::max(targets, 1)) {
   bool same_lead = true;
   for (int i = 0; i < kLegs; ++i) {
@@ -32,7 +32,7 @@ ParameterSet::ParameterSet(const Model& nominal, CalibrationModel model, LeadEff
     nominal_home_command_[i] = nominal.home_command()[i];
     same_lead = same_lead && leg.lead == nominal.leg(0).lead;
   }
-  lead_count_ = same_lead ? 1 : kLegs;
+  lead_count_ = same_lead && leads == LeadFit::Shared ? 1 : kLegs;
   offset_ = lead_count_;
   int next = offset_ + kLegs;
   if (model_ == CalibrationModel::Geometry) {

@@ -141,6 +141,13 @@ ModelSpec real_platform(const Model& nominal, const PlatformErrors& e) {
   return spec;
 }
 
+CalibrationStep perfect_calibration_step() {
+  return [](const Model&, const Model& real, std::uint64_t, CalibratedController& controller) {
+    controller.spec = real.spec();
+    return Status::Ok;
+  };
+}
+
 // ---------------------------------------------------------------------------------------------
 
 void ErrorHistogram::add(double value) noexcept {
@@ -261,87 +268,154 @@ Status tolerance_linear(const Model& nominal, const std::vector<Pose>& poses, co
   return Status::Ok;
 }
 
+namespace {
+
+// What every platform of a study shares: the poses and the nominal model's commands for them.
+struct StudyPoses {
+  const std::vector<Pose>& poses;
+  std::vector<Vector6d> commands;
+  std::vector<Placement> placements;
+};
+
+// The errors of one (platform, pose): point A, pivot position [m], orientation [rad].
+struct PoseErrors {
+  double point = 0.0, position = 0.0, orientation = 0.0;
+};
+
+// The errors of the real placement `y` (P in B) against the commanded `x` in a calibration's
+// frames: y re-expressed as the controller's P in its B; point A the real one against where the
+// controller's model puts it.
+PoseErrors calibrated_errors(const Model& real, const Model& controller, const CalibratedController& c,
+                             const Placement& y, const Placement& x) {
+  const ModelSpec& spec = real.spec();
+  Placement z;
+  z.R_BP = c.X_CB.R * y.R_BP * c.X_PC.R;
+  const Vector3d pivot_B = platform_point_B(real, y, apply(c.X_PC, spec.pivot_P));  // the controller's pivot
+  z.t = apply(c.X_CB, pivot_B) - real.pivot_home_B();
+  const Vector3d A_C = apply(c.X_CB, platform_point_B(real, y, spec.observation_P));
+  PoseErrors e;
+  e.point = (A_C - platform_point_B(controller, x, controller.spec().observation_P)).norm();
+  e.position = (z.t - x.t).norm();
+  e.orientation = rotation_angle(z.R_BP * x.R_BP.transpose());
+  return e;
+}
+
+// The errors in the nominal frames, point A at the nominal arm.
+PoseErrors nominal_frame_errors(const Vector3d& arm_P, const Placement& y, const Placement& x) {
+  const Vector3d dt = y.t - x.t;
+  PoseErrors e;
+  e.position = dt.norm();
+  e.orientation = rotation_angle(y.R_BP * x.R_BP.transpose());
+  e.point = (dt + (y.R_BP - x.R_BP) * arm_P).norm();
+  return e;
+}
+
+struct Histograms {
+  ErrorHistogram point, position, orientation;
+};
+
+// Platform `index` with errors `e` (slot k of `out`): built, calibrated if asked. Without a
+// controller `real` is left empty; the calibration's status goes to out.calibration.
+void platform_setup(const Model& nominal, const ToleranceOptions& o, const PlatformErrors& e, std::uint64_t index,
+                    std::size_t k, ToleranceChunk& out, std::optional<Model>& real, std::optional<Model>& controller,
+                    CalibratedController& calibrated) {
+  Status calibration = Status::Ok;
+  try {
+    real.emplace(real_platform(nominal, e));
+    if (o.calibration) {
+      calibrated.spec = nominal.spec();
+      calibration = o.calibration(nominal, *real, index, calibrated);
+      if (calibration == Status::Ok) controller.emplace(calibrated.spec);
+    }
+  } catch (const Error&) {
+    // A platform the Model refuses (its home outside a limit), or a calibrated configuration.
+    if (real && o.calibration && calibration == Status::Ok) calibration = Status::NonFiniteInput;
+  }
+  out.calibration[k] = static_cast<std::uint8_t>(calibration);
+  if (o.calibration && !controller) real.reset();
+}
+
+// Platform `index` of a study into slot k of `out` and the histograms.
+void study_platform(const Model& nominal, const StudyPoses& sp, const ToleranceOptions& o,
+                    const ToleranceLinear* linear, std::uint64_t index, std::size_t k, ToleranceChunk& out,
+                    Histograms& h) {
+  const std::size_t np = sp.poses.size();
+  const PlatformErrors e = sample_errors(nominal, o.sigmas, o.seed, index);
+  std::optional<Model> real, controller;
+  CalibratedController calibrated;
+  platform_setup(nominal, o, e, index, k, out, real, controller, calibrated);
+  if (!real) {
+    out.failures[k] = static_cast<std::uint32_t>(np);
+    out.max_point[k] = out.rms_point[k] = out.max_position[k] = out.max_orientation[k] = NAN;
+    if (o.linear_worst) out.max_point_linear[k] = NAN;
+    return;
+  }
+  Eigen::VectorXd z;  // the linear model's parameter errors after a calibration
+  if (o.linear_worst && !linear->point_factor.empty()) linear->draw(index, z);
+  const Vector3d arm_P = nominal.spec().observation_P - nominal.spec().pivot_P;
+  double sum2 = 0.0;
+  std::size_t counted = 0;
+  FkResult fk;
+  for (std::size_t p = 0; p < np; ++p) {
+    Vector6d m = sp.commands[p];
+    LimitReport report;
+    if ((controller && motor_commands(*controller, sp.poses[p], Strategy::Compensated, m, report) != Status::Ok) ||
+        forward_kinematics(*real, m, LengthKind::Motor, sp.placements[p], fk) != Status::Ok) {
+      ++out.failures[k];
+      continue;
+    }
+    const PoseErrors d = controller ? calibrated_errors(*real, *controller, calibrated, fk.placement, sp.placements[p])
+                                    : nominal_frame_errors(arm_P, fk.placement, sp.placements[p]);
+    out.max_point[k] = std::max(out.max_point[k], d.point);
+    out.max_position[k] = std::max(out.max_position[k], d.position);
+    out.max_orientation[k] = std::max(out.max_orientation[k], d.orientation);
+    sum2 += d.point * d.point;
+    ++counted;
+    h.point.add(d.point);
+    h.position.add(d.position);
+    h.orientation.add(d.orientation);
+    if (o.linear_worst)
+      out.max_point_linear[k] = std::max(
+          out.max_point_linear[k], z.size() > 0 ? (linear->point_factor[p] * z).norm() : (linear->point[p] * e).norm());
+  }
+  out.rms_point[k] = counted ? std::sqrt(sum2 / static_cast<double>(counted)) : NAN;
+}
+
+}  // namespace
+
 Status tolerance_chunk(const Model& nominal, const std::vector<Pose>& poses, const ToleranceOptions& o,
                        std::uint64_t first, std::size_t count, ToleranceChunk& out, const ToleranceLinear* linear) {
   out = ToleranceChunk{};
   out.first = first;
-  if (o.linear_worst && (linear == nullptr || linear->point.size() != poses.size())) return Status::NonFiniteInput;
-  // The nominal commands, once for every platform that has no calibration of its own.
   const std::size_t np = poses.size();
-  std::vector<Vector6d> commands(np);
-  std::vector<Placement> placements(np);
+  if (o.linear_worst &&
+      (linear == nullptr || (linear->point.size() != np && (linear->point_factor.size() != np || !linear->draw))))
+    return Status::NonFiniteInput;
+  // The nominal commands, once for every platform that has no calibration of its own.
+  StudyPoses sp{poses, std::vector<Vector6d>(np), std::vector<Placement>(np)};
   for (std::size_t k = 0; k < np; ++k) {
     LimitReport report;
-    if (const Status s = motor_commands(nominal, poses[k], Strategy::Compensated, commands[k], report); s != Status::Ok)
+    if (const Status s = motor_commands(nominal, poses[k], Strategy::Compensated, sp.commands[k], report);
+        s != Status::Ok)
       return s;
-    placements[k] = placement_from_pose(poses[k]);
+    sp.placements[k] = placement_from_pose(poses[k]);
   }
-  const Vector3d arm_P = nominal.spec().observation_P - nominal.spec().pivot_P;
   out.max_point.assign(count, 0.0);
   out.rms_point.assign(count, 0.0);
   out.max_position.assign(count, 0.0);
   out.max_orientation.assign(count, 0.0);
   out.max_point_linear.assign(count, o.linear_worst ? 0.0 : NAN);
   out.failures.assign(count, 0);
+  out.calibration.assign(count, static_cast<std::uint8_t>(Status::Ok));
   std::mutex merge;
-  detail::for_blocks(count, 8, o.threads, [&](std::size_t begin, std::size_t end) {
-    ErrorHistogram point, position, orientation;
-    FkResult fk;
-    for (std::size_t k = begin; k < end; ++k) {
-      const std::uint64_t index = first + k;
-      const PlatformErrors e = sample_errors(nominal, o.sigmas, o.seed, index);
-      std::optional<Model> real, controller;
-      try {
-        real.emplace(real_platform(nominal, e));
-        if (o.calibration) {
-          ModelSpec spec = nominal.spec();
-          if (o.calibration(nominal, *real, index, spec) == Status::Ok) controller.emplace(spec);
-        }
-      } catch (const Error&) {
-        // A platform the Model refuses (its home outside a limit): every pose fails.
-      }
-      if (!real || (o.calibration && !controller)) {
-        out.failures[k] = static_cast<std::uint32_t>(np);
-        out.max_point[k] = out.rms_point[k] = out.max_position[k] = out.max_orientation[k] = NAN;
-        continue;
-      }
-      double sum2 = 0.0;
-      std::size_t counted = 0;
-      for (std::size_t p = 0; p < np; ++p) {
-        Vector6d m = commands[p];
-        if (controller) {
-          LimitReport report;
-          if (motor_commands(*controller, poses[p], Strategy::Compensated, m, report) != Status::Ok) {
-            ++out.failures[k];
-            continue;
-          }
-        }
-        if (forward_kinematics(*real, m, LengthKind::Motor, placements[p], fk) != Status::Ok) {
-          ++out.failures[k];
-          continue;
-        }
-        const Placement& x = placements[p];
-        const Vector3d dt = fk.placement.t - x.t;
-        const double dp = dt.norm();
-        const double dr = rotation_angle(fk.placement.R_BP * x.R_BP.transpose());
-        const double da = (dt + (fk.placement.R_BP - x.R_BP) * arm_P).norm();
-        out.max_point[k] = std::max(out.max_point[k], da);
-        out.max_position[k] = std::max(out.max_position[k], dp);
-        out.max_orientation[k] = std::max(out.max_orientation[k], dr);
-        sum2 += da * da;
-        ++counted;
-        point.add(da);
-        position.add(dp);
-        orientation.add(dr);
-        if (o.linear_worst) out.max_point_linear[k] = std::max(out.max_point_linear[k], (linear->point[p] * e).norm());
-      }
-      out.rms_point[k] = counted ? std::sqrt(sum2 / static_cast<double>(counted)) : NAN;
-    }
+  detail::for_blocks(count, o.calibration ? 1 : 8, o.threads, [&](std::size_t begin, std::size_t end) {
+    Histograms h;
+    for (std::size_t k = begin; k < end; ++k) study_platform(nominal, sp, o, linear, first + k, k, out, h);
     // Integer counts: the sum does not depend on the order the blocks end in.
     const std::lock_guard<std::mutex> lock(merge);
-    out.point.merge(point);
-    out.position.merge(position);
-    out.orientation.merge(orientation);
+    out.point.merge(h.point);
+    out.position.merge(h.position);
+    out.orientation.merge(h.orientation);
   });
   return Status::Ok;
 }
@@ -355,6 +429,7 @@ void append_chunk(ToleranceChunk& into, const ToleranceChunk& next) {
   append(into.max_orientation, next.max_orientation);
   append(into.max_point_linear, next.max_point_linear);
   append(into.failures, next.failures);
+  append(into.calibration, next.calibration);
   into.point.merge(next.point);
   into.position.merge(next.position);
   into.orientation.merge(next.orientation);
@@ -499,6 +574,8 @@ ToleranceSummary summarize_tolerance(const ToleranceChunk& c, std::size_t poses,
   s.platforms = c.size();
   s.poses = poses;
   for (const std::uint32_t f : c.failures) s.failures += f;
+  for (const std::uint8_t status : c.calibration)
+    ++s.calibration[std::min<std::size_t>(status, s.calibration.size() - 1)];
   const auto pooled = [](const ErrorHistogram& h, const std::vector<double>& worst) {
     ErrorQuantiles q;
     q.median = h.quantile(0.5);

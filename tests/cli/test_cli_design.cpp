@@ -205,11 +205,63 @@ TEST(CliTolerance, ReportsTheMonteCarloBesideTheLinearisedAnswer) {
   EXPECT_LT(YAML::Load(perfect.out)["monte_carlo"]["point"]["max"].as<double>(), 1e-11);
 }
 
+TEST(CliTolerance, AfterATrackerCalibrationFromAStationPlanMicrometresRemain) {
+  // 40 random stations, and the same plan as synth --run-out writes it: the same study.
+  const std::vector<std::string> common = {"tolerance",    "--platforms",         "4",
+                                           "--workspace",  "random=40,samples=5", "--json",
+                                           "--no-figures", "--tracker-noise-um",  "10"};
+  auto args = common;
+  args.insert(args.end(), {"--calibration", "stations:40", "--out", (temp_dir() / "cal").string()});
+  const Outcome r = run(args);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const YAML::Node j = YAML::Load(r.out);
+  EXPECT_EQ(j["calibration"].as<std::string>(), "stations:40");
+  EXPECT_DOUBLE_EQ(j["tracker"]["noise"].as<double>(), 10e-6);
+  EXPECT_EQ(j["failures"].as<int>(), 0);
+  // Measured 1.8 um median (0.22 mm with the nominal controller), MC / linear 0.99.
+  const double mc = j["monte_carlo"]["point"]["median"].as<double>(),
+               lin = j["linearised"]["point"]["median"].as<double>();
+  EXPECT_LT(mc, 10e-6);
+  EXPECT_NEAR(mc / lin, 1.0, 0.3);
+  const fs::path run_csv = temp_dir() / "run.csv";
+  const Outcome synth =
+      run({"synth", "--stations", "40", "--run-out", run_csv.string(), "--out", (temp_dir() / "log.csv").string()});
+  ASSERT_EQ(synth.code, 0) << synth.err;
+  args = common;
+  args.insert(args.end(), {"--station-plan", run_csv.string(), "--out", (temp_dir() / "plan").string()});
+  const Outcome p = run(args);
+  ASSERT_EQ(p.code, 0) << p.err;
+  const YAML::Node k = YAML::Load(p.out);
+  EXPECT_EQ(k["calibration"].as<std::string>(), "plan");
+  EXPECT_EQ(k["tracker"]["stations"].size(), 42u);
+  // The run's rests are the stations to the last bits of its trajectory: the same platforms' errors
+  // to 1e-4 (measured 7e-6: the identification amplifies them).
+  const auto max_points = [](const std::string& csv) {
+    std::vector<double> v;
+    std::istringstream in(csv);
+    std::string line;
+    std::getline(in, line);  // the header
+    while (std::getline(in, line)) v.push_back(std::stod(line.substr(line.find(',') + 1)));
+    return v;
+  };
+  const std::vector<double> a = max_points(read_file(temp_dir() / "plan" / "platforms.csv"));
+  const std::vector<double> b = max_points(read_file(temp_dir() / "cal" / "platforms.csv"));
+  ASSERT_EQ(a.size(), 4u);
+  ASSERT_EQ(b.size(), 4u);
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i] / b[i], 1.0, 1e-4) << "platform " << i;
+}
+
 TEST(CliDesignCommands, BadInputsAreOneLineWithTheirExitCodes) {
   const std::string out = (temp_dir() / "bad").string();
   expect_one_line_error(run({"design", "--workspace", "random=many", "--out", out}), 2, "--workspace 'random=many'");
   expect_one_line_error(run({"design", "--workspace", "colour=red", "--out", out}), 2, "unknown key");
   expect_one_line_error(run({"tolerance", "--sigma-joint-um", "-1", "--out", out}), 2, "--sigma-joint-um");
+  expect_one_line_error(run({"tolerance", "--calibration", "stations:0", "--out", out}), 2, "--calibration");
+  expect_one_line_error(run({"tolerance", "--calibration", "plan", "--out", out}), 2, "--station-plan");
+  expect_one_line_error(run({"tolerance", "--tracker-noise-um", "0", "--out", out}), 2, "--tracker-noise-um");
+  expect_one_line_error(run({"tolerance", "--points-per-station", "0", "--out", out}), 2, "--points-per-station");
+  expect_one_line_error(run({"tolerance", "--station-plan", "/nonexistent/run.csv", "--out", out}), 2,
+                        "--station-plan");
   expect_one_line_error(run({"workspace", "--orientation", "0,0", "--out", out}), 2, "--orientation");
   expect_one_line_error(run({"workspace", "--spacing", "0", "--out", out}), 2, "--spacing");
   const Outcome s = run({"tolerance", "--scheduler", "localhost:8786", "--out", out});

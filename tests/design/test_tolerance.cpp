@@ -118,17 +118,17 @@ TEST(Tolerance, APerfectCalibrationLeavesNoError) {
   ToleranceOptions o;
   o.linear_worst = false;
   std::atomic<int> calls{0};
-  o.calibration = [&](const Model&, const Model& real, std::uint64_t, ModelSpec& controller) {
+  const CalibrationStep perfect = perfect_calibration_step();
+  o.calibration = [&](const Model& nominal, const Model& real, std::uint64_t index, CalibratedController& controller) {
     ++calls;
-    controller = real.spec();
-    return Status::Ok;
+    return perfect(nominal, real, index, controller);
   };
   ToleranceChunk c;
   ASSERT_EQ(tolerance_chunk(seed, poses, o, 0, 20, c), Status::Ok);
   EXPECT_EQ(calls, 20);
   for (std::size_t k = 0; k < c.size(); ++k) EXPECT_LT(c.max_point[k], 1e-11);
   // A calibration that fails counts every pose of its platform as failed.
-  o.calibration = [](const Model&, const Model&, std::uint64_t index, ModelSpec&) {
+  o.calibration = [](const Model&, const Model&, std::uint64_t index, CalibratedController&) {
     return index == 3 ? Status::NotIdentifiable : Status::Ok;
   };
   ASSERT_EQ(tolerance_chunk(seed, poses, o, 0, 5, c), Status::Ok);

@@ -18,13 +18,13 @@ def same_model(a, b, poses):
 
 def test_pickle_round_trip_is_exact(model, poses):
     m = hexatwist.Model.from_arrays(model.base, model.platform, model.base_axes, model.platform_axes,
-                                    model.home_height, lead=[0.01, 0.012, 0.01, 0.01, 0.008, 0.01], thread="left",
+                                    model.home_height, lead=[0.01, 0.012, 0.01, 0.01, 0.008, 0.01], thread_hand="left",
                                     length_offsets=[1e-4, 0, -2e-4, 0, 0, 3e-5], length_min=1.4, length_max=2.45,
                                     bend_max=0.7, singularity_margin=0.08, observation_point=[1.2, 0, 0], name="odd")
     for original in (model, m):
         copy = pickle.loads(pickle.dumps(original, protocol=pickle.HIGHEST_PROTOCOL))
         assert copy.name == original.name and np.array_equal(copy.lead, original.lead)
-        assert copy.threads == original.threads and copy.limits == original.limits
+        assert copy.thread_hands == original.thread_hands and copy.limits == original.limits
         assert same_model(copy, original, poses[:2000])
     r = hexatwist.commands(model, poses[:100])
     assert np.array_equal(pickle.loads(pickle.dumps(r)).commands, r.commands, equal_nan=True)

@@ -6,6 +6,7 @@ import socket
 import subprocess
 import sys
 import time
+from collections.abc import Mapping
 
 import numpy as np
 import pytest
@@ -114,8 +115,8 @@ def test_per_row_keyword_arrays_are_cut_with_the_rows(client, model):
 
 
 def same(a, b):
-    """Equal numbers, NaN equal to NaN, through nested dicts."""
-    if isinstance(a, dict):
+    """Equal numbers, NaN equal to NaN, through nested dicts and typed results."""
+    if isinstance(a, Mapping):
         return a.keys() == b.keys() and all(same(a[k], b[k]) for k in a)
     if a is None or b is None:  # JSON's null for a number without a value
         return a is None and b is None
@@ -132,6 +133,19 @@ def test_a_tolerance_study_on_two_workers_equals_the_local_run_bit_for_bit(clien
     assert same(local.summary, remote.summary)
     assert same(local.linear, remote.linear)
     assert len(local.max_point) == 120 and local.summary["failures"] == 0
+
+
+def test_a_calibrated_tolerance_study_on_two_workers_equals_the_local_run_bit_for_bit(client, model):
+    settings = dict(platforms=6, seed=3, random=40, test_samples=5, calibration="stations:30,2",
+                    tracker=dict(noise=20e-6, points_per_station=10))
+    local = hexatwist.tolerance(model, **settings)
+    remote = hexatwist.tolerance(model, client=client, chunk=4, **settings)
+    for key in local:
+        if isinstance(local[key], np.ndarray):
+            assert np.array_equal(local[key], remote[key], equal_nan=True), key
+    assert same(local.summary, remote.summary)
+    assert same(local.linear, remote.linear)
+    assert np.all(local.calibration == 0)
 
 
 def test_a_workspace_map_and_volume_on_two_workers_equal_the_local_run_bit_for_bit(client, model):
@@ -170,6 +184,14 @@ def test_the_command_line_on_the_cluster_equals_its_local_run(client, tmp_path):
     for key in ("monte_carlo", "linearised", "worst_per_platform", "failures"):
         assert same(local[key], remote[key]), key
     assert (tmp_path / "tl" / "platforms.csv").read_text() == (tmp_path / "tr" / "platforms.csv").read_text()
+    common = ["--platforms", "4", "--workspace", "random=30,samples=5", "--json", "--no-figures",
+              "--calibration", "stations:30", "--tracker-noise-um", "20"]
+    local = run("tolerance", *common, "--out", str(tmp_path / "cl"))
+    remote = run("tolerance", *common, "--out", str(tmp_path / "cr"), "--scheduler", scheduler)
+    for key in ("monte_carlo", "linearised", "worst_per_platform", "failures"):
+        assert same(local[key], remote[key]), key
+    assert local["tracker"] == remote["tracker"] and local["tracker"]["noise"] == 20e-6
+    assert (tmp_path / "cl" / "platforms.csv").read_text() == (tmp_path / "cr" / "platforms.csv").read_text()
     common = ["--heights", "0", "--spacing", "0.05", "--map-spacing", "0.05", "--yaws", "0", "--json", "--no-figures"]
     local = run("workspace", *common, "--out", str(tmp_path / "wl"))
     remote = run("workspace", *common, "--out", str(tmp_path / "wr"), "--scheduler", scheduler)

@@ -1,6 +1,7 @@
 """Dynamics and motor sizing through the bindings: the library called directly (bit for bit), and
 properties that break if an argument were swapped (forward dynamics inverts inverse dynamics, the
 energies, the torque's parts)."""
+import json
 import os
 import pickle
 import subprocess
@@ -196,10 +197,25 @@ def test_size_motors_equals_the_library_bit_for_bit(rig, simulator_csv, tmp_path
     check, leg, index, time, value, bound, status = ref[n * 55 + 90:]
     v = s.summary["first_violation"]
     assert status == 0 and s.summary["status"] == "ok"
-    # The fast cue exceeds the seed motor (as `hexatwist dynamics` reports: leg 4 at 0.930 s).
-    assert s.summary["envelope"] == "exceeded" and check == 1 and v["check"] == "speed"
-    assert (v["leg"], v["index"], v["time"], v["value"], v["bound"]) == (leg, index, time, value, bound)
-    assert v["leg"] == 3 and v["time"] == pytest.approx(0.93)
+    # The fast cue exceeds the seed motor (as `hexatwist dynamics` reports: leg 4 at 0.930 s); the
+    # library's leg index (0-based) is Python's leg number minus one.
+    assert s.summary.envelope == "exceeded" and check == 1 and v.check == "speed"
+    assert (v.leg - 1, v.index, v.time, v.value, v.bound) == (leg, index, time, value, bound)
+    assert v.leg == 4 and v.time == pytest.approx(0.93)
+
+
+def test_size_motors_reaches_the_verdict_of_hexatwist_dynamics(rig, simulator_csv, tmp_path):
+    # Side by side with the command line's summary.json: the same violation, the same leg number.
+    out = tmp_path / "dynamics-out"
+    run = subprocess.run([tool("HEXATWIST_CLI"), "dynamics", "--trajectory", simulator_csv, "--no-figures", "--out",
+                          str(out)], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 3, run.stderr  # the motor envelope exceeded
+    cli = json.loads((out / "summary.json").read_text())
+    s = hexatwist.size_motors(rig, simulator_csv).summary
+    v, c = s.first_violation, cli["first_violation"]
+    assert v is not None and (v.check, v.leg, v.time, v.value, v.bound) == \
+        (c["check"], c["leg"], c["time"], c["value"], c["bound"])
+    assert f"leg {v.leg} " in c["message"] and s.samples == cli["samples"]
 
 
 def test_size_motors_from_poses_and_inverse_dynamics_agree(rig, simulator_csv):

@@ -54,6 +54,9 @@ def test_python_and_the_cli_reach_the_same_estimate_bit_for_bit(log_dir):
     np.testing.assert_array_equal([p["sd"] for p in cli["estimate"]["parameters"]], py.sd)
     assert cli["sigma"] == py.sigma and cli["fit_test"]["z"] == py.fit_z
     assert cli["accuracy"]["median"] == py.accuracy["median"]
+    # The worst stations, numbered from 1 in both.
+    assert [(w["station"], w["points"], w["statistic"]) for w in cli["worst_stations"]] == \
+        [(w.station, w.count, w.statistic) for w in py.worst] and len(py.worst) > 0
     # The corrected configuration: Python writes the CLI's file, byte for byte but for the header
     # comments and the name, which the CLI gives the log's file name.
     def body(text):
@@ -92,3 +95,24 @@ def test_bad_arguments_raise_one_line():
         hexatwist.identify(model, motor, np.zeros((10, 3)), targets=np.full(10, -1))
     with pytest.raises(hexatwist.InputError, match="NaN"):
         hexatwist.identify(model, motor, np.full((10, 3), np.nan))
+
+
+def test_a_time_offset_outside_the_run_is_refused_by_both_naming_the_parameter(log_dir):
+    # The library blames the time offset (ParameterError): the CLI names its option, Python its keyword,
+    # on the same point of the same log.
+    cli = run("identify", "--points", "s.csv", "--stations", "30", "--station-seed", "4", "--time-offset", "-1000",
+              "--no-figures", cwd=log_dir, check=False)
+    assert cli.returncode == 2, cli.stderr
+    assert cli.stderr.rstrip().endswith("[--time-offset]") and len(cli.stderr.strip().splitlines()) == 1
+    model = hexatwist.default_model()
+    log = hexatwist.read_point_log(str(log_dir / "s.csv"))
+    stations = hexatwist.stations_run(count=30, seed=4)
+    with pytest.raises(hexatwist.InputError) as raised:
+        hexatwist.observations_at_rest(model, stations.t, stations.poses, log.stamps, log.points, time_offset=-1000.0)
+    message = str(raised.value)
+    assert message.endswith(" [time_offset]") and "\n" not in message
+    # The same point (line 2 of the log, which Python was given as arrays) at the same time as the CLI's.
+    assert message.startswith("point log:2:1: ") and cli.stderr.startswith("hexatwist: error: s.csv:2:1: ")
+    assert message[len("point log:2:1: "):-len(" [time_offset]")] in cli.stderr
+    with pytest.raises(hexatwist.InputError, match=r"settle.*\[settle\]$"):
+        hexatwist.observations_at_rest(model, stations.t, stations.poses, log.stamps, log.points, settle=-1.0)

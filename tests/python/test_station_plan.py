@@ -25,7 +25,7 @@ def test_the_plan_determines_the_model_better_than_random_stations(plan):
     assert plan.stations.shape == (16, 6)
     assert plan.planned.status == plan.random.status == "ok"
     assert plan.planned.criterion > plan.random.criterion
-    assert plan.planned.accuracy["max"] < plan.random.accuracy["max"]
+    assert plan.planned.accuracy.max < plan.random.accuracy.max
     assert len(plan.parameter_names) == plan.planned.covariance.shape[0] == plan.planned.sd.shape[0]
     # Every station within the range; the random ones are stations_run's of the same seed.
     assert np.all(np.abs(plan.stations[:, :3]) <= 0.25) and np.all(np.abs(plan.stations[:, 3:]) <= np.radians(15))
@@ -44,10 +44,11 @@ def test_python_and_the_cli_plan_the_same_run_bit_for_bit(plan, tmp_path):
     for key in ("planned", "random"):
         assert cli[key]["criterion"] == plan[key].criterion
         np.testing.assert_array_equal(cli[key]["sd"], plan[key].sd)
+        np.testing.assert_array_equal(np.array(cli[key]["stations"]), plan[key].stations)
     # The accuracy: the CLI predicts it over 1000 poses.
     full = hexatwist.plan_stations(count=16, seed=3, candidates=600)
-    assert cli["planned"]["accuracy"]["max"] == full.planned.accuracy["max"]
-    assert cli["random"]["accuracy"]["median"] == full.random.accuracy["median"]
+    assert cli["planned"]["accuracy"]["max"] == full.planned.accuracy.max
+    assert cli["random"]["accuracy"]["median"] == full.random.accuracy.median
     # The run written: stations_run of the planned stations, every 10th control sample (100 Hz).
     rows = np.loadtxt(tmp_path / "run.csv", delimiter=",", skiprows=1)
     run = hexatwist.stations_run(stations=plan.stations)

@@ -34,6 +34,7 @@ enum class AxisFit {
 struct IdentificationOptions {
   CalibrationModel model = CalibrationModel::Geometry;  ///< which parameters
   LeadEffect lead_effect = LeadEffect::TwistAndTravel;  ///< measurement model of the lead
+  LeadFit leads = LeadFit::Shared;                      ///< one lead, or one per leg
   AxisFit axes = AxisFit::Auto;                         ///< which U-joint axes (Geometry)
   /// Auto: an axis direction is fitted when the data determine both its angles to this [rad].
   double axis_sd_max = deg2rad(0.1);

@@ -27,19 +27,27 @@ enum class LeadEffect {
   TwistAndTravel,  ///< also through the travel: the drives turn the screws by the nominal lead's angles
 };
 
+/// How many screw leads an identification fits (theory §13).
+enum class LeadFit {
+  Shared,  ///< one for every leg, unless the nominal leads differ (then one per leg)
+  /// one per leg: screws of one type differ by their lead class, which the drives' travel shows
+  /// (LeadEffect::TwistAndTravel: 50 ppm over a 0.2 m stroke is 10 um)
+  PerLeg,
+};
+
 /// One flag per U-joint fixed axis: legs 1..6 at the base, then legs 1..6 at the platform.
 using AxisSelection = std::array<bool, 2 * kLegs>;
 
 /// The layout of the parameter vector theta (caller-owned, built once per identification).
-/// Order: leads (one, or one per leg where the nominal leads differ), the six zero offsets, the
+/// Order: leads (one, or one per leg where the nominal leads differ or LeadFit::PerLeg), the six zero offsets, the
 /// base joints (12 gauge coordinates), the platform joints (12), the selected axes (2 each),
 /// three coordinates per target [m, P], the tracker rotation dw [rad, B] and translation [m, B].
 /// Joints and axes only in the Geometry model.
 class ParameterSet {
  public:
-  /// The layout for `nominal` (its leads decide one or six lead parameters).
+  /// The layout for `nominal` (its leads and `leads` decide one or six lead parameters).
   ParameterSet(const Model& nominal, CalibrationModel model, LeadEffect lead_effect, const AxisSelection& axes,
-               int targets);
+               int targets, LeadFit leads = LeadFit::Shared);
   ParameterSet() = default;
 
   CalibrationModel model() const noexcept { return model_; }

@@ -4,10 +4,12 @@
 // calibration step plugs in between the sampled platform and its controller.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
 
+#include "hexatwist/calibration/registration.hpp"
 #include "hexatwist/kinematics/forward.hpp"
 
 namespace hexatwist {
@@ -43,11 +45,25 @@ PlatformErrors sample_errors(const Model& nominal, const ToleranceSigmas& sigmas
 /// referenced to the nominal home commands (what the controller's homing sets).
 ModelSpec real_platform(const Model& nominal, const PlatformErrors& errors);
 
-/// A calibration: from the nominal model and a sampled real platform (`index` of the study), the
-/// configuration its controller runs afterwards (`controller`, preset to the nominal spec). A
-/// perfect one writes real.spec(). A status other than Ok counts the platform as failed.
-using CalibrationStep =
-    std::function<Status(const Model& nominal, const Model& real, std::uint64_t index, ModelSpec& controller)>;
+/// What a calibration leaves a sampled platform: the configuration its controller runs, and the
+/// frames of the calibrated machine, in which the study measures its errors.
+struct CalibratedController {
+  ModelSpec spec;  ///< the controller's configuration (preset to the nominal one)
+  /// The real platform's base frame B in the controller's base frame, as the calibration places it
+  /// (identity: the controller's B is the real one).
+  RigidTransform X_CB;
+  /// The controller's platform frame in the real platform's P (identity: the real P).
+  RigidTransform X_PC;
+};
+
+/// A calibration: from the nominal model and a sampled real platform (`index` of the study), its
+/// controller. A status other than Ok counts the platform as failed. Point A's error is then the
+/// real observation point against where the controller's model puts it, in the frames above.
+using CalibrationStep = std::function<Status(const Model& nominal, const Model& real, std::uint64_t index,
+                                             CalibratedController& controller)>;
+
+/// The floor of every calibration: a controller that runs the real platform's own model, in its frames.
+CalibrationStep perfect_calibration_step();
 
 /// Settings of a study.
 struct ToleranceOptions {
@@ -83,13 +99,16 @@ struct ErrorHistogram {
 /// over the poses, and the pooled histograms of every (platform, pose) error. Platform k's numbers
 /// depend only on (seed, k) and the poses: chunks concatenate to the whole study bit for bit.
 struct ToleranceChunk {
-  std::uint64_t first = 0;                      ///< index of the first platform
-  std::vector<double> max_point;                ///< largest |point A error| over the poses [m]
-  std::vector<double> rms_point;                ///< its RMS over the poses [m]
-  std::vector<double> max_position;             ///< largest |pivot position error| [m]
-  std::vector<double> max_orientation;          ///< largest orientation error (rotation angle) [rad]
-  std::vector<double> max_point_linear;         ///< largest |point A error| of the linear model, same errors [m]
-  std::vector<std::uint32_t> failures;          ///< poses where the controller refused or the FK failed
+  std::uint64_t first = 0;              ///< index of the first platform
+  std::vector<double> max_point;        ///< largest |point A error| over the poses [m]
+  std::vector<double> rms_point;        ///< its RMS over the poses [m]
+  std::vector<double> max_position;     ///< largest |pivot position error| [m]
+  std::vector<double> max_orientation;  ///< largest orientation error (rotation angle) [rad]
+  /// Largest |point A error| of the linear model, same errors [m] (after a calibration, the same
+  /// tracker noise: ToleranceLinear::draw)
+  std::vector<double> max_point_linear;
+  std::vector<std::uint32_t> failures;    ///< poses where the controller refused or the FK failed (all: no controller)
+  std::vector<std::uint8_t> calibration;  ///< the status of each platform's calibration (Ok without one)
   ErrorHistogram point, position, orientation;  ///< pooled over platforms and poses [m, m, rad]
   std::size_t size() const noexcept { return max_point.size(); }
 };
@@ -102,6 +121,13 @@ struct ToleranceLinear {
   std::vector<Matrix3d> point_covariance;                        ///< per pose [m^2]
   std::vector<Matrix3d> position_covariance;                     ///< [m^2]
   std::vector<Matrix3d> orientation_covariance;                  ///< [rad^2]
+  /// After a calibration (calibrated_linear, tolerance_calibration.hpp), instead of `point`: J L per
+  /// pose, d(point A error)/d(identified parameters) times a square root of their covariance
+  /// C = L L^T, so that J L z is the linear model's point error for the parameter errors L z [m]
+  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> point_factor;
+  /// With point_factor: the coordinates z (standard normal) of platform `index`'s parameter errors
+  /// that the linear model gives its calibration's errors (its tracker noise)
+  std::function<void(std::uint64_t index, Eigen::VectorXd& z)> draw;
 };
 
 /// The linear model at every pose of `poses` for the nominal commands. Returns the status of a
@@ -112,9 +138,9 @@ struct ToleranceLinear {
 /// Platforms [first, first + count) of the study over `poses` (each inside the nominal
 /// workspace): each sampled (sample_errors), built (real_platform), calibrated if asked, driven by
 /// its controller's compensated commands at every pose, its pose found by twist-aware forward
-/// kinematics from the commanded one; errors against the commanded pose. `linear` (required when
-/// options.linear_worst) gives the linear model for max_point_linear. Returns the status of a
-/// pose the nominal model refuses.
+/// kinematics from the commanded one; errors against the commanded pose (in the calibration's frames).
+/// `linear` (required when options.linear_worst) gives the linear model for max_point_linear.
+/// Returns the status of a pose the nominal model refuses.
 [[nodiscard]] Status tolerance_chunk(const Model& nominal, const std::vector<Pose>& poses,
                                      const ToleranceOptions& options, std::uint64_t first, std::size_t count,
                                      ToleranceChunk& out, const ToleranceLinear* linear = nullptr);
@@ -145,8 +171,10 @@ std::vector<double> gaussian_norm_mixture_cdf(const std::vector<Matrix3d>& covar
 /// A study's summary.
 struct ToleranceSummary {
   std::size_t platforms = 0, poses = 0;
-  std::uint64_t failures = 0;                   ///< (platform, pose) pairs without an error (refused or FK failed)
-  ErrorQuantiles point, position, orientation;  ///< Monte Carlo, pooled over platforms and poses
+  std::uint64_t failures = 0;  ///< (platform, pose) pairs without an error (refused, FK or calibration failed)
+  /// Platforms by the status of their calibration (index: the Status; all Ok without one)
+  std::array<std::uint64_t, static_cast<std::size_t>(kLastStatus) + 1> calibration{};
+  ErrorQuantiles point, position, orientation;                       ///< Monte Carlo, pooled over platforms and poses
   ErrorQuantiles point_linear, position_linear, orientation_linear;  ///< the covariance answer (no max)
   ErrorQuantiles worst_point;         ///< per platform, the largest point error over the poses: Monte Carlo
   ErrorQuantiles worst_point_linear;  ///< the same with the linear model and the same errors

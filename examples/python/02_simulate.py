@@ -16,11 +16,12 @@ rig = hexatwist.Rig()  # platform + servo + load + rates (configs/seed.yaml), bu
 sweep = hexatwist.sweep_trajectory(5, np.deg2rad(10), velocity=np.deg2rad(15), acceleration=np.deg2rad(45),
                                    jerk=np.deg2rad(180), dwell=0.2, dt=rig.control_period)
 duration = sweep.dt * (len(sweep.poses) - 1)
-for strategy in ("conventional", "compensated"):
+strategies: tuple[hexatwist.Strategy, ...] = ("conventional", "compensated")
+for strategy in strategies:
     run = hexatwist.simulate(rig, poses=sweep.poses, strategy=strategy)  # one sample per 1 ms tick
     s = run.summary
-    if s.status != "ok":  # a limit, the motor speed or the holding torque: where, and which leg
-        print(f"t = {s.time:.3f} s, leg {s.leg}: {s.status}")
+    if s.status != "ok":  # a limit, the motor speed or the holding torque: when, and which leg
+        print(f"t = {s.time:.3f} s, leg {s.leg}: {hexatwist.describe_status(hexatwist.Status[s.status.upper()])}")
         sys.exit(1)
     print(f"{strategy:<12}  {duration:.2f} s simulated: point A misses by up to {1e3 * run.error.max():.4f} mm "
           f"(with perfect servos {1e3 * run.error_twist_only.max():.1e} mm)")
