@@ -174,18 +174,11 @@ std::string find_gnuplot() {
   }
 }
 
-void write_figures(const std::vector<Figure>& figures) {
-  if (figures.empty()) return;
-  const std::string gnuplot = find_gnuplot();
-  if (gnuplot.empty()) {
-    const char* env = std::getenv("HEXATWIST_GNUPLOT");
-    throw ExitError(kExitOutputFailed,
-                    env != nullptr && *env != '\0'
-                        ? fmt::format("gnuplot not found at HEXATWIST_GNUPLOT='{}'; run scripts/setup.sh or install "
-                                      "gnuplot-nox",
-                                      printable(env))
-                        : std::string("gnuplot not found; run scripts/setup.sh or install gnuplot-nox"));
-  }
+namespace {
+
+// Every figure writable and consistent before gnuplot runs: its directory, one stem each, maps
+// and series whose sizes agree.
+void check_figures(const std::vector<Figure>& figures) {
   std::set<std::string> stems;
   for (const Figure& fig : figures) {
     check_output_directory(fig.stem);
@@ -206,6 +199,74 @@ void write_figures(const std::vector<Figure>& figures) {
                           fmt::format("figure '{}': series '{}' has {} x values but {} y values", printable(fig.stem),
                                       printable(s.label), s.x.size(), s.y.size()));
   }
+}
+
+// gnuplot's failure in one line: the figure whose commands hold the failing line, how it ended,
+// its first message.
+ExitError gnuplot_failure(const std::vector<Figure>& figures, const Script& script, int status,
+                          const fs::path& err_path) {
+  const auto [message, line] = first_error(read_text(err_path));
+  std::string where;
+  if (line > 0) {
+    std::size_t offset = 0;
+    for (std::size_t l = 1; l < line && offset != std::string::npos; ++l) {
+      offset = script.text.find('\n', offset);
+      if (offset != std::string::npos) ++offset;
+    }
+    const auto it = std::upper_bound(script.figure_start.begin(), script.figure_start.end(), offset);
+    if (it != script.figure_start.begin())
+      where = fmt::format(" drawing '{}'",
+                          printable(figures[static_cast<std::size_t>(it - script.figure_start.begin() - 1)].stem));
+  }
+  const std::string how = WIFEXITED(status) ? fmt::format("exit status {}", WEXITSTATUS(status))
+                                            : fmt::format("signal {}", WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  return ExitError(kExitOutputFailed, fmt::format("gnuplot failed{} ({}){}{}", where, how, message.empty() ? "" : ": ",
+                                                  printable(message)));
+}
+
+// Every drawn file checked, then all put in place, or none (a failure half way removes those
+// already placed).
+void publish_all(const std::vector<Figure>& figures, const fs::path& scratch) {
+  for (std::size_t f = 0; f < figures.size(); ++f) {
+    for (const char* ext : {"png", "svg"}) {
+      const fs::path drawn = scratch / fmt::format("f{}.{}", f, ext);
+      std::error_code ec;
+      const auto size = fs::file_size(drawn, ec);
+      if (ec || size == 0)
+        throw ExitError(kExitOutputFailed,
+                        fmt::format("gnuplot did not write figure '{}.{}'", printable(figures[f].stem), ext));
+    }
+  }
+  std::vector<std::string> published;
+  try {
+    for (std::size_t f = 0; f < figures.size(); ++f)
+      for (const char* ext : {"png", "svg"}) {
+        const std::string to = fmt::format("{}.{}", figures[f].stem, ext);
+        publish(scratch / fmt::format("f{}.{}", f, ext), to);
+        published.push_back(to);
+      }
+  } catch (...) {
+    std::error_code ignored;
+    for (const std::string& p : published) fs::remove(p, ignored);
+    throw;
+  }
+}
+
+}  // namespace
+
+void write_figures(const std::vector<Figure>& figures) {
+  if (figures.empty()) return;
+  const std::string gnuplot = find_gnuplot();
+  if (gnuplot.empty()) {
+    const char* env = std::getenv("HEXATWIST_GNUPLOT");
+    throw ExitError(kExitOutputFailed,
+                    env != nullptr && *env != '\0'
+                        ? fmt::format("gnuplot not found at HEXATWIST_GNUPLOT='{}'; run scripts/setup.sh or install "
+                                      "gnuplot-nox",
+                                      printable(env))
+                        : std::string("gnuplot not found; run scripts/setup.sh or install gnuplot-nox"));
+  }
+  check_figures(figures);
 
   const ScratchDir scratch;
   const Script script = build_script(figures, scratch.path());
@@ -219,54 +280,9 @@ void write_figures(const std::vector<Figure>& figures) {
       throw ExitError(kExitOutputFailed,
                       fmt::format("cannot write gnuplot script '{}'", printable(script_path.string())));
   }
-
   const int status = run_gnuplot(gnuplot, script_path, err_path);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    const auto [message, line] = first_error(read_text(err_path));
-    // The figure whose commands hold the failing line.
-    std::string where;
-    if (line > 0) {
-      std::size_t offset = 0;
-      for (std::size_t l = 1; l < line && offset != std::string::npos; ++l) {
-        offset = script.text.find('\n', offset);
-        if (offset != std::string::npos) ++offset;
-      }
-      const auto it = std::upper_bound(script.figure_start.begin(), script.figure_start.end(), offset);
-      if (it != script.figure_start.begin())
-        where = fmt::format(" drawing '{}'",
-                            printable(figures[static_cast<std::size_t>(it - script.figure_start.begin() - 1)].stem));
-    }
-    const std::string how = WIFEXITED(status) ? fmt::format("exit status {}", WEXITSTATUS(status))
-                                              : fmt::format("signal {}", WIFSIGNALED(status) ? WTERMSIG(status) : 0);
-    throw ExitError(kExitOutputFailed, fmt::format("gnuplot failed{} ({}){}{}", where, how, message.empty() ? "" : ": ",
-                                                   printable(message)));
-  }
-
-  // Every file drawn before any is put in place.
-  for (std::size_t f = 0; f < figures.size(); ++f) {
-    for (const char* ext : {"png", "svg"}) {
-      const fs::path drawn = scratch.path() / fmt::format("f{}.{}", f, ext);
-      std::error_code ec;
-      const auto size = fs::file_size(drawn, ec);
-      if (ec || size == 0)
-        throw ExitError(kExitOutputFailed,
-                        fmt::format("gnuplot did not write figure '{}.{}'", printable(figures[f].stem), ext));
-    }
-  }
-  // A failure half way removes the figures already put in place: all of them or none.
-  std::vector<std::string> published;
-  try {
-    for (std::size_t f = 0; f < figures.size(); ++f)
-      for (const char* ext : {"png", "svg"}) {
-        const std::string to = fmt::format("{}.{}", figures[f].stem, ext);
-        publish(scratch.path() / fmt::format("f{}.{}", f, ext), to);
-        published.push_back(to);
-      }
-  } catch (...) {
-    std::error_code ignored;
-    for (const std::string& p : published) fs::remove(p, ignored);
-    throw;
-  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) throw gnuplot_failure(figures, script, status, err_path);
+  publish_all(figures, scratch.path());
 }
 
 }  // namespace hexatwist::cli
