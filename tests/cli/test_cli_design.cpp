@@ -16,78 +16,13 @@
 #include <string>
 #include <vector>
 
+#include "cli_support.hpp"
+
+using namespace hexatwist::cli_test;
+
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kPi = 3.14159265358979323846;
-
-const fs::path& temp_dir() {
-  struct Dir {
-    fs::path path;
-    Dir() {
-      std::string tmpl = (fs::temp_directory_path() / "hexatwist_cli_design_XXXXXX").string();
-      if (mkdtemp(tmpl.data()) == nullptr) std::abort();
-      path = tmpl;
-    }
-    ~Dir() {
-      std::error_code ec;
-      fs::remove_all(path, ec);
-    }
-  };
-  static const Dir dir;
-  return dir.path;
-}
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) {
-    if (c == '\'')
-      out.append("'\\''");
-    else
-      out.push_back(c);
-  }
-  out.push_back('\'');
-  return out;
-}
-
-struct Outcome {
-  int code = -1;
-  std::string out, err;
-};
-
-Outcome run(const std::vector<std::string>& args, const std::string& redirect = "") {
-  const fs::path err = temp_dir() / "stderr.txt";
-  std::string command = quote(HEXATWIST_CLI);
-  for (const std::string& a : args) {
-    command.push_back(' ');
-    command.append(quote(a));
-  }
-  command.append(" 2>").append(quote(err.string())).append(redirect);
-  Outcome r;
-  FILE* p = popen(command.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  for (std::size_t n; (n = fread(buf, 1, sizeof buf, p)) > 0;) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.err = read_file(err);
-  return r;
-}
-
-// One line on stderr, "hexatwist: error: ..." holding `part`.
-void expect_one_line_error(const Outcome& r, int code, const std::string& part) {
-  EXPECT_EQ(r.code, code) << r.err;
-  EXPECT_EQ(r.err.rfind("hexatwist: error: ", 0), 0u) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
-}
 
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> f;
@@ -253,31 +188,29 @@ TEST(CliTolerance, AfterATrackerCalibrationFromAStationPlanMicrometresRemain) {
 
 TEST(CliDesignCommands, BadInputsAreOneLineWithTheirExitCodes) {
   const std::string out = (temp_dir() / "bad").string();
-  expect_one_line_error(run({"design", "--workspace", "random=many", "--out", out}), 2, "--workspace 'random=many'");
-  expect_one_line_error(run({"design", "--workspace", "colour=red", "--out", out}), 2, "unknown key");
-  expect_one_line_error(run({"tolerance", "--sigma-joint-um", "-1", "--out", out}), 2, "--sigma-joint-um");
-  expect_one_line_error(run({"tolerance", "--calibration", "stations:0", "--out", out}), 2, "--calibration");
-  expect_one_line_error(run({"tolerance", "--calibration", "plan", "--out", out}), 2, "--station-plan");
-  expect_one_line_error(run({"tolerance", "--tracker-noise-um", "0", "--out", out}), 2, "--tracker-noise-um");
-  expect_one_line_error(run({"tolerance", "--points-per-station", "0", "--out", out}), 2, "--points-per-station");
-  expect_one_line_error(run({"tolerance", "--station-plan", "/nonexistent/run.csv", "--out", out}), 2,
-                        "--station-plan");
-  expect_one_line_error(run({"workspace", "--orientation", "0,0", "--out", out}), 2, "--orientation");
-  expect_one_line_error(run({"workspace", "--spacing", "0", "--out", out}), 2, "--spacing");
+  expect_error(run({"design", "--workspace", "random=many", "--out", out}), 2, {"--workspace 'random=many'"});
+  expect_error(run({"design", "--workspace", "colour=red", "--out", out}), 2, {"unknown key"});
+  expect_error(run({"tolerance", "--sigma-joint-um", "-1", "--out", out}), 2, {"--sigma-joint-um"});
+  expect_error(run({"tolerance", "--calibration", "stations:0", "--out", out}), 2, {"--calibration"});
+  expect_error(run({"tolerance", "--calibration", "plan", "--out", out}), 2, {"--station-plan"});
+  expect_error(run({"tolerance", "--tracker-noise-um", "0", "--out", out}), 2, {"--tracker-noise-um"});
+  expect_error(run({"tolerance", "--points-per-station", "0", "--out", out}), 2, {"--points-per-station"});
+  expect_error(run({"tolerance", "--station-plan", "/nonexistent/run.csv", "--out", out}), 2, {"--station-plan"});
+  expect_error(run({"workspace", "--orientation", "0,0", "--out", out}), 2, {"--orientation"});
+  expect_error(run({"workspace", "--spacing", "0", "--out", out}), 2, {"--spacing"});
   const Outcome s = run({"tolerance", "--scheduler", "localhost:8786", "--out", out});
   EXPECT_EQ(s.code, 2) << s.err;
   EXPECT_NE(s.err.find("tcp://HOST:PORT"), std::string::npos) << s.err;
   // A required trajectory outside the limits: file, line and limit.
   const fs::path csv = temp_dir() / "high.csv";
   std::ofstream(csv) << "t,x,y,z,roll,pitch,yaw\n0,0,0,0,0,0,0\n1,0,0,0.9,0,0,0\n";
-  expect_one_line_error(run({"design", "--trajectory", csv.string(), "--out", out}), 3, "high.csv:3");
+  expect_error(run({"design", "--trajectory", csv.string(), "--out", out}), 3, {"high.csv:3"});
   // The designed file cannot be written: exit 4, nothing left.
-  expect_one_line_error(run({"design", "--workspace", "random=10,samples=3", "--out", "/nonexistent/d.yaml"}), 4,
-                        "/nonexistent/d.yaml");
+  expect_error(run({"design", "--workspace", "random=10,samples=3", "--out", "/nonexistent/d.yaml"}), 4,
+               {"/nonexistent/d.yaml"});
   // Standard output that cannot be written: exit 4, and no report left behind.
-  const Outcome full =
-      run({"tolerance", "--platforms", "2", "--workspace", "random=5,samples=3", "--no-figures", "--out", out},
-          " >/dev/full");
+  const Outcome full = run_to_full_disk(
+      {"tolerance", "--platforms", "2", "--workspace", "random=5,samples=3", "--no-figures", "--out", out});
   EXPECT_EQ(full.code, 4) << full.err;
   EXPECT_FALSE(fs::exists(fs::path(out) / "summary.json"));
 }

@@ -9,20 +9,13 @@
 #include <cmath>
 #include <random>
 
+#include "design/design_support.hpp"
 #include "hexatwist/design/required_workspace.hpp"
-#include "support.hpp"
 
 namespace hexatwist {
 namespace {
 
-std::vector<Pose> workspace(int random) {
-  RequiredWorkspaceSpec spec;
-  spec.test_samples = 11;
-  spec.random = random;
-  RequiredWorkspace w;
-  EXPECT_EQ(required_workspace(test::seed_model(), StudySpec{}, spec, Strategy::Compensated, w), Status::Ok);
-  return w.poses;
-}
+std::vector<Pose> workspace(int random) { return test::required_poses(random); }
 
 TEST(Tolerance, LinearisedAndMonteCarloMediansAndNinetyFifthPercentilesAgreeToTenPercent) {
   const Model& seed = test::seed_model();

@@ -5,21 +5,14 @@
 #include <cmath>
 #include <cstring>
 
+#include "design/design_support.hpp"
 #include "hexatwist/design/required_workspace.hpp"
 #include "hexatwist/error.hpp"
-#include "support.hpp"
 
 namespace hexatwist {
 namespace {
 
-std::vector<Pose> workspace(int random) {
-  RequiredWorkspaceSpec spec;
-  spec.test_samples = 11;
-  spec.random = random;
-  RequiredWorkspace w;
-  EXPECT_EQ(required_workspace(test::seed_model(), StudySpec{}, spec, Strategy::Compensated, w), Status::Ok);
-  return w.poses;
-}
+std::vector<Pose> workspace(int random) { return test::required_poses(random); }
 
 TrackerCalibration forty_stations() {
   TrackerCalibration c;
