@@ -151,7 +151,12 @@ std::string text_report(const Report& r) {
       r.line_of(static_cast<std::size_t>(id.max_after_index)), 1e3 * id.sigma, 1e3 * id.tracker_noise, id.fit_z,
       id.condition);
   const CrossValidation& cv = id.cross_validation;
-  if (cv.folds > 0)
+  if (cv.folds > 0 && cv.predicted == 0)
+    t += fmt::format(
+        "cross-validated ({} folds over the stations): not possible: with a fold's stations left out the "
+        "rest do not determine the model (too few stations: plan more)\n",
+        cv.folds);
+  else if (cv.folds > 0)
     t += fmt::format(
         "cross-validated ({} folds over the stations): the {} left-out stations' mean points are predicted to {:.1f} "
         "um rms, {:.1f} um at most ({:.1f} um expected from the noise and the covariance)\n",

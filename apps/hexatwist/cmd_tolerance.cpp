@@ -395,6 +395,13 @@ int run_tolerance(const ToleranceCommandOptions& o) {
   to.threads = 0;
   ToleranceLinear linear;
   const Status prepared = prepare_calibration(model, req.poses, calibration, to, linear);  // names its option
+  if (prepared == Status::NotIdentifiable)
+    throw ExitError(
+        kExitBadInput,
+        fmt::format("{}: the station plan does not determine the calibrated parameters ({}): plan more "
+                    "stations or spread them wider (hexatwist stations)",
+                    o.station_plan.empty() ? "--calibration " + o.calibration : "--station-plan " + o.station_plan,
+                    describe(prepared)));
   if (prepared != Status::Ok)
     throw ExitError(kExitOutOfLimit,
                     fmt::format("the linear model failed: {} ({})", describe(prepared), to_string(prepared)));
@@ -491,7 +498,18 @@ Command make_tolerance_command(CLI::App& root) {
   app->add_flag("--no-figures", o->no_figures, "Skip the figure (gnuplot)");
   app->add_flag("--no-csv", o->no_csv, "Skip platforms.csv");
   add_scheduler_option(*app, o->scheduler);
-  return {app, [o] { return run_tolerance(*o); }};
+  return {app, [o, app] {
+            // The tracker's options have an effect only on a tracker calibration: refused, not ignored, without one.
+            const bool tracker =
+                o->calibration.rfind("stations:", 0) == 0 || o->calibration == "plan" || !o->station_plan.empty();
+            for (const char* option : {"--tracker-noise-um", "--points-per-station", "--calibration-frames"})
+              if (!tracker && app->count(option) > 0)
+                throw ExitError(kExitBadInput,
+                                fmt::format("{}: only with a tracker calibration (--calibration "
+                                            "stations:N[,SEED], or --station-plan), not with --calibration {}",
+                                            option, o->calibration));
+            return run_tolerance(*o);
+          }};
 }
 
 }  // namespace hexatwist::cli

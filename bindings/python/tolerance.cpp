@@ -92,6 +92,11 @@ CalibrationChoice choice_of(const std::string& calibration, const py::object& tr
   CalibrationChoice c;
   c.name = calibration;
   if (tracker.is_none()) return c;
+  if (calibration.rfind("stations:", 0) != 0 && calibration != "plan")
+    raise_input(
+        "tracker: only with a tracker calibration (calibration=\"stations:N[,SEED]\" or \"plan\"), not with "
+        "calibration=\"" +
+        calibration + "\"");
   const py::dict t = tracker;
   for (const auto& kv : t) {
     const std::string k = kv.first.cast<std::string>();

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 
@@ -46,11 +47,24 @@ Status check_inputs(const Model& nominal, std::span<const Observation> observati
       reason = fmt::format("target {} has no observation (targets are numbered from 0 without gaps)", t);
       return Status::NotIdentifiable;
     }
-  const int equations = 3 * static_cast<int>(groups.station.size());
+  // A pose visited twice (home at both ends of a run) gives the same equations twice: only distinct
+  // commands (per target) count.
+  std::vector<std::array<double, kLegs + 1>> keys;
+  for (std::size_t g = 0; g < groups.station.size(); ++g) {
+    std::array<double, kLegs + 1> key{};
+    const Vector6d& m = observations[groups.first[g]].motor;
+    for (int i = 0; i < kLegs; ++i) key[static_cast<std::size_t>(i)] = std::round(m[i] / kSameCommand);
+    key[kLegs] = groups.target[g];
+    keys.push_back(key);
+  }
+  std::sort(keys.begin(), keys.end());
+  const auto distinct = static_cast<int>(std::unique(keys.begin(), keys.end()) - keys.begin());
+  const int equations = 3 * distinct;
   if (equations <= set.size()) {
     reason = fmt::format(
-        "{} stations give {} equations (3 per station and target) for {} parameters: at least {} stations are needed",
-        groups.stations, equations, set.size(),
+        "{} stations ({} distinct poses and targets; a pose visited twice counts once) give {} equations (3 per "
+        "pose and target) for {} parameters: at least {} distinct stations are needed",
+        groups.stations, distinct, equations, set.size(),
         (set.size() / 3 + 1 + groups.targets - 1) / std::max(groups.targets, 1));
     return Status::NotIdentifiable;
   }

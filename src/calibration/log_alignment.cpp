@@ -56,4 +56,32 @@ void check_settle(const std::string& source, double settle) {
                          "settle");
 }
 
+void check_within_reach(const Model& model, const PointLog& log) {
+  const ModelSpec& spec = model.spec();
+  double base = 0.0, platform = spec.observation_P.norm();
+  for (const LegSpec& leg : spec.legs) {
+    base = std::max(base, leg.base_B.norm());
+    platform = std::max(platform, leg.platform_P.norm());
+  }
+  const double reach = base + spec.limits.length_max + platform;
+  const double bound = (1.0 + std::sqrt(3.0)) * reach;
+  if (log.points_T.empty()) return;
+  Vector3d median;
+  std::vector<double> c(log.points_T.size());
+  for (int a = 0; a < 3; ++a) {
+    for (std::size_t k = 0; k < c.size(); ++k) c[k] = log.points_T[k][a];
+    std::nth_element(c.begin(), c.begin() + static_cast<std::ptrdiff_t>(c.size() / 2), c.end());
+    median[a] = c[c.size() / 2];
+  }
+  for (std::size_t k = 0; k < log.points_T.size(); ++k) {
+    const double d = (log.points_T[k] - median).norm();
+    if (!(d <= bound))
+      throw Error(fmt::format(
+          "{}: the point ({:.6g}, {:.6g}, {:.6g}) m is farther than {:.4g} m from the log's median point, farther "
+          "than two points of this platform can be apart (a joint reaches {:.4g} m from the base frame's origin): "
+          "not a point of this run",
+          point_location(log, k), log.points_T[k].x(), log.points_T[k].y(), log.points_T[k].z(), bound, reach));
+  }
+}
+
 }  // namespace hexatwist::detail

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "hexatwist/calibration/point_log.hpp"
+#include "hexatwist/kinematics/model.hpp"
 #include "hexatwist/motion/trajectory.hpp"
 
 namespace hexatwist::detail {
@@ -28,5 +29,11 @@ std::vector<double> aligned_times(const TimedPoses& commanded, const PointLog& l
 
 /// Throws unless settle is finite and >= 0.
 void check_settle(const std::string& source, double settle);
+
+/// Throws naming the first point of the log that no point of `model`'s platform can be: farther
+/// from the log's median point than (1 + sqrt 3) R, R the farthest any platform point (joints and
+/// the observation point) can be from the base frame's origin (a typing or export error: its
+/// error, its registration or its identification would mean nothing).
+void check_within_reach(const Model& model, const PointLog& log);
 
 }  // namespace hexatwist::detail

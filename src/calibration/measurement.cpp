@@ -86,6 +86,7 @@ Measurement measure_points(const Model& model, const TimedPoses& commanded, cons
   const std::string& src = log.source;
   const std::size_t n = log.points_T.size();
   const std::vector<double> times = aligned_times(commanded, log, options.time);
+  detail::check_within_reach(model, log);
   const auto where = [&](std::size_t k) { return point_location(log, k); };
   const std::vector<Pose> desired = interpolate(commanded, times);
   const Vector3d& obs = model.spec().observation_P;

@@ -57,6 +57,7 @@ double tracker_scatter(const ObservationGroups& groups) noexcept {
 ObservationSet observations_at_rest(const Model& model, const TimedPoses& commanded, const PointLog& log,
                                     const TimeAlignment& time, Strategy strategy, double settle) {
   detail::check_settle(log.source, settle);
+  detail::check_within_reach(model, log);
   const std::vector<double> times = detail::aligned_times(commanded, log, time);
   const std::vector<Pose> desired = interpolate(commanded, times);
   ObservationSet set;

@@ -206,6 +206,9 @@ Conditioning conditioning(const ParameterSet& set, const Eigen::MatrixXd& J, dou
     scale[j] = J.col(j).norm();
     if (scale[j] > 0.0) Js.col(j) /= scale[j];
   }
+  // Fewer equations than parameters: as many zero rows as make J square, so that the combinations
+  // the rows cannot fix are the zero singular values (undetermined), not missing ones.
+  if (Js.rows() < n) Js.conservativeResizeLike(Eigen::MatrixXd::Zero(n, n));
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeThinV);
   const Eigen::VectorXd& s = svd.singularValues();
   const Eigen::MatrixXd& V = svd.matrixV();

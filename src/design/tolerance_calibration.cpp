@@ -224,7 +224,10 @@ AxisSelection chosen_axes(const TrackerCalibration& c, const PlanModel& m) {
   const detail::Conditioning cond = detail::conditioning(m.every, m.J_all, 1e300);
   for (int a = 0, k = m.every.axis_index(); a < 2 * kLegs; ++a) {
     if (!m.every.axes()[static_cast<std::size_t>(a)]) continue;
-    const double sd = m.noise * std::sqrt(std::max(cond.inverse_normal(k, k), cond.inverse_normal(k + 1, k + 1)));
+    // No covariance (the plan leaves some combination undetermined): no axis is determined.
+    const double sd = cond.inverse_normal.size() == 0
+                          ? std::numeric_limits<double>::infinity()
+                          : m.noise * std::sqrt(std::max(cond.inverse_normal(k, k), cond.inverse_normal(k + 1, k + 1)));
     chosen[static_cast<std::size_t>(a)] = o.axes == AxisFit::All || sd <= o.axis_sd_max;
     k += 2;
   }

@@ -367,6 +367,29 @@ TEST(Measurement, OptionErrorsNameTheirParameter) {
   EXPECT_EQ(parameter_of(mo), "register_first");
 }
 
+// A point no point of the platform can be (1e6 or 1e300 typed for a coordinate), anywhere in the
+// log, at rest or not: measure and the observations of an identification name its line.
+TEST(Measurement, APointOutOfThePlatformsReachIsRefusedNamingItsLine) {
+  const ShortRun run(2, deg2rad(5.0));
+  SynthesisOptions o;
+  o.seed = 5;
+  const SyntheticLog good = synth(run, o);
+  MeasurementOptions mo;
+  mo.window.until = run.calibration_end;
+  for (const double wild : {1e6, 1e300}) {
+    PointLog bad = good.log;
+    bad.points_T[7].x() = wild;
+    const std::string line = "synthetic log:" + std::to_string(bad.lines[7]);
+    expect_measure_error(run, bad, mo, {line, "not a point of this run"});
+    test::expect_error_line(
+        [&] {
+          (void)observations_at_rest(run.rig().model(), timed_poses(run.trajectory), bad, {}, Strategy::Compensated,
+                                     0.25);
+        },
+        line, {"farther than", "not a point of this run"});
+  }
+}
+
 // A log that is not of this run is refused, not evaluated: its registration misfit or its errors
 // say so, whatever the tracker frame.
 TEST(Measurement, LogsOfAnotherShapeOrMotionAreRefused) {
@@ -390,9 +413,10 @@ TEST(Measurement, LogsOfAnotherShapeOrMotionAreRefused) {
     other.points_T[k].x() += 0.5 * std::sin(0.01 * static_cast<double>(k));
   expect_measure_error(run, other, mo, {"misses the run by", "another motion"});
 
-  // One point of another world: 100 m off.
+  // One point 5 m off: within the platform's reach of the others, but farther from where the run
+  // puts it than a leg is long.
   PointLog typo = good.log;
-  typo.points_T.back().y() += 100.0;
+  typo.points_T.back().y() += 5.0;
   expect_measure_error(run, typo, mo, {":" + std::to_string(typo.lines.back()) + ": the point is", "maximum length"});
 }
 

@@ -494,7 +494,7 @@ TEST(CliMeasure, AnAbsurdPointAfterTheWindowIsRefusedNamingItsLine) {
   const std::string bad = write_file("absurd-bad.csv", joined(rows));
   const std::filesystem::path out = temp_dir() / "absurd-out";
   expect_error(run({"measure", "--points", bad, "--trajectory", traj, "--register-until", "8", "--out", out.string()}),
-               2, {"absurd-bad.csv:1001", "maximum length", "not a point of this run"});
+               2, {"absurd-bad.csv:1001", "farther than", "not a point of this run"});
   EXPECT_FALSE(std::filesystem::exists(out / "summary.json"));
 }
 

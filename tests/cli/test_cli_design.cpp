@@ -195,6 +195,9 @@ TEST(CliDesignCommands, BadInputsAreOneLineWithTheirExitCodes) {
   expect_error(run({"tolerance", "--calibration", "plan", "--out", out}), 2, {"--station-plan"});
   expect_error(run({"tolerance", "--tracker-noise-um", "0", "--out", out}), 2, {"--tracker-noise-um"});
   expect_error(run({"tolerance", "--points-per-station", "0", "--out", out}), 2, {"--points-per-station"});
+  expect_error(run({"tolerance", "--tracker-noise-um", "5", "--out", out}), 2, {"--tracker-noise-um", "only with"});
+  expect_error(run({"tolerance", "--calibration", "stations:5", "--platforms", "2", "--out", out}), 2,
+               {"--calibration stations:5", "does not determine"});
   expect_error(run({"tolerance", "--station-plan", "/nonexistent/run.csv", "--out", out}), 2, {"--station-plan"});
   expect_error(run({"workspace", "--orientation", "0,0", "--out", out}), 2, {"--orientation"});
   expect_error(run({"workspace", "--spacing", "0", "--out", out}), 2, {"--spacing"});

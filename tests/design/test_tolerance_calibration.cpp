@@ -217,5 +217,20 @@ TEST(ToleranceCalibration, BadInputsAreRefusedNamingTheField) {
   }
 }
 
+TEST(ToleranceCalibration, APlanOfTooFewStationsIsNotIdentifiableNotACrash) {
+  // 5 and 13 stations give fewer equations than the geometric model (with every axis) has
+  // parameters: the plan's Jacobian is wide, and the study says NotIdentifiable; 14 determine it.
+  const std::vector<Pose> poses = workspace(0);
+  for (const int n : {5, 13, 14}) {
+    SCOPED_TRACE(n);
+    CalibrationChoice choice;
+    choice.name = "stations:" + std::to_string(n);
+    ToleranceOptions o;
+    ToleranceLinear l;
+    EXPECT_EQ(prepare_calibration(test::seed_model(), poses, choice, o, l),
+              n < 14 ? Status::NotIdentifiable : Status::Ok);
+  }
+}
+
 }  // namespace
 }  // namespace hexatwist
