@@ -68,6 +68,10 @@ def snapshot(pins):
     }
 
 
+def settled():
+    return max(abs(a - c) for a, c in zip(stat.joint_actual_position[:6], stat.joint_position[:6])) <= 1e-9
+
+
 def idle():
     return stat.interp_state == linuxcnc.INTERP_IDLE and stat.queue == 0 and stat.inpos
 
@@ -132,7 +136,10 @@ def run(plan):
             record["done"] = mdi(step["mdi"])
         elif "program" in step:
             record["done"], record["samples"] = program(step["program"], step.get("pauses", 0), pins)
-        time.sleep(0.05)  # a few servo cycles: the feedback and the pins settle
+        # The feedback and the pins settle: the simulated joints reach their commands (a loaded
+        # machine may take more than a few servo cycles), then a few cycles more for the pins.
+        wait_until(settled, 2.0)
+        time.sleep(0.05)
         record["errors"] = drain_errors()
         record.update(snapshot(pins))
         results.append(record)
