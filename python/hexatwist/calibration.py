@@ -333,7 +333,7 @@ class StationsQuality(Result):
     sd_geometric: float
     """The geometric mean of the parameters' standard deviations [m]."""
     condition: float
-    """Condition number of the column-scaled Jacobian, as identify computes it (at most 1e8)."""
+    """Condition number of the column-scaled Jacobian, as identify computes it (at most 1e6)."""
     path: float
     """Length of the moves home, stations, home in pose coordinates [m or rad]."""
     covariance: FloatArray
