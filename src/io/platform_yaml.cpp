@@ -16,7 +16,7 @@ namespace hexatwist {
 namespace {
 
 // Shortest text that reads back to the same double.
-YAML::Node number(double v) { return YAML::Node(fmt::format("{}", v)); }
+YAML::Node number(double v) { return YAML::Node(fmt::format("{}", v == 0.0 ? 0.0 : v)); }  // -0 written as 0
 
 // The shortest degrees text that load_config turns back into exactly `rad` (deg2rad of it == rad):
 // rad2deg's nearest double does not always do that (1.5 deg -> rad -> deg -> rad moves by one
