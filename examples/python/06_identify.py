@@ -52,7 +52,8 @@ print("truth [mm]:", " ".join(f"{1e3 * v:+.4f}" for v in truth),
       f"(largest miss {np.abs(offsets - truth).max() / sds[np.argmax(np.abs(offsets - truth))]:.1f} sd)")
 
 fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.5), constrained_layout=True)
-a.plot(rz_log.stamps, 1e3 * (rz_log.points - rz_log.points[0]), lw=0.8)
+for axis, name in enumerate("xyz"):
+    a.plot(rz_log.stamps, 1e3 * (rz_log.points[:, axis] - rz_log.points[0, axis]), lw=0.8, label=f"{name} (tracker)")
 a.axvline(measured.calibration_end, color="k", ls=":", label="calibration end")
 a.set(xlabel="log time [s]", ylabel="tracker point - first point [mm]",
       title=f"tracker_Rz.csv (x, y, z): identify -> {rz.status}")
