@@ -239,14 +239,16 @@ TEST(CliIdentify, SynthThenIdentifyRecoversTheTruthAndWritesAConfigThatExplainsT
   const YAML::Node params = e["parameters"];
   for (std::size_t k = 0; k < params.size(); ++k) {
     const std::string name = params[k]["name"].as<std::string>();
-    if (name == "lead")
+    if (name == "lead") {
       EXPECT_LT(std::abs(params[k]["estimate"].as<double>() - real["leads"][0].as<double>()),
                 4 * params[k]["sd"].as<double>());
-    if (name.starts_with("offset "))
+    }
+    if (name.starts_with("offset ")) {
       EXPECT_LT(std::abs(params[k]["estimate"].as<double>() -
                          real["length_offsets"][std::stoi(name.substr(7)) - 1].as<double>()),
                 4 * params[k]["sd"].as<double>())
           << name;
+    }
   }
   for (int i = 0; i < 6; ++i) EXPECT_EQ(e["threads"][i].as<std::string>(), "left");
   EXPECT_EQ(e["twist_sign"].as<double>(), -1.0);
