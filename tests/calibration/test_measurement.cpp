@@ -571,7 +571,7 @@ TEST(Measurement, PointsAtRestOfAStationsRunIdentifyTheRealPlatform) {
   const ParameterSet& ps = id.parameters;
   Eigen::VectorXd truth_error = Eigen::VectorXd::Zero(ps.rotation_index());
   truth_error[0] = c.legs[0].lead - lead;
-  truth_error.segment(ps.offset_index(), kLegs) = offsets - o.errors.zero_offset;
+  truth_error.segment<kLegs>(ps.offset_index()) = offsets - o.errors.zero_offset;
   truth_error.segment<3>(ps.target_index()) = c.observation_P - point;
   for (int p = 0; p < ps.rotation_index(); ++p) {
     EXPECT_LT(std::abs(truth_error[p]), 4.0 * id.sd[p]) << ps.name(p);
