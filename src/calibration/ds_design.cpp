@@ -26,9 +26,12 @@ double log_det_spd(const Matrix& A) {
   return std::isfinite(d) ? d : kMinusInfinity;
 }
 
-// Every candidate's quadratic form A_k = J_k inverse J_k^T.
+// Every candidate's quadratic form A_k = J_k inverse J_k^T. The product is coefficient-based
+// (lazyProduct): Eigen 3.4's blocked product packs its operands with aligned vector stores into
+// buffers aligned to EIGEN_MAX_ALIGN_BYTES (16, CMakeLists.txt), which AVX's 32-byte stores may miss
+// (UBSan: a misaligned store in gemm_pack_lhs).
 void quadratic_forms(const Eigen::MatrixXd& inverse, const Eigen::MatrixXd& rows, int r, Eigen::MatrixXd& quad) {
-  const Eigen::MatrixXd JM = rows * inverse;
+  const Eigen::MatrixXd JM = rows.lazyProduct(inverse);
   quad.resize(rows.rows(), r);
   for (Eigen::Index k = 0; k < rows.rows(); k += r)
     quad.middleRows(k, r).noalias() = JM.middleRows(k, r) * rows.middleRows(k, r).transpose();
@@ -109,7 +112,7 @@ void DsDesign::swap_gains_of(const Forms& f, const Eigen::MatrixXd& rows, int po
   const Small removed = I - Small(f.quad.middleRows(R * i, R));
   const double base = log_det_spd(removed);
   const Small Q = removed.llt().solve(I);
-  const Eigen::MatrixXd B = rows * (f.inverse * rows.middleRows(R * i, R).transpose());
+  const Eigen::MatrixXd B = rows.lazyProduct(f.inverse * rows.middleRows(R * i, R).transpose());
   for (int k = 0; k < candidates(); ++k) {
     if (used_[static_cast<std::size_t>(k)] != 0) continue;
     const Small Bk = B.middleRows(R * k, R);
@@ -145,7 +148,7 @@ void DsDesign::woodbury(Forms& f, const Eigen::MatrixXd& rows, int r, int added,
   const Eigen::MatrixXd W = f.inverse * U.transpose();
   const Wide K = S + U * W;
   const Wide K_inv = K.fullPivLu().inverse();
-  const Eigen::MatrixXd C = rows * W;
+  const Eigen::MatrixXd C = rows.lazyProduct(W);
   for (Eigen::Index k = 0; k < rows.rows(); k += R) {
     const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxRows, 2 * kMaxRows> Ck = C.middleRows(k, R);
     f.quad.middleRows(k, R).noalias() -= Ck * K_inv * Ck.transpose();
