@@ -29,7 +29,10 @@ fi
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DHEXATWIST_SANITIZE=ON \
   -DHEXATWIST_BUILD_BENCHMARKS=OFF -DCMAKE_CXX_FLAGS=-mno-avx512f >/dev/null
 env "${sanitizer_env[@]}" cmake --build build-asan -- -j2
-env "${sanitizer_env[@]}" ctest --test-dir build-asan --output-on-failure -j2
+# The README's printed digits are the Release build's (the same commands run under the sanitizers
+# in their own tests): this build, without AVX-512 and at -O1, differs in an identification's last
+# digits, and the README's examples take it 9 minutes.
+env "${sanitizer_env[@]}" ctest --test-dir build-asan --output-on-failure -j2 -E '^CliReadme[.]
 stage_done "ASan + UBSan build and tests"
 
 HEXATWIST_FUZZ_SEED=${HEXATWIST_FUZZ_SEED:-1} bash scripts/fuzz.sh "${HEXATWIST_FUZZ_SECONDS:-60}"
