@@ -32,7 +32,7 @@ env "${sanitizer_env[@]}" cmake --build build-asan -- -j2
 # The README's printed digits are the Release build's (the same commands run under the sanitizers
 # in their own tests): this build, without AVX-512 and at -O1, differs in an identification's last
 # digits, and the README's examples take it 9 minutes.
-env "${sanitizer_env[@]}" ctest --test-dir build-asan --output-on-failure -j2 -E '^CliReadme[.]
+env "${sanitizer_env[@]}" ctest --test-dir build-asan --output-on-failure -j2 -E '^CliReadme[.]'
 stage_done "ASan + UBSan build and tests"
 
 HEXATWIST_FUZZ_SEED=${HEXATWIST_FUZZ_SEED:-1} bash scripts/fuzz.sh "${HEXATWIST_FUZZ_SECONDS:-60}"

@@ -24,6 +24,7 @@ struct DesignCommandOptions {
   double max_volume_loss_pct = 5.0;
   double clearance_deg = 0.0;
   std::string volume_orientation = "0,0,0";
+  double cell = 0.0;  // the volume's grid cell [m]; 0: automatic
   std::string out;
   bool json = false;
 };
@@ -97,6 +98,7 @@ std::string report_json(const Model& model, const DesignCommandOptions& o, const
   j.field("tilt", o.tilt);
   j.field("max_volume_loss", d.max_volume_loss);
   j.key("volume_orientation").vector(d.volume_rpy);
+  j.field("cell", o.cell);
   j.field("objective_before", r.objective_before);
   j.field("objective_after", r.objective_after);
   j.key("before");
@@ -185,6 +187,7 @@ int run_design(const DesignCommandOptions& o) {
   check_option(o.clearance_deg >= 0.0 && o.clearance_deg < 80.0, "--clearance", o.clearance_deg,
                "an angle from 0 to 80 deg");
   const std::vector<double> vo = parse_numbers(o.volume_orientation, 3, "--volume-orientation", "roll,pitch,yaw [deg]");
+  check_cell_option(o.cell);
   const RequiredPoses req = required_poses(config, o.required);
   // The configuration's own text: every other key of it is kept in the designed one.
   const std::string text = o.model.config.empty()
@@ -198,6 +201,7 @@ int run_design(const DesignCommandOptions& o) {
   d.max_volume_loss = o.max_volume_loss_pct / 100.0;
   d.clearance = deg2rad(o.clearance_deg);
   d.volume_rpy = Vector3d(deg2rad(vo[0]), deg2rad(vo[1]), deg2rad(vo[2]));
+  d.volume.cell = o.cell;
   d.threads = 0;
   AxisDesign r;
   if (const Status s = design_axes(model, req.poses, d, r); s != Status::Ok)
@@ -255,6 +259,7 @@ Command make_design_command(CLI::App& root) {
       ->capture_default_str();
   app->add_option("--volume-orientation", o->volume_orientation, "roll,pitch,yaw of the volume kept [deg]")
       ->capture_default_str();
+  add_cell_option(*app, o->cell);
   app->add_option("--out", o->out, "The designed configuration (YAML)")->required();
   app->add_flag("--json", o->json, "Print the report as JSON (SI)");
   return {app, [o] { return run_design(*o); }};

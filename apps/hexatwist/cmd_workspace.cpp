@@ -124,7 +124,7 @@ Results compute(const Model& model, const WorkspaceCommandOptions& o) {
   r.rpy = Vector3d(deg2rad(orientation[0]), deg2rad(orientation[1]), deg2rad(orientation[2]));
   check_option(o.spacing > 0.0 && o.spacing <= 1.0, "--spacing", o.spacing, "a spacing from 0 to 1 m");
   check_option(o.map_spacing > 0.0 && o.map_spacing <= 1.0, "--map-spacing", o.map_spacing, "a spacing from 0 to 1 m");
-  check_option(o.cell >= 0.0 && o.cell <= 1.0, "--cell", o.cell, "0 (automatic) to 1 m");
+  check_cell_option(o.cell);
   check_option(std::isfinite(o.xz_at), "--xz-at", o.xz_at, "a finite y [m]");
   check_option(std::isfinite(o.yz_at), "--yz-at", o.yz_at, "a finite x [m]");
   check_option(std::isfinite(o.map_height), "--map-height", o.map_height, "a finite z [m]");
@@ -588,8 +588,7 @@ Command make_workspace_command(CLI::App& root) {
       ->capture_default_str();
   app->add_option("--map-height", o->map_height, "z of the maps' x-y slice [m]")->capture_default_str();
   app->add_option("--map-spacing", o->map_spacing, "between the maps' nodes [m]")->capture_default_str();
-  app->add_option("--cell", o->cell, "the volume's grid cell [m] (0: the bounds' larger side / 64)")
-      ->capture_default_str();
+  add_cell_option(*app, o->cell);
   app->add_option("--out", o->out, "Output folder (created if missing), written as a set: all files or none (exit 4)")
       ->capture_default_str();
   app->add_flag("--json", o->json, "Print summary.json instead of the text report");

@@ -174,6 +174,14 @@ void write_required_json(JsonWriter& j, const RequiredPoses& r) {
   j.end_object();
 }
 
+void add_cell_option(CLI::App& app, double& cell) {
+  app.add_option("--cell", cell, "the volume's grid cell [m] (0: the bounds' larger side / 64)")->capture_default_str();
+}
+
+void check_cell_option(double cell) {
+  check_option(cell >= 0.0 && cell <= 1.0, "--cell", cell, "0 (automatic) to 1 m");
+}
+
 void add_scheduler_option(CLI::App& app, std::string& scheduler) {
   app.add_option(
          "--scheduler", scheduler,

@@ -43,6 +43,12 @@ RequiredPoses required_poses(const Config& config, const RequiredOptions& o);
 /// Writes the required workspace's description as a JSON object.
 void write_required_json(JsonWriter& j, const RequiredPoses& r);
 
+/// Adds --cell (the side of the volume's grid cell [m]; 0: the bounds' larger side / 64) to a
+/// command that computes a workspace volume (workspace, design).
+void add_cell_option(CLI::App& app, double& cell);
+/// ExitError(2) naming --cell unless it is 0 (automatic) to 1 m.
+void check_cell_option(double cell);
+
 /// Adds --scheduler (a Dask scheduler's address, tcp://HOST:PORT) to a command.
 void add_scheduler_option(CLI::App& app, std::string& scheduler);
 

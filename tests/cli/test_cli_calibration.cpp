@@ -360,29 +360,29 @@ TEST(CliIdentify, TwoThreadSensesThatFitEquallyWellExitFiveAndWriteNothing) {
 TEST(CliIdentify, BadRunsAndLogsAreOneLineErrors) {
   const std::string log = (temp_dir() / "stations.csv").string();
   if (!std::filesystem::exists(log)) {
-    ASSERT_EQ(run({"synth", "--stations", "40", "--station-seed", "3", "--out", log}).code, 0);
+    ASSERT_EQ(run({"synth", "--stations", "20", "--station-seed", "3", "--out", log}).code, 0);
   }
   // No run, two runs.
   expect_error(run({"identify", "--points", log}), 2, {"--test", "--trajectory", "--stations"});
-  expect_error(run({"identify", "--points", log, "--stations", "40", "--test", "Rz"}), 2, {"excludes"});
+  expect_error(run({"identify", "--points", log, "--stations", "20", "--test", "Rz"}), 2, {"excludes"});
   // The log is longer than the run it is said to be: its points after the run's end.
   expect_error(run({"identify", "--points", log, "--stations", "3"}), 2, {"stations.csv:", "outside", "time span"});
   // Five points; only the first rest at home counts as at rest when the settle time is 5 s.
   std::vector<std::string> rows = lines_of(read_file(log));
   expect_error(run({"identify", "--points", write_file("five.csv", joined({rows.begin(), rows.begin() + 6})),
-                    "--stations", "40", "--station-seed", "3"}),
+                    "--stations", "20", "--station-seed", "3"}),
                2, {"five.csv: only 5 of the 5 points are at rest", "at least 6"});
-  expect_error(run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--settle", "5"}), 5,
+  expect_error(run({"identify", "--points", log, "--stations", "20", "--station-seed", "3", "--settle", "5"}), 5,
                {"at rest at 1 station: not identifiable: ", "stations are needed"});
   // Stamps out of order; a missing unit; an unknown lead model.
   std::swap(rows[5], rows[6]);
-  expect_error(run({"identify", "--points", write_file("swapped.csv", joined(rows)), "--stations", "40"}), 2,
+  expect_error(run({"identify", "--points", write_file("swapped.csv", joined(rows)), "--stations", "20"}), 2,
                {"swapped.csv:7:", "strictly increasing"});
   rows = lines_of(read_file(log));
   rows[0] = "t,x,y,z";
-  expect_error(run({"identify", "--points", write_file("nounits.csv", joined(rows)), "--stations", "40"}), 2,
+  expect_error(run({"identify", "--points", write_file("nounits.csv", joined(rows)), "--stations", "20"}), 2,
                {"nounits.csv:1:", "units"});
-  expect_error(run({"identify", "--points", log, "--stations", "40", "--lead-effect", "both"}), 2, {"--lead-effect"});
+  expect_error(run({"identify", "--points", log, "--stations", "20", "--lead-effect", "both"}), 2, {"--lead-effect"});
 }
 
 TEST(CliIdentify, TheRunWrittenBySynthIdentifiesAsTheStationsDo) {
@@ -422,9 +422,9 @@ TEST(CliIdentify, TheRunWrittenBySynthIdentifiesAsTheStationsDo) {
 TEST(CliIdentify, JsonStatusAgreesWithTheExitCodeWhenTheConfigurationCannotBeWritten) {
   const std::string log = (temp_dir() / "stations.csv").string();
   if (!std::filesystem::exists(log)) {
-    ASSERT_EQ(run({"synth", "--stations", "40", "--station-seed", "3", "--out", log}).code, 0);
+    ASSERT_EQ(run({"synth", "--stations", "20", "--station-seed", "3", "--out", log}).code, 0);
   }
-  const Outcome r = run({"identify", "--points", log, "--stations", "40", "--station-seed", "3", "--json",
+  const Outcome r = run({"identify", "--points", log, "--stations", "20", "--station-seed", "3", "--json",
                          "--no-figures", "--out", "/proc/hexatwist-x.yaml"});
   expect_error(r, 4, {"hexatwist-x.yaml"});
   const YAML::Node j = json(r);

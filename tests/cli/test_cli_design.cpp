@@ -110,6 +110,17 @@ TEST(CliDesign, WritesAConfigurationWhoseLargestTwistIsHalvedWithEveryLimitKept)
   ASSERT_EQ(text.code, 0) << text.err;
   EXPECT_NE(text.out.find("largest |twist|"), std::string::npos);
   EXPECT_NE(text.out.find("U-joint singularity"), std::string::npos);
+  // --cell: a coarser volume grid (as workspace's and Python's), the same volume within the errors
+  // each run states, the coarser one's error larger.
+  const Outcome coarse = run({"design", "--workspace", "random=50,samples=5", "--cell", "0.1", "--json", "--out",
+                              (temp_dir() / "d3.yaml").string()});
+  ASSERT_EQ(coarse.code, 0) << coarse.err;
+  const YAML::Node c = YAML::Load(coarse.out);
+  EXPECT_EQ(c["cell"].as<double>(), 0.1);
+  const double fine_error = j["before"]["volume_error"].as<double>(),
+               coarse_error = c["before"]["volume_error"].as<double>();
+  EXPECT_GT(coarse_error, 2.0 * fine_error);
+  EXPECT_NEAR(c["before"]["volume"].as<double>(), j["before"]["volume"].as<double>(), coarse_error + fine_error);
 }
 
 TEST(CliTolerance, ReportsTheMonteCarloBesideTheLinearisedAnswer) {
