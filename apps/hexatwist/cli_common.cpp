@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "json.hpp"
@@ -69,6 +70,31 @@ Config load_config_from(const ModelOptions& opts) {
   } catch (const Error& e) {
     throw ExitError(kExitBadInput, e.what());
   }
+}
+
+Vector6d per_leg_option(const std::string& text, const char* option, const std::string& what, double lo, double hi,
+                        double scale) {
+  const bool six = text.find(',') != std::string::npos;
+  const std::vector<double> v = parse_numbers(text, six ? 6 : 1, option, what);
+  Vector6d out;
+  for (int i = 0; i < kLegs; ++i) {
+    const double x = v[six ? static_cast<std::size_t>(i) : 0];
+    check_option(x >= lo && x <= hi, option, x, what);
+    out[i] = x * scale;
+  }
+  return out;
+}
+
+Vector6d temperature_option(const std::string& text, const Model& model) {
+  if (text.empty()) return Vector6d::Constant(std::numeric_limits<double>::quiet_NaN());
+  if (!model.has_thermal())
+    throw ExitError(kExitBadInput, fmt::format("--temperature-c {}: the configuration's legs do not expand "
+                                               "(leg_effects: length_expansion, lead_expansion), so a temperature "
+                                               "changes nothing",
+                                               printable(text)));
+  return per_leg_option(text, "--temperature-c",
+                        fmt::format("a temperature from {:g} to {:g} degC, or six", kMinTemperature, kMaxTemperature),
+                        kMinTemperature, kMaxTemperature, 1.0);
 }
 
 std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option,

@@ -69,6 +69,21 @@ std::string model_source(const ModelOptions& opts);
 std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option,
                                   const std::string& what);
 
+/// One value for every leg, or six comma-separated, each checked against [lo, hi] in the option's
+/// units (`what` says them for the message) and multiplied by `scale` to SI.
+Vector6d per_leg_option(const std::string& text, const char* option, const std::string& what, double lo, double hi,
+                        double scale);
+
+/// The legs' temperatures of `--temperature-c` [degC] (one or six; empty: the reference, NaN).
+/// ExitError(2) for a value outside the plausible range, or any value for a `model` whose legs do
+/// not expand (it would change nothing).
+Vector6d temperature_option(const std::string& text, const Model& model);
+
+/// Help text of `--temperature-c`.
+inline constexpr const char* kTemperatureHelp =
+    "Each leg's temperature [degC], one or six, for a configuration with leg_effects (their thermal "
+    "expansion); default: its reference temperature";
+
 /// ExitError(2) "OPTION VALUE: expected EXPECTED" unless `ok`: the check of a number option's
 /// range, sign and finiteness (NaN and infinities never pass: `ok` must be false for them).
 void check_option(bool ok, std::string_view option, double value, std::string_view expected);

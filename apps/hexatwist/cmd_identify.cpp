@@ -24,6 +24,7 @@ struct IdentifyOptions {
   std::string model = "geometry";
   std::string lead_effect = "travel";
   std::string axes = "auto";
+  std::string effects = "none";
   double tracker_noise_um = std::numeric_limits<double>::quiet_NaN();
   int folds = 5;
   std::string out = "identified.yaml";
@@ -36,6 +37,7 @@ IdentificationOptions library_options(const IdentifyOptions& o) {
   io.model = o.model == "basic" ? CalibrationModel::Basic : CalibrationModel::Geometry;
   io.lead_effect = o.lead_effect == "twist" ? LeadEffect::TwistOnly : LeadEffect::TwistAndTravel;
   io.axes = o.axes == "none" ? AxisFit::None : o.axes == "all" ? AxisFit::All : AxisFit::Auto;
+  io.effects = effect_fit(o.effects);
   io.tracker_noise = o.tracker_noise_um * 1e-6;
   io.folds = o.folds;
   return io;
@@ -104,6 +106,16 @@ std::vector<Row> parameter_rows(const Report& r) {
     for (int k = ps.axis_index(); k < ps.axis_index() + ps.axis_count(); ++k)
       rows.push_back({ps.name(k), "deg", 0.0, rad2deg(id.estimate[k]), rad2deg(id.sd[k]), 4});
   }
+  if (ps.compliance_index() >= 0) {
+    const int k = ps.compliance_index();
+    rows.push_back({ps.name(k), "um/kN", 1e9 * id.nominal[k], 1e9 * id.estimate[k], 1e9 * id.sd[k], 4});
+  }
+  const int effects_end = ps.effect_index() + ps.effects().count();
+  for (int k = ps.effect_index(); k < effects_end; ++k)
+    if (ps.name(k) == "lead drift")
+      rows.push_back({ps.name(k), "ppm", 0.0, 1e6 * id.estimate[k], 1e6 * id.sd[k], 2});
+    else if (k != ps.compliance_index())
+      rows.push_back({ps.name(k), "mm", 1e3 * id.nominal[k], 1e3 * id.estimate[k], 1e3 * id.sd[k], 4});
   for (int k = ps.target_index(); k < ps.rotation_index(); ++k)
     rows.push_back({k - ps.target_index() < 3 ? fmt::format("point {}", "xyz"[k - ps.target_index()]) : ps.name(k),
                     "mm", 1e3 * id.nominal[k], 1e3 * id.estimate[k], 1e3 * id.sd[k], 4});
@@ -170,7 +182,7 @@ std::string text_report(const Report& r) {
       1e3 * acc.max, 1e3 * acc.aligned_median, 1e3 * acc.aligned_max);
   t += fmt::format("{:<18} {:>12} {:>12} {:>10} {:>12}\n", "parameter", "nominal", "estimate", "sd", "change");
   for (const Row& row : parameter_rows(r)) {
-    const std::string change = row.name.starts_with("lead")
+    const std::string change = row.name.starts_with("lead") && row.nominal != 0.0
                                    ? fmt::format("{:+.4f} %", 100.0 * (row.estimate / row.nominal - 1.0))
                                    : fmt::format("{:+.{}f}", row.estimate - row.nominal, row.decimals);
     t += fmt::format("{:<18} {:>12.{}f} {:>12.{}f} {:>10.{}f} {:>12}  [{}]\n", row.name, row.nominal, row.decimals,
@@ -508,6 +520,19 @@ Command make_identify_command(CLI::App& root) {
                   "U-joint fixed axes (geometry model): auto fits those the data determine to 0.1 deg, none keeps "
                   "them as configured, all fits every one")
       ->check(CLI::IsMember({"auto", "none", "all"}))
+      ->capture_default_str();
+  app->add_option("--effects", o->effects,
+                  "The legs' effects fitted besides the geometry, comma-separated: load (one compliance under the "
+                  "configuration's load), play (each leg's, from approaches from both sides), heat (each leg's drift "
+                  "over the run and a common curvature); none")
+      ->check([](const std::string& v) {
+        try {
+          (void)effect_fit(v);
+          return std::string();
+        } catch (const Error& e) {
+          return std::string(e.what());
+        }
+      })
       ->capture_default_str();
   app->add_option("--tracker-noise-um", o->tracker_noise_um,
                   "The tracker's noise per axis [um], for logs without repeated points at rest (default: their "

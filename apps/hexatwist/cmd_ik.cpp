@@ -14,6 +14,7 @@ namespace {
 struct IkOptions {
   ModelOptions model;
   std::string pose = "0,0,0,0,0,0";
+  std::string temperature_c;
   bool json = false;
 };
 
@@ -21,7 +22,11 @@ int run_ik(const IkOptions& o) {
   const Model model = load_model_from(o.model);
   const Pose pose = parse_pose_m_deg(o.pose, "--pose");
   auto report = std::make_unique<CommandReport>();
-  const Status status = compute_commands(model, pose, *report);
+  LegInputs inputs;
+  inputs.temperature = temperature_option(o.temperature_c, model);
+  const Status status = compute_commands(model, pose, inputs, nullptr, *report);
+  const bool effects = model.has_leg_effects();
+  const LegEffects& e = report->effects;
   // The numbers were finite when parsed (parse_pose_m_deg): so they are too large to compute with.
   if (status == Status::NonFiniteInput)
     throw ExitError(kExitBadInput, fmt::format("--pose {}: too large to compute with (the leg lengths overflow); "
@@ -58,7 +63,17 @@ int run_ik(const IkOptions& o) {
       ok ? j.value(report->conventional[i]) : j.null();
       j.key("command_compensated");
       ok ? j.value(report->compensated[i]) : j.null();
-      j.field("bend_base", bend_base[i]).field("bend_platform", bend_platform[i]).end_object();
+      j.field("bend_base", bend_base[i]).field("bend_platform", bend_platform[i]);
+      // The legs' effects at this pose (theory §4b): real minus rigid length, in its parts.
+      if (effects && ok)
+        j.field("force", e.force[i])
+            .field("temperature", e.temperature[i])
+            .field("direction", e.direction[i])
+            .field("effect_load", e.load[i])
+            .field("effect_thermal", e.thermal[i])
+            .field("effect_play", e.play[i])
+            .field("effect", e.total[i]);
+      j.end_object();
     }
     j.end_array().end_object();
     write_stdout(j.str());
@@ -80,6 +95,14 @@ int run_ik(const IkOptions& o) {
       out += fmt::format("{:>3}  {:9.6f}  {}  {}  {}  {}  {:14.3f}  {:18.3f}\n", i + 1, report->legs.length[i], tw, le,
                          cc, cp, rad2deg(bend_base[i]), rad2deg(bend_platform[i]));
     }
+    if (effects && ok) {
+      out += "leg effects (real minus rigid length, compensated; each leg approached from home):\n";
+      out += "leg  force[kN]  temperature[degC]  load[um]  thermal[um]  play[um]  total[um]\n";
+      for (int i = 0; i < kLegs; ++i)
+        out += fmt::format("{:>3}  {:9.3f}  {:17.2f}  {:8.2f}  {:11.2f}  {:8.2f}  {:9.2f}\n", i + 1, 1e-3 * e.force[i],
+                           e.temperature[i], 1e6 * tidy(e.load[i]), 1e6 * tidy(e.thermal[i]), 1e6 * tidy(e.play[i]),
+                           1e6 * tidy(e.total[i]));
+    }
     out +=
         fmt::format("status: {}\n", ok ? "ok" : std::string(to_string(status)) + ": " + describe_limit(report->limit));
     write_stdout(out);
@@ -100,6 +123,7 @@ Command make_ik_command(CLI::App& root) {
   app->add_option("--pose", opts->pose,
                   "Pose relative to home: x,y,z in m and roll,pitch,yaw in degrees, e.g. --pose=0.1,0,0.2,0,0,15")
       ->capture_default_str();
+  app->add_option("--temperature-c", opts->temperature_c, kTemperatureHelp);
   add_model_options(*app, opts->model);
   app->add_flag("--json", opts->json, "Machine-readable output (SI units: m, rad)");
   return {app, [opts] { return run_ik(*opts); }};

@@ -142,6 +142,18 @@ int run_linuxcnc(const LinuxcncOptions& o, const std::string& command_line) {
   files.input("--config", o.model.config);
   files.output("--out", o.out);
   const Config config = load_config_from(o.model);
+  if (const Model& model = config.rig.model(); model.has_play()) {
+    // The module keeps no direction of motion; LinuxCNC's backlash compensation does, per joint.
+    const double unit = o.units == "mm" ? 1000.0 : o.units == "inch" ? 1.0 / 0.0254 : 1.0;
+    std::string backlash;
+    for (int i = 0; i < kLegs; ++i)
+      backlash +=
+          fmt::format("{}[JOINT_{}]BACKLASH = {:g}", i == 0 ? "" : ", ", i, 2.0 * model.geometry().half_play[i] * unit);
+    throw ExitError(kExitBadInput,
+                    fmt::format("{}: leg_effects.play: LinuxCNC compensates the play itself, following each joint's "
+                                "direction: remove it from the configuration and give {} ({})",
+                                model_source(o.model), backlash, o.units));
+  }
   const std::string text = ini_text(o, config, command_line);
   if (!o.out.empty()) files.add(o.out, text);
   files.finish(o.out.empty() ? text : std::string());

@@ -48,6 +48,7 @@ struct StreamOptions {
   double max_acceleration = 0;  // 0 = no limit
   double rate = 1000;
   std::string start;
+  std::string temperature_c;
   std::uint64_t count = 0;
   double idle_timeout = 0;
   int rt_priority = 0;
@@ -300,7 +301,8 @@ UdpSocket::Received receive_datagram(UdpSocket& in, const StreamOptions& o, std:
 
 int run_stream(const StreamOptions& o) {
   const Model model = load_model_from(o.model);
-  const StreamSettings settings = settings_from(o);
+  StreamSettings settings = settings_from(o);
+  settings.inputs.temperature = temperature_option(o.temperature_c, model);
   check_settings(model, settings, o);
   const StreamFormat format =
       parse_choice<StreamFormat>(o.format, "--format", {{"csv", StreamFormat::Csv}, {"json", StreamFormat::Json}});
@@ -448,6 +450,7 @@ Command make_stream_command(CLI::App& root) {
          "--rate", o->rate,
          "input rate the limits assume [Hz]: one input every 1/rate s; only with --max-velocity or --max-acceleration")
       ->capture_default_str();
+  app->add_option("--temperature-c", o->temperature_c, kTemperatureHelp);
   app->add_option("--start", o->start,
                   "pose the platform stands at when the stream starts (x,y,z [m],roll,pitch,yaw [deg]), home or none; "
                   "default: home with rate limits, none without");

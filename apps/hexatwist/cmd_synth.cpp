@@ -32,6 +32,10 @@ struct SynthOptions {
   double joint_errors_mm = 0.0;
   double axis_errors_deg = 0.0;
   std::string targets_mm;
+  std::string stiffness_n_per_um;
+  std::string play_um;
+  std::string temperature_rise_k;
+  std::string expansion_ppm_per_k = "11.5,11.5";
   std::string out;
   std::string run_out;
 };
@@ -98,6 +102,13 @@ std::string truth_json(const Config& config, const SynthOptions& o, const Run& r
   for (int i = 0; i < kLegs; ++i) j.value(real.leg(i).thread == ThreadSense::Right ? "right" : "left");
   j.end_array();
   j.key("length_offsets").vector(real.geometry().length_offset);
+  j.key("stiffness").begin_array();
+  for (const LegSpec& leg : real.spec().legs) j.value(leg.stiffness);  // null: rigid
+  j.end_array();
+  j.key("play").begin_array();
+  for (const LegSpec& leg : real.spec().legs) j.value(leg.play);
+  j.end_array();
+  j.key("temperature_rise").vector(so.temperature_rise);
   j.key("home_commands").vector(real.home_command());
   j.key("targets").begin_array();
   j.vector(real.spec().observation_P);
@@ -187,6 +198,28 @@ SynthesisOptions synthesis_options(const SynthOptions& o, const Rig& rig) {
                                                  so.extra_targets_P.size() + 1, kMaxTargets));
   }
 
+  // The real legs' effects (theory §4b): stiffness, play, warming and expansion.
+  if (!o.stiffness_n_per_um.empty())
+    so.errors.stiffness = per_leg_option(
+        o.stiffness_n_per_um, "--stiffness-n-per-um",
+        fmt::format("an axial stiffness from {:g} to {:g} N/um, or six", kMinStiffness / 1e6, kMaxStiffness / 1e6),
+        kMinStiffness / 1e6, kMaxStiffness / 1e6, 1e6);
+  if (!o.play_um.empty())
+    so.errors.play =
+        per_leg_option(o.play_um, "--play-um", fmt::format("a play from 0 to {:g} um, or six", kMaxPlay * 1e6), 0.0,
+                       kMaxPlay * 1e6, 1e-6);
+  // The expansions are checked whether or not the legs warm: a bad value is never ignored.
+  const std::vector<double> expansion = parse_numbers(o.expansion_ppm_per_k, 2, "--expansion-ppm-per-k",
+                                                      "the length's and the lead's expansion [ppm/K], two numbers");
+  for (const double v : expansion)
+    check_option(v >= kMinExpansion * 1e6 && v <= kMaxExpansion * 1e6, "--expansion-ppm-per-k", v,
+                 fmt::format("expansions from {:g} to {:g} ppm/K", kMinExpansion * 1e6, kMaxExpansion * 1e6));
+  if (!o.temperature_rise_k.empty()) {
+    so.temperature_rise = per_leg_option(o.temperature_rise_k, "--temperature-rise-k",
+                                         "a temperature rise from -50 to 50 K over the run, or six", -50.0, 50.0, 1.0);
+    so.errors.length_expansion = expansion[0] * 1e-6;
+    so.errors.lead_expansion = expansion[1] * 1e-6;
+  }
   return so;
 }
 
@@ -322,6 +355,17 @@ Command make_synth_command(CLI::App& root) {
   app->add_option("--targets-mm", o->targets_mm,
                   "More targets on the platform, measured at every sample after A: \"x,y,z;x,y,z\" [mm, platform]; the "
                   "log gets a target column (A, T2, T3, ...)");
+  app->add_option("--stiffness-n-per-um", o->stiffness_n_per_um,
+                  "The real legs' axial stiffness [N/um], one or six: they shorten under the configuration's load "
+                  "(default: as configured)");
+  app->add_option("--play-um", o->play_um,
+                  "The real legs' play (lost motion of nut and joints) [um], one or six (default: as configured)");
+  app->add_option("--temperature-rise-k", o->temperature_rise_k,
+                  "The legs warm by this over the run [K], one or six, along 1 - exp(-t/T) (default: no warming)");
+  app->add_option("--expansion-ppm-per-k", o->expansion_ppm_per_k,
+                  "With --temperature-rise-k: the real legs' expansion of the length between the joints and of the "
+                  "screw's lead [ppm/K] (steel: 11.5)")
+      ->capture_default_str();
   app->add_flag("--flip-sign", o->flip_sign, "The real twist term has the opposite sign (other thread hand)");
   app->add_option("--offsets-mm", o->offsets_mm,
                   "Zero-length offset of each leg's motor-side length [mm]: one number B draws each uniformly in "

@@ -65,10 +65,12 @@ int main(int argc, char** argv) {
       if (word.starts_with("-")) continue;
       for (const Command& c : commands) chosen = chosen || c.app->get_name() == word;
       if (chosen) break;
+      // The list is the commands' own, so that it names every one.
+      std::string names;
+      for (std::size_t n = 0; n < commands.size(); ++n)
+        names += (n == 0 ? "" : n + 1 == commands.size() ? " or " : ", ") + commands[n].app->get_name();
       print_error("hexatwist: error: ",
-                  fmt::format("unknown subcommand '{}'; expected study, simulate, dynamics, synth, "
-                              "measure, identify, stream, ik, fk, config, linuxcnc or mjcf (see --help)",
-                              word));
+                  fmt::format("unknown subcommand '{}'; expected {} (see --help)", printable(word), names));
       return kExitBadInput;
     }
     print_error("hexatwist: error: ", fmt::format("{} (see --help)", e.what()));

@@ -9,6 +9,7 @@
 #include "hexatwist/kinematics/compensation.hpp"
 #include "hexatwist/kinematics/forward.hpp"
 #include "hexatwist/kinematics/kinematics.hpp"
+#include "hexatwist/kinematics/leg_effects.hpp"
 #include "hexatwist/kinematics/limits.hpp"
 #include "hexatwist/kinematics/model.hpp"
 #include "hexatwist/kinematics/pose.hpp"

@@ -244,6 +244,18 @@ int rtapi_app_main(void) {
     hal_exit(comp_id);
     return -EINVAL;
   }
+  if (hexatwist_model_play(model, NULL)) {
+    /* The module keeps no direction of motion: LinuxCNC's own backlash compensation does. */
+    rtapi_print_msg(RTAPI_MSG_ERR,
+                    NAME
+                    ": %s: its legs have play (leg_effects.play): give it to LinuxCNC as each joint's "
+                    "[JOINT_n]BACKLASH and leave it out of the configuration\n",
+                    config[0] != '\0' ? config : "the configuration");
+    hexatwist_model_free(model);
+    model = NULL;
+    hal_exit(comp_id);
+    return -EINVAL;
+  }
   home_height = hexatwist_model_home_height(model);
   hexatwist_fk_tracker_reset(&tracker);
   if (export_pins() != 0) {

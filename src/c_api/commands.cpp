@@ -1,6 +1,7 @@
 // C API: motor commands (paper Eq. 1-12), the full command report and the twist; real-time.
 #include "c_api.hpp"
 #include "hexatwist/kinematics/compensation.hpp"
+#include "hexatwist/kinematics/leg_effects.hpp"
 #include "hexatwist/kinematics/twist.hpp"
 
 using namespace hexatwist;
@@ -20,6 +21,56 @@ hexatwist_status hexatwist_motor_commands(const hexatwist_model* model, const do
                      strategy == HEXATWIST_COMPENSATED ? Strategy::Compensated : Strategy::Conventional, cmd, report);
   c_api::from_limit(report, limit);
   if (s == Status::Ok) c_api::from_vector(cmd, command);
+  return c_api::to_c(s);
+}
+
+hexatwist_leg_inputs hexatwist_leg_inputs_default(void) {
+  hexatwist_leg_inputs in;
+  for (int i = 0; i < HEXATWIST_LEGS; ++i) in.force[i] = in.temperature[i] = NAN;
+  return in;
+}
+
+void hexatwist_play_start(const hexatwist_model* model, hexatwist_play_state* play) {
+  if (model == nullptr || play == nullptr) return;
+  PlayState p;
+  start_play(model->model, model->model.home_command(), p);
+  play->started = 1;
+  c_api::from_vector(p.direction, play->direction);
+  c_api::from_vector(p.last, play->last);
+}
+
+hexatwist_status hexatwist_motor_commands_under(const hexatwist_model* model, const double pose[6],
+                                                hexatwist_strategy strategy, const hexatwist_leg_inputs* inputs,
+                                                hexatwist_play_state* play, double command[HEXATWIST_LEGS],
+                                                hexatwist_limit* limit) {
+  if (model == nullptr || pose == nullptr || command == nullptr ||
+      (strategy != HEXATWIST_CONVENTIONAL && strategy != HEXATWIST_COMPENSATED))
+    return HEXATWIST_INVALID_ARGUMENT;
+  LegInputs in;
+  if (inputs != nullptr) {
+    in.force = c_api::to_vector(inputs->force);
+    in.temperature = c_api::to_vector(inputs->temperature);
+  }
+  PlayState state;
+  if (play != nullptr) {
+    state.started = play->started != 0;
+    state.direction = c_api::to_vector(play->direction);
+    state.last = c_api::to_vector(play->last);
+  }
+  Vector6d cmd;
+  LimitReport report;
+  const Status s = motor_commands(model->model, c_api::to_pose(pose),
+                                  strategy == HEXATWIST_COMPENSATED ? Strategy::Compensated : Strategy::Conventional,
+                                  in, play != nullptr ? &state : nullptr, cmd, report);
+  c_api::from_limit(report, limit);
+  if (s == Status::Ok) {
+    c_api::from_vector(cmd, command);
+    if (play != nullptr) {
+      play->started = state.started ? 1 : 0;
+      c_api::from_vector(state.direction, play->direction);
+      c_api::from_vector(state.last, play->last);
+    }
+  }
   return c_api::to_c(s);
 }
 

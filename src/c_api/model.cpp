@@ -78,6 +78,12 @@ void hexatwist_model_home_commands(const hexatwist_model* model, double motor[HE
   c_api::from_vector(model->model.home_command(), motor);
 }
 
+int hexatwist_model_play(const hexatwist_model* model, double play[HEXATWIST_LEGS]) {
+  if (model == nullptr) return 0;
+  if (play != nullptr) c_api::from_vector(2.0 * model->model.geometry().half_play, play);
+  return model->model.has_play() ? 1 : 0;
+}
+
 void hexatwist_model_stroke(const hexatwist_model* model, double* length_min, double* length_max) {
   if (model == nullptr) return;
   if (length_min != nullptr) *length_min = model->model.spec().limits.length_min;

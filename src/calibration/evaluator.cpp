@@ -3,9 +3,14 @@
 #include <ceres/jet.h>
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
 
 #include "hexatwist/error.hpp"
+#include "hexatwist/kinematics/leg_effects.hpp"
 #include "hexatwist/kinematics/twist.hpp"
 #include "kinematics/geometry.hpp"
 
@@ -76,7 +81,8 @@ Eigen::Matrix<double, 1, kLocal> leg_gradient(const Model& candidate, const Para
 }  // namespace
 
 Status pose_sensitivity(const Model& candidate, const ParameterSet& set, const FkResult& fk, const Vector6d& motor,
-                        Eigen::Matrix<double, 6, Eigen::Dynamic>& dx_dtheta) {
+                        Eigen::Matrix<double, 6, Eigen::Dynamic>& dx_dtheta,
+                        const Eigen::Matrix<double, 6, Eigen::Dynamic>* effects) {
   Matrix6d J_f_x;
   if (const Status s = length_jacobian(candidate, fk.legs, LengthKind::Motor, J_f_x); s != Status::Ok) return s;
   // The twist even where a lead is 0: the lead's own column is the twist (a sense that drove the
@@ -97,6 +103,8 @@ Status pose_sensitivity(const Model& candidate, const ParameterSet& set, const F
     if (travel && leg.lead > 0.0) d_lead -= (motor[i] - candidate.home_command()[i]) * leg.drive_scale / leg.lead;
     df(i, set.lead_count() == 1 ? 0 : i) = d_lead;
     df(i, set.offset_index() + i) = -1.0;
+    if (effects != nullptr && effects->cols() > 0)
+      df.row(i).segment(set.effect_index(), effects->cols()) = -effects->row(i);
     if (!geometry) continue;
     const Eigen::Matrix<double, 1, kLocal> g = leg_gradient(candidate, set, i, fk.placement);
     df.row(i).segment(set.base_index(), joints) = g.segment<3>(0) * set.base_basis().middleRows<3>(3 * i);
@@ -132,6 +140,79 @@ Eigen::Matrix<double, 3, Eigen::Dynamic> point_sensitivity(const ParameterSet& s
   return G;
 }
 
+EffectRegressors effect_regressors(const ParameterSet& set, std::span<const Observation> observations,
+                                   const ObservationGroups& groups, const std::vector<Vector6d>& station_motor) {
+  EffectRegressors out;
+  const Model nominal(set.nominal());
+  const std::size_t stations = station_motor.size();
+  // Each leg's direction: the sense of its last change of command, from home in the homing direction.
+  // Where the observations do not say (Observation::direction 0).
+  std::vector<Vector6d> given(stations, Vector6d::Zero());
+  for (std::size_t g = 0; g < groups.station.size(); ++g)
+    given[static_cast<std::size_t>(groups.station[g])] = observations[groups.first[g]].direction;
+  Vector6d last = nominal.home_command(), direction = nominal.geometry().home_direction;
+  for (std::size_t s = 0; s < stations; ++s) {
+    const Vector6d& m = station_motor[s];
+    for (int i = 0; i < kLegs; ++i) {
+      if (std::abs(m[i] - last[i]) > kSameCommand) direction[i] = m[i] > last[i] ? 1.0 : -1.0;
+      if (given[s][i] != 0.0) direction[i] = given[s][i];
+      last[i] = m[i];
+    }
+    out.direction.push_back(direction);
+  }
+  const EffectFit& fit = set.effects();
+  out.regressors.assign(stations, Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, fit.count()));
+  if (!fit.any()) return out;
+  const auto fail = [&](std::string reason) {
+    out.status = Status::NotIdentifiable;
+    out.reason = std::move(reason);
+    return out;
+  };
+  // Each station's time as a fraction of the run's (heat).
+  std::vector<double> time(stations, std::numeric_limits<double>::quiet_NaN());
+  double t0 = INFINITY, t1 = -INFINITY;
+  for (const Observation& o : observations) {
+    t0 = std::min(t0, o.time);
+    t1 = std::max(t1, o.time);
+  }
+  for (std::size_t g = 0; g < groups.station.size(); ++g)
+    time[static_cast<std::size_t>(groups.station[g])] = observations[groups.first[g]].time;
+  if (fit.heat && !(std::isfinite(t0) && std::isfinite(t1) && t1 > t0 &&
+                    std::all_of(observations.begin(), observations.end(),
+                                [](const Observation& o) { return std::isfinite(o.time); })))
+    return fail("heat: the legs' drift needs each observation's time, over a run of some duration");
+  if (fit.load && !nominal.spec().static_load.present)
+    return fail("load: the legs' forces need the configuration's load (its load and mechanism sections)");
+  Placement guess;
+  for (std::size_t s = 0; s < stations; ++s) {
+    Eigen::Matrix<double, 6, Eigen::Dynamic>& r = out.regressors[s];
+    int k = 0;
+    if (fit.load) {
+      FkResult fk;
+      Vector6d force;
+      const Status st = forward_kinematics(nominal, station_motor[s], LengthKind::Motor, guess, fk);
+      if (st != Status::Ok || static_leg_forces(nominal, nominal.spec().static_load, fk.legs, force) != Status::Ok)
+        return fail(fmt::format("load: station {}: the nominal model's forces there cannot be computed ({})", s + 1,
+                                describe(st)));
+      guess = fk.placement;
+      r.col(k++) = force - nominal.reference_force();
+    }
+    if (fit.play) {
+      for (int i = 0; i < kLegs; ++i) r(i, k + i) = -0.5 * (out.direction[s][i] - nominal.geometry().home_direction[i]);
+      k += kLegs;
+    }
+    if (fit.heat) {
+      const double f = (time[s] - t0) / (t1 - t0);
+      for (int i = 0; i < kLegs; ++i) {
+        r(i, k + i) = f;
+        r(i, k + kLegs + i) = f * f;
+        r(i, k + 2 * kLegs) = f * (station_motor[s][i] - nominal.home_command()[i]);
+      }
+    }
+  }
+  return out;
+}
+
 Evaluator::Evaluator(const ParameterSet& set, std::span<const Observation> observations,
                      const ObservationGroups& groups, const FkOptions& fk)
     : set_(set), observations_(observations), groups_(groups), fk_options_(fk) {
@@ -139,11 +220,16 @@ Evaluator::Evaluator(const ParameterSet& set, std::span<const Observation> obser
   for (std::size_t g = 0; g < groups.station.size(); ++g)
     station_motor_[static_cast<std::size_t>(groups.station[g])] = observations[groups.first[g]].motor;
   poses_.assign(station_motor_.size(), Placement{});
+  effects_ = effect_regressors(set, observations, groups, station_motor_);
 }
 
 Status Evaluator::evaluate(const Eigen::VectorXd& theta, double sign, const RigidTransform& X_BT, Eigen::VectorXd& e,
                            Eigen::MatrixXd* J, std::span<const char> skip) {
   candidate_.reset();
+  if (effects_.status != Status::Ok) {
+    failed_station_ = -1;
+    return effects_.status;
+  }
   try {
     candidate_.emplace(set_.platform(theta, sign));
   } catch (const Error&) {
@@ -154,11 +240,22 @@ Status Evaluator::evaluate(const Eigen::VectorXd& theta, double sign, const Rigi
   const auto stations = static_cast<std::size_t>(groups_.stations);
   const auto skipped = [&](std::size_t s) { return s < skip.size() && skip[s] != 0; };
   std::vector<FkResult> fk(stations);
+  const int fitted = set_.effects().count();
+  const Eigen::VectorXd effect_theta = theta.segment(set_.effect_index(), fitted);
   for (std::size_t s = 0; s < stations; ++s) {
     if (skipped(s)) continue;
-    if (const Status st =
-            forward_kinematics(model, station_motor_[s], LengthKind::Motor, poses_[s], fk[s], fk_options_);
-        st != Status::Ok && st != Status::AssemblyModeChanged) {
+    // The fitted effects shift the legs' lengths, so the nut's travel: the drives' command by that
+    // over their scale. The configuration's own effects act at the station's approach direction.
+    Vector6d motor = station_motor_[s];
+    if (fitted > 0) {
+      const Vector6d shift = effects_.regressors[s] * effect_theta;
+      for (int i = 0; i < kLegs; ++i) motor[i] += shift[i] / model.leg(i).drive_scale;
+    }
+    const Status st =
+        model.has_leg_effects()
+            ? forward_kinematics(model, motor, LegInputs{}, &effects_.direction[s], poses_[s], fk[s], fk_options_)
+            : forward_kinematics(model, motor, LengthKind::Motor, poses_[s], fk[s], fk_options_);
+    if (st != Status::Ok && st != Status::AssemblyModeChanged) {
       failed_station_ = static_cast<int>(s);
       return st;
     }
@@ -167,7 +264,8 @@ Status Evaluator::evaluate(const Eigen::VectorXd& theta, double sign, const Rigi
   std::vector<Eigen::Matrix<double, 6, Eigen::Dynamic>> dx(J != nullptr ? stations : 0);
   for (std::size_t s = 0; s < dx.size(); ++s) {
     if (skipped(s)) continue;
-    if (const Status st = pose_sensitivity(model, set_, fk[s], station_motor_[s], dx[s]); st != Status::Ok) {
+    if (const Status st = pose_sensitivity(model, set_, fk[s], station_motor_[s], dx[s], &effects_.regressors[s]);
+        st != Status::Ok) {
       failed_station_ = static_cast<int>(s);
       return st;
     }

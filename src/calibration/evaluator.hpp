@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -26,8 +27,26 @@ struct StationSensitivity {
 /// d x / d theta (6 x set.platform_size()) at the solution `fk` of `candidate` (the platform
 /// set.platform(theta, sign)) for the drives' commands `motor`: -J_f_x^-1 df/dtheta with
 /// f = |L| - offset - k dtheta(x) - travel(m) (theory §13). Returns a forward-kinematics status.
+/// `effects` (may be null): the station's regressors of the legs' effects (6 x set.effects().count(),
+/// EffectRegressors), whose length shift enters f as the offsets do.
 Status pose_sensitivity(const Model& candidate, const ParameterSet& set, const FkResult& fk, const Vector6d& motor,
-                        Eigen::Matrix<double, 6, Eigen::Dynamic>& dx_dtheta);
+                        Eigen::Matrix<double, 6, Eigen::Dynamic>& dx_dtheta,
+                        const Eigen::Matrix<double, 6, Eigen::Dynamic>* effects = nullptr);
+
+/// The legs' effects at each station (theory §13b): each leg's direction of approach (from the
+/// stations' order, starting from home in the homing direction), and the regressors whose product
+/// with the effects' parameters (ParameterSet::effect_index() on) is each leg's length shift [m].
+struct EffectRegressors {
+  Status status = Status::Ok;  ///< NotIdentifiable where an effect cannot be modelled (reason says why)
+  std::string reason;
+  std::vector<Vector6d> direction;                                   ///< per station [-]
+  std::vector<Eigen::Matrix<double, 6, Eigen::Dynamic>> regressors;  ///< per station, 6 x count
+};
+
+/// The regressors of set.effects() for the stations of `groups` (station_motor: each station's
+/// commands): load needs the nominal model's static load, heat the observations' times.
+EffectRegressors effect_regressors(const ParameterSet& set, std::span<const Observation> observations,
+                                   const ObservationGroups& groups, const std::vector<Vector6d>& station_motor);
 
 /// d A_B / d theta_platform (3 x set.platform_size()) of target t at the pose `fk` with sensitivity
 /// `dx_dtheta`, for the commands held fixed: the derivative of where the target is.
@@ -63,6 +82,8 @@ class Evaluator {
   int failed_station() const noexcept { return failed_station_; }
   /// The poses of the last evaluation, per station.
   const std::vector<Placement>& poses() const noexcept { return poses_; }
+  /// The legs' effects at the stations; a status other than Ok fails every evaluation.
+  const EffectRegressors& effects() const noexcept { return effects_; }
   /// The candidate model of the last evaluation (empty if it was invalid).
   const std::optional<Model>& candidate() const noexcept { return candidate_; }
 
@@ -72,6 +93,7 @@ class Evaluator {
   const ObservationGroups& groups_;
   FkOptions fk_options_;
   std::vector<Vector6d> station_motor_;
+  EffectRegressors effects_;
   std::vector<Placement> poses_;
   std::optional<Model> candidate_;
   int failed_station_ = -1;

@@ -132,7 +132,7 @@ void axis_observability(const Model& nominal, const IdentificationOptions& optio
   AxisSelection all;
   all.fill(true);
   const ParameterSet every(nominal, CalibrationModel::Geometry, options.lead_effect, all, fitted.targets(),
-                           options.leads);
+                           options.leads, options.effects);
   // The estimate in the larger layout: the same values, the axes at zero.
   Eigen::VectorXd theta = Eigen::VectorXd::Zero(every.size());
   theta.head(fitted.axis_index()) = id.estimate.head(fitted.axis_index());
@@ -320,7 +320,7 @@ Status fit_both_senses(const Model& nominal, ParameterSet& set, std::span<const 
     }
     if (any) {
       ParameterSet with_axes(nominal, CalibrationModel::Geometry, options.lead_effect, chosen, set.targets(),
-                             options.leads);
+                             options.leads, options.effects);
       Eigen::VectorXd theta = Eigen::VectorXd::Zero(with_axes.size());
       theta.head(set.axis_index()) = out.estimate.head(set.axis_index());
       theta.tail(with_axes.size() - with_axes.target_index()) = out.estimate.tail(set.size() - set.target_index());
@@ -350,7 +350,7 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
   out.groups = static_cast<int>(groups.station.size());
   // The axes, if any, are added once the rest is fitted (fit_both_senses).
   ParameterSet set(nominal, options.model, options.lead_effect, AxisSelection{}, std::max(groups.targets, 1),
-                   options.leads);
+                   options.leads, options.effects);
   out.parameters = set;
   const auto fail = [&](Status s, std::string reason = {}, std::string hint = {}) {
     if (!reason.empty()) out.reason = std::move(reason);
@@ -373,6 +373,9 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
 
   // The start, its residual and the identifiability there.
   Evaluator evaluator(set, observations, groups, options.fk);
+  if (evaluator.effects().status != Status::Ok)
+    return fail(evaluator.effects().status, evaluator.effects().reason,
+                "give the configuration's load, or fit other effects (--effects)");
   Eigen::VectorXd start;
   RigidTransform X_start;
   Registration registration;
@@ -408,7 +411,7 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
   Evaluator at_estimate(set, observations, groups, options.fk);
   if (const Status s = fit_statistics(set, at_estimate, observations, groups, options, out); s != Status::Ok)
     return fail(s);
-  out.corrected = set.platform(out.estimate, out.twist_sign);
+  out.corrected = set.platform(out.estimate, out.twist_sign, true);
   if (solved != Status::Ok)
     return fail(solved, fmt::format("sign {:+.0f}: {}", out.twist_sign, out.fits[out.twist_sign > 0 ? 0 : 1].message));
 
@@ -424,8 +427,9 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
                     options.fit_sigmas, w.station + 1, w.count, 1e3 * w.mean_error),
         set.model() == CalibrationModel::Basic
             ? "the joint geometry is off: identify the joint centres too, the geometry model (--model geometry)"
-            : "an error the model does not have: another configuration, log, run or strategy than the machine's, "
-              "a servo still moving (a longer settle time), or U-joint axes (fit them all: --axes all)");
+            : "an error the model does not have: legs that warm, deflect under the load or have play (fit them: "
+              "--effects heat,load,play), another configuration, log, run or strategy than the machine's, a servo "
+              "still moving (a longer settle time), or U-joint axes (fit them all: --axes all)");
   }
   // Is the thread sense decided? The rejected sense must fit worse than the noise explains.
   {

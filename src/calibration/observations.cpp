@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 
 #include "calibration/log_alignment.hpp"
@@ -54,6 +56,34 @@ double tracker_scatter(const ObservationGroups& groups) noexcept {
                                  : std::numeric_limits<double>::quiet_NaN();
 }
 
+namespace {
+
+// Each leg's direction of approach to the pose `at` held at time t: walking back along the
+// commanded trajectory, the sense of the first difference of 1 um or more in its command (0 where
+// the trajectory never moved it so far).
+Vector6d approach_direction(const Model& model, const TimedPoses& commanded, double t, const Pose& at,
+                            const Vector6d& motor, Strategy strategy) {
+  constexpr double kMoved = 1e-6;  // [m]
+  Vector6d direction = Vector6d::Zero();
+  auto it = std::upper_bound(commanded.t.begin(), commanded.t.end(), t);
+  for (auto j = static_cast<std::ptrdiff_t>(it - commanded.t.begin()) - 1; j >= 0; --j) {
+    const Pose& p = commanded.poses[static_cast<std::size_t>(j)];
+    if ((p.to_vector() - at.to_vector()).cwiseAbs().maxCoeff() <= detail::kSamePose) continue;
+    Vector6d m;
+    LimitReport limit;
+    if (motor_commands(model, p, strategy, m, limit) != Status::Ok) continue;
+    bool all = true;
+    for (int i = 0; i < kLegs; ++i) {
+      if (direction[i] == 0.0 && std::abs(motor[i] - m[i]) >= kMoved) direction[i] = motor[i] > m[i] ? 1.0 : -1.0;
+      all = all && direction[i] != 0.0;
+    }
+    if (all) break;
+  }
+  return direction;
+}
+
+}  // namespace
+
 ObservationSet observations_at_rest(const Model& model, const TimedPoses& commanded, const PointLog& log,
                                     const TimeAlignment& time, Strategy strategy, double settle) {
   detail::check_settle(log.source, settle);
@@ -71,10 +101,15 @@ ObservationSet observations_at_rest(const Model& model, const TimedPoses& comman
       throw Error(fmt::format("{}: the commanded pose at t = {} s is outside a limit ({}); no command reached it",
                               detail::point_location(log, k), times[k], describe(s)));
     o.p_T = log.points_T[k];
+    o.time = times[k];
     o.target = k < log.targets.size() ? log.targets[k] : 0;
     if (set.points.empty() ||
-        (desired[k].to_vector() - desired[set.points.back()].to_vector()).cwiseAbs().maxCoeff() > detail::kSamePose)
+        (desired[k].to_vector() - desired[set.points.back()].to_vector()).cwiseAbs().maxCoeff() > detail::kSamePose) {
       ++set.poses;
+      o.direction = approach_direction(model, commanded, times[k], desired[k], o.motor, strategy);
+    } else {
+      o.direction = set.observations.back().direction;
+    }
     set.observations.push_back(o);
     set.points.push_back(k);
   }

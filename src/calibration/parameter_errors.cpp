@@ -25,6 +25,10 @@ Model real_model(const Model& nominal, const ParameterErrors& errors) {
     const Vector3d wp = errors.platform_axis_rotation.row(i).transpose();
     leg.axis_base_B = exp_so3(wb) * leg.axis_base_B;
     leg.axis_platform_P = exp_so3(wp) * leg.axis_platform_P;
+    if (!std::isnan(errors.stiffness[i])) leg.stiffness = errors.stiffness[i];
+    if (!std::isnan(errors.play[i])) leg.play = errors.play[i];
+    if (!std::isnan(errors.length_expansion)) leg.length_expansion = errors.length_expansion;
+    if (!std::isnan(errors.lead_expansion)) leg.lead_expansion = errors.lead_expansion;
   }
   spec.observation_P += errors.observation_offset_P;
   return Model(spec);

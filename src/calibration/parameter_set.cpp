@@ -2,8 +2,13 @@
 
 #include <fmt/format.h>
 
+#include "hexatwist/error.hpp"
+
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 namespace hexatwist {
 
@@ -22,9 +27,40 @@ Eigen::MatrixXd gauge_basis(const LegVectors& points) {
   return svd.matrixV().rightCols(3 * kLegs - 6);
 }
 
+std::string EffectFit::names() const {
+  std::string out;
+  for (const auto& [on, name] : {std::pair{load, "load"}, std::pair{play, "play"}, std::pair{heat, "heat"}})
+    if (on) out += (out.empty() ? "" : ",") + std::string(name);
+  return out.empty() ? "none" : out;
+}
+
+EffectFit effect_fit(std::string_view names) {
+  EffectFit fit;
+  if (names == "none") return fit;
+  std::size_t begin = 0;
+  while (begin <= names.size()) {
+    const std::size_t end = std::min(names.find(',', begin), names.size());
+    const std::string_view word = names.substr(begin, end - begin);
+    if (word == "load")
+      fit.load = true;
+    else if (word == "play")
+      fit.play = true;
+    else if (word == "heat")
+      fit.heat = true;
+    else
+      throw Error(fmt::format("effects: '{}' is not one of load, play, heat (a comma-separated list) or none", word));
+    begin = end + 1;
+  }
+  return fit;
+}
+
 ParameterSet::ParameterSet(const Model& nominal, CalibrationModel model, LeadEffect lead_effect,
-                           const AxisSelection& axes, int targets, LeadFit leads)
-    : nominal_(nominal.spec()), model_(model), lead_effect_(lead_effect), targets_(std::max(targets, 1)) {
+                           const AxisSelection& axes, int targets, LeadFit leads, EffectFit effects)
+    : nominal_(nominal.spec()),
+      model_(model),
+      lead_effect_(lead_effect),
+      effects_(effects),
+      targets_(std::max(targets, 1)) {
   bool same_lead = true;
   for (int i = 0; i < kLegs; ++i) {
     const Leg& leg = nominal.leg(i);
@@ -35,6 +71,16 @@ ParameterSet::ParameterSet(const Model& nominal, CalibrationModel model, LeadEff
   lead_count_ = same_lead && leads == LeadFit::Shared ? 1 : kLegs;
   offset_ = lead_count_;
   int next = offset_ + kLegs;
+  if (effects_.load) compliance_ = next++;
+  if (effects_.play) {
+    play_ = next;
+    next += kLegs;
+  }
+  if (effects_.heat) {
+    drift_ = next;
+    curvature_ = drift_ + kLegs;
+    next = curvature_ + kLegs + 1;
+  }
   if (model_ == CalibrationModel::Geometry) {
     base_ = next;
     platform_ = base_ + 3 * kLegs - 6;
@@ -66,6 +112,9 @@ std::string ParameterSet::group(int i) const {
   if (i < 0 || i >= size_) return "?";
   if (i < offset_) return "lead";
   if (i < offset_ + kLegs) return "offsets";
+  if (i == compliance_) return "load";
+  if (play_ >= 0 && i >= play_ && i < play_ + kLegs) return "play";
+  if (drift_ >= 0 && i >= drift_ && i <= curvature_ + kLegs) return "heat";
   if (base_ >= 0 && i < platform_) return "base joints";
   if (platform_ >= 0 && i < axis_) return "platform joints";
   if (axis_count_ > 0 && i >= axis_ && i < axis_ + axis_count_) return "axes";
@@ -77,6 +126,12 @@ std::string ParameterSet::name(int i) const {
   if (i < 0 || i >= size_) return "?";
   if (i < offset_) return lead_count_ == 1 ? std::string("lead") : fmt::format("lead {}", i + 1);
   if (i < offset_ + kLegs) return fmt::format("offset {}", i - offset_ + 1);
+  if (i == compliance_) return "compliance";
+  if (play_ >= 0 && i >= play_ && i < play_ + kLegs) return fmt::format("play {}", i - play_ + 1);
+  if (drift_ >= 0 && i >= drift_ && i < curvature_) return fmt::format("drift {}", i - drift_ + 1);
+  if (curvature_ >= 0 && i >= curvature_ && i < curvature_ + kLegs)
+    return fmt::format("curvature {}", i - curvature_ + 1);
+  if (curvature_ >= 0 && i == curvature_ + kLegs) return "lead drift";
   if (base_ >= 0 && i < platform_) return fmt::format("base joints g{}", i - base_ + 1);
   if (platform_ >= 0 && i < axis_) return fmt::format("platform joints g{}", i - platform_ + 1);
   if (axis_count_ > 0 && i >= axis_ && i < axis_ + axis_count_) {
@@ -100,13 +155,23 @@ Eigen::VectorXd ParameterSet::nominal_vector() const {
   for (int j = 0; j < lead_count_; ++j) theta[j] = nominal_.legs[static_cast<std::size_t>(j)].lead;
   for (int i = 0; i < kLegs; ++i) theta[offset_ + i] = nominal_.legs[static_cast<std::size_t>(i)].length_offset;
   theta.segment<3>(target_) = nominal_.observation_P;
+  // The effects start where the configuration puts them: its compliance and plays, no drift.
+  if (compliance_ >= 0) {
+    for (const LegSpec& leg : nominal_.legs) theta[compliance_] += 1.0 / leg.stiffness / kLegs;  // their mean
+  }
+  for (int i = 0; i < kLegs && play_ >= 0; ++i) theta[play_ + i] = nominal_.legs[static_cast<std::size_t>(i)].play;
   return theta;
 }
 
-ModelSpec ParameterSet::platform(const Eigen::VectorXd& theta, double sign) const {
+ModelSpec ParameterSet::platform(const Eigen::VectorXd& theta, double sign, bool with_effects) const {
   ModelSpec spec = nominal_;
   for (int i = 0; i < kLegs; ++i) {
     LegSpec& leg = spec.legs[static_cast<std::size_t>(i)];
+    if (compliance_ >= 0)
+      // Stiffer than the Model's plausible range (1e11 N/m) is rigid to a tracker.
+      leg.stiffness = with_effects && theta[compliance_] > 1e-11 ? 1.0 / theta[compliance_]
+                                                                 : std::numeric_limits<double>::infinity();
+    if (play_ >= 0) leg.play = with_effects ? std::max(theta[play_ + i], 0.0) : 0.0;
     leg.lead = theta[lead_count_ == 1 ? 0 : i];
     if (sign < 0.0) leg.thread = leg.thread == ThreadSense::Right ? ThreadSense::Left : ThreadSense::Right;
     leg.length_offset = theta[offset_ + i];

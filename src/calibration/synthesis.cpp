@@ -6,6 +6,7 @@
 
 #include "calibration/random.hpp"
 #include "hexatwist/error.hpp"
+#include "hexatwist/kinematics/leg_effects.hpp"
 
 namespace hexatwist {
 using detail::Random;
@@ -68,11 +69,29 @@ Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisO
   for (std::size_t t = 1; t < targets.size(); ++t) out.log.target_names.push_back(fmt::format("T{}", t + 1));
   FkResult fk;
   Placement guess = placement_from_pose(trajectory.poses.front());
+  if (!options.temperature_rise.allFinite())
+    throw Error("temperature_rise: expected finite temperature rises [K], got NaN or inf");
+  // The play's dead band follows the drives' commands: a servo's settling within the gap (its
+  // overshoot of a few um at the end of a move) is left out, since a leg's load and friction hold
+  // the nut there.
+  NutGap nuts;
+  Vector6d direction = real.geometry().home_direction;
+  const double duration = out.simulation.empty() ? 0.0 : out.simulation.back().time;
+  std::size_t played = 0;  // the ticks the dead band has followed
   for (std::size_t k = 0; k < out.simulation.size(); k += every) {
     const SimulationSample& sample = out.simulation[k];
+    for (; played <= k; ++played) direction = follow_nuts(real, out.simulation[played].command, nuts);
     // The drives' motor-side lengths on the real platform: its leads, joints, offsets and the
-    // drives' reference and scale (real_model) give the pose the platform takes.
-    if (const Status s = forward_kinematics(real, sample.motor, LengthKind::Motor, guess, fk); s != Status::Ok) {
+    // drives' reference and scale (real_model) give the pose the platform takes, under its legs'
+    // effects (the direction d = -2 g / b gives the play's term g - g_home).
+    LegInputs inputs;
+    const double shape = duration > 0.0 ? (1.0 - std::exp(-sample.time / duration)) / (1.0 - std::exp(-1.0)) : 0.0;
+    for (int i = 0; i < kLegs; ++i)
+      inputs.temperature[i] = real.reference_temperature() + options.temperature_rise[i] * shape;
+    const Status fk_status = real.has_leg_effects()
+                                 ? forward_kinematics(real, sample.motor, inputs, &direction, guess, fk)
+                                 : forward_kinematics(real, sample.motor, LengthKind::Motor, guess, fk);
+    if (const Status s = fk_status; s != Status::Ok) {
       issue.status = s;
       issue.index = k;
       issue.time = sample.time;

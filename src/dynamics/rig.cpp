@@ -112,9 +112,37 @@ int check_simulation(const SimulationSpec& sim) {
   return static_cast<int>(substeps);
 }
 
+bool same_load(const StaticLoadSpec& a, const StaticLoadSpec& b) {
+  return a.present == b.present && a.gravity == b.gravity && a.mass == b.mass &&
+         a.center_of_mass_P == b.center_of_mass_P && a.rod_mass == b.rod_mass && a.leg_moment == b.leg_moment;
+}
+
 }  // namespace
 
-Rig::Rig(const RigSpec& spec) : Rig(Model(spec.model), spec.servo, spec.load, spec.simulation, spec.mechanism) {}
+StaticLoadSpec static_load_spec(const LoadSpec& load, const MechanismSpec& mechanism) noexcept {
+  StaticLoadSpec s;
+  s.present = true;
+  s.gravity = load.gravity;
+  s.mass = load.mass;
+  s.center_of_mass_P = load.center_of_mass_P;
+  s.rod_mass = mechanism.rod.mass;
+  s.leg_moment = mechanism.housing.mass * mechanism.housing.center - mechanism.rod.mass * mechanism.rod.center;
+  return s;
+}
+
+namespace {
+// The model of a rig's specification, with the rig's static load (a stiffness needs it at once).
+ModelSpec with_static_load(const RigSpec& spec) {
+  check_load(spec.load);  // named as load.* and mechanism.* before the model sees them
+  check_mechanism(spec.mechanism);
+  ModelSpec model = spec.model;
+  model.static_load = static_load_spec(spec.load, spec.mechanism);
+  return model;
+}
+}  // namespace
+
+Rig::Rig(const RigSpec& spec)
+    : Rig(Model(with_static_load(spec)), spec.servo, spec.load, spec.simulation, spec.mechanism) {}
 
 Rig::Rig(Model model, const ServoSpec& servo, const LoadSpec& load, const SimulationSpec& simulation,
          const MechanismSpec& mechanism)
@@ -131,6 +159,12 @@ void Rig::validate_and_derive() {
   check_servo(s);
   check_load(load_);
   check_mechanism(mechanism_);
+  // The legs' static forces (their deflection) are this rig's load's: the model carries it.
+  if (const StaticLoadSpec load = static_load_spec(load_, mechanism_); !same_load(model_.spec().static_load, load)) {
+    ModelSpec spec = model_.spec();
+    spec.static_load = load;
+    model_ = Model(spec);
+  }
   substeps_ = check_simulation(simulation_);
   control_period_ = 1.0 / simulation_.control_rate;
   derive_drives();

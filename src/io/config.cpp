@@ -254,6 +254,60 @@ void read_leg_list(const Reader& r, const Field& top, const char* key, const cha
   }
 }
 
+// A number for every leg of the `leg_effects` block: one for all six, or a list of six. Non-finite
+// values are refused, except infinity where `infinite_ok` (a rigid leg's stiffness: .inf).
+void read_effect(const Reader& r, const Field& block, const char* key, const char* what, double LegSpec::*member,
+                 bool infinite_ok, Locations& locs, ModelSpec& spec) {
+  const Field f = Reader::child(block, key);
+  if (!f.present()) return;
+  const auto value = [&](const Field& v) {
+    if (infinite_ok && v.node.IsScalar()) {
+      const std::string& t = v.node.Scalar();
+      if (t == ".inf" || t == ".Inf" || t == ".INF" || t == "inf") return std::numeric_limits<double>::infinity();
+    }
+    return r.number(v, what);
+  };
+  if (f.node.IsSequence()) {
+    if (f.node.size() != kLegs)
+      r.fail(f.at(), f.path,
+             fmt::format("expected one number or a list of 6 ({}), got {} numbers", what, f.node.size()));
+    for (int i = 0; i < kLegs; ++i) {
+      const Field item = Reader::item(f, static_cast<std::size_t>(i), fmt::format("{}[{}]", f.path, i));
+      spec.legs[static_cast<std::size_t>(i)].*member = value(item);
+      locs[fmt::format("leg {}: {}", i + 1, key)] = loc(item);
+    }
+    return;
+  }
+  if (!f.node.IsScalar())
+    r.fail(f.at(), f.path, fmt::format("expected one number or a list of 6 ({}), got {}", what, kind(f.node)));
+  const double v = value(f);
+  for (int i = 0; i < kLegs; ++i) {
+    spec.legs[static_cast<std::size_t>(i)].*member = v;
+    locs[fmt::format("leg {}: {}", i + 1, key)] = loc(f);
+  }
+}
+
+// `leg_effects`: what the real legs add to the geometry (kinematics/leg_effects.hpp, theory §4b).
+void read_leg_effects(const Reader& r, const Field& top, Locations& locs, ModelSpec& spec) {
+  const Field block = Reader::child(top, "leg_effects");
+  if (!block.present()) return;
+  r.require_map(block, "stiffness, play, home_direction, length_expansion, lead_expansion, reference_temperature");
+  r.only_keys(block,
+              {"stiffness", "play", "home_direction", "length_expansion", "lead_expansion", "reference_temperature"});
+  read_effect(r, block, "stiffness", "axial stiffness of each leg [N/m], .inf = rigid", &LegSpec::stiffness, true, locs,
+              spec);
+  read_effect(r, block, "play", "lost motion along each leg [m]", &LegSpec::play, false, locs, spec);
+  read_effect(r, block, "home_direction", "direction of each leg's homing approach, +1 or -1", &LegSpec::home_direction,
+              false, locs, spec);
+  read_effect(r, block, "length_expansion", "thermal expansion of the length between the joints [1/K]",
+              &LegSpec::length_expansion, false, locs, spec);
+  read_effect(r, block, "lead_expansion", "thermal expansion of the lead [1/K]", &LegSpec::lead_expansion, false, locs,
+              spec);
+  const Field t = Reader::child(block, "reference_temperature");
+  spec.reference_temperature = r.number_or(t, "temperature at which the geometry holds [degC]", 20.0);
+  locs["reference_temperature"] = loc(t);
+}
+
 // `limits`, `observation_point` and `pivot`.
 void read_limits_and_points(const Reader& r, const Field& top, Locations& locs, ModelSpec& spec) {
   const Field lim = Reader::child(top, "limits");
@@ -286,7 +340,7 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
   const YAML::Node root = load_document(r, yaml_text, source);
   const Field top{root, "", root.Mark()};
   r.only_keys(top, {"name", "symmetric", "legs", "home_height", "screw", "length_offsets", "home_commands", "limits",
-                    "observation_point", "pivot", "servo", "load", "simulation", "study", "mechanism"});
+                    "observation_point", "pivot", "servo", "load", "simulation", "study", "mechanism", "leg_effects"});
 
   ModelSpec spec;
   const Field name = Reader::child(top, "name");
@@ -320,8 +374,12 @@ ModelSpec parse(std::string_view yaml_text, std::string_view source, Locations& 
                 &LegSpec::length_offset, "length_offset", locs, spec);
   read_leg_list(r, top, "home_commands", "motor-side length each drive reads at its reference (homing), legs 1..6 [m]",
                 &LegSpec::home_command, "home_command", locs, spec);
+  read_leg_effects(r, top, locs, spec);
   read_limits_and_points(r, top, locs, spec);
   read_sections(r, top, locs, extras);
+  // The legs' static load is that of the load and mechanism sections (defaults where absent), as
+  // the Rig's: a model read alone carries it too.
+  spec.static_load = static_load_spec(extras.rig.load, extras.rig.mechanism);
   return spec;
 }
 
@@ -337,7 +395,8 @@ std::string locate(const Reader& r, const Locations& locs, std::string_view sour
   const bool leg_field = field.starts_with("leg ");
   if (leg_field)
     for (const char* s :
-         {"base_axis", "platform_axis", "base", "platform", "lead", "length_offset", "drive_lead", "home_command"}) {
+         {"base_axis", "platform_axis", "base", "platform", "lead", "length_offset", "drive_lead", "home_command",
+          "stiffness", "play", "home_direction", "length_expansion", "lead_expansion"}) {
       const std::size_t n = std::strlen(s);
       if (what.starts_with(s) && what.substr(n).starts_with(": ")) {
         sub = s;

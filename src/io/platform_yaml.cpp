@@ -57,8 +57,9 @@ YAML::Node flow(const Vector3d& v) { return flow({v.x(), v.y(), v.z()}); }
 YAML::Node flow(const Vector6d& v) { return flow({v[0], v[1], v[2], v[3], v[4], v[5]}); }
 
 // The keys that describe the platform: replaced by the block, wherever the user had them.
-const std::set<std::string> kPlatformKeys{"name",  "symmetric",      "legs",          "home_height",
-                                          "screw", "length_offsets", "home_commands", "observation_point"};
+const std::set<std::string> kPlatformKeys{"name",       "symmetric",      "legs",          "home_height",
+                                          "screw",      "length_offsets", "home_commands", "observation_point",
+                                          "leg_effects"};
 
 const char* thread_name(ThreadSense t) { return t == ThreadSense::Right ? "right" : "left"; }
 const char* driven_name(DrivenSide d) { return d == DrivenSide::Base ? "base" : "platform"; }
@@ -108,6 +109,38 @@ void check_only_axes(const ModelSpec& base, const ModelSpec& designed, std::stri
   }
 }
 
+// One number if the legs agree, else a list of six; infinity written as .inf.
+YAML::Node per_leg(const ModelSpec& platform, double LegSpec::*member) {
+  const auto value = [](double v) { return std::isinf(v) ? YAML::Node(".inf") : number(v); };
+  const double first = platform.legs[0].*member;
+  bool equal = true;
+  for (const LegSpec& leg : platform.legs) equal = equal && leg.*member == first;
+  if (equal) return value(first);
+  YAML::Node list(YAML::NodeType::Sequence);
+  for (const LegSpec& leg : platform.legs) list.push_back(value(leg.*member));
+  list.SetStyle(YAML::EmitterStyle::Flow);
+  return list;
+}
+
+// The `leg_effects` block: the fields that differ from their defaults (theory §4b).
+YAML::Node leg_effects_node(const ModelSpec& platform) {
+  YAML::Node block(YAML::NodeType::Map);
+  const LegSpec defaults;
+  const auto any = [&](double LegSpec::*member) {
+    for (const LegSpec& leg : platform.legs)
+      if (!(leg.*member == defaults.*member)) return true;
+    return false;
+  };
+  for (const auto& [key, member] : {std::pair{"stiffness", &LegSpec::stiffness}, std::pair{"play", &LegSpec::play},
+                                    std::pair{"home_direction", &LegSpec::home_direction},
+                                    std::pair{"length_expansion", &LegSpec::length_expansion},
+                                    std::pair{"lead_expansion", &LegSpec::lead_expansion}})
+    if (any(member)) block[key] = per_leg(platform, member);
+  if (platform.reference_temperature != ModelSpec{}.reference_temperature)
+    block["reference_temperature"] = number(platform.reference_temperature);
+  return block;
+}
+
 // The platform block, in the order the legs form reads.
 YAML::Node platform_block(const ModelSpec& platform, const Model& model, bool write_home_commands) {
   const LegSpec& first = platform.legs[0];
@@ -133,6 +166,7 @@ YAML::Node platform_block(const ModelSpec& platform, const Model& model, bool wr
   block["length_offsets"] = flow(offsets);
   if (write_home_commands || homes_differ) block["home_commands"] = flow(homes);
   block["observation_point"] = flow(platform.observation_P);
+  if (const YAML::Node effects = leg_effects_node(platform); effects.size() > 0) block["leg_effects"] = effects;
   return block;
 }
 

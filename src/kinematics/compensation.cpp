@@ -21,12 +21,29 @@ void length_error(const Model& model, const Vector6d& dtheta, Vector6d& error) n
   error = model.geometry().twist_gain.cwiseProduct(dtheta);
 }
 
-Status compute_commands(const Model& model, const Pose& pose, CommandReport& out) noexcept {
+namespace {
+
+// The travel under the legs' effects for the twist-compensated travel u0 (leg_effects.hpp): the
+// direction of each leg decided on the travel without its play term, then the play's term with it.
+// `no_play` receives that travel (what the play state moves on to).
+void effects_travel(const Model& model, const Vector6d& u0, const Vector6d& twist_term, const Vector6d& force,
+                    const Vector6d& temperature, const PlayState* play, Vector6d& travel, Vector6d& no_play,
+                    Vector6d& direction, LegEffects* effects) noexcept {
+  const Vector6d& home = model.geometry().home_direction;
+  travel_under_effects(model, u0, twist_term, force, temperature, home, no_play, nullptr);
+  direction = play_direction(model, play != nullptr ? *play : PlayState{}, no_play);
+  travel_under_effects(model, u0, twist_term, force, temperature, direction, travel, effects);
+}
+
+// Inverse kinematics, the limits, the twist and Eq. (10)-(12) as the nuts' travels: Ok when the
+// pose is inside every limit (out.conventional and out.compensated then hold travels still to be
+// checked against the stroke), else the status to return. The twist is defined wherever no U-joint
+// is singular, also outside the other limits.
+Status rigid_travels(const Model& model, const Pose& pose, CommandReport& out) noexcept {
   out.limit = LimitReport{};
   if (!pose.is_finite()) return fail(out.limit, Status::NonFiniteInput);
   if (const Status s = inverse_kinematics(model, pose, out.legs); s != Status::Ok) return fail(out.limit, s);
   const Status pose_status = check_limits(model, out.legs, out.limit);
-  // The twist is defined wherever no U-joint is singular, also outside the other limits.
   if (const Status s = twist(model, out.legs, out.twist); s != Status::Ok) {
     if (pose_status != Status::Ok) return pose_status;
     return fail(out.limit, s);
@@ -35,12 +52,23 @@ Status compute_commands(const Model& model, const Pose& pose, CommandReport& out
   // Eq. (11)-(12) as absolute motor-side lengths; both commands take the legs' zero errors out.
   out.conventional = out.legs.length - model.geometry().length_offset;
   out.compensated = out.conventional - out.length_error;
-  if (pose_status != Status::Ok) return pose_status;
-  // The stroke is the nut's travel; the drives' commands follow from it (theory §4).
+  return pose_status;
+}
+
+// The stroke is the nut's travel; the drives' commands follow from it (theory §4).
+Status drive_commands(const Model& model, CommandReport& out) noexcept {
   const Status stroke = check_stroke(model, out.compensated, out.limit);
   out.conventional = model.motor_from_travel(out.conventional);
   out.compensated = model.motor_from_travel(out.compensated);
   return stroke;
+}
+
+}  // namespace
+
+Status compute_commands(const Model& model, const Pose& pose, CommandReport& out) noexcept {
+  if (model.has_leg_effects()) return compute_commands(model, pose, LegInputs{}, nullptr, out);
+  if (const Status s = rigid_travels(model, pose, out); s != Status::Ok) return s;
+  return drive_commands(model, out);
 }
 
 namespace {
@@ -109,6 +137,8 @@ bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, V
 
 Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, Vector6d& command,
                       LimitReport& report) noexcept {
+  if (strategy == Strategy::Compensated && model.has_leg_effects())
+    return motor_commands(model, pose, strategy, LegInputs{}, nullptr, command, report);
   if (!pose.is_finite()) return fail(report, Status::NonFiniteInput);
   const bool compensated = strategy == Strategy::Compensated && model.has_twist();
   if (commands_in_lanes(model, pose, compensated, command)) {
@@ -118,6 +148,52 @@ Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, V
   }
   // Some test failed: the same computation through a LegState, which names the leg and limit.
   return detail::commands_through_state(model, pose, compensated, command, report);
+}
+
+Status compute_commands(const Model& model, const Pose& pose, const LegInputs& inputs, const PlayState* play,
+                        CommandReport& out) noexcept {
+  if (!model.has_leg_effects()) return compute_commands(model, pose, out);
+  out.effects = LegEffects{};
+  if (const Status s = rigid_travels(model, pose, out); s != Status::Ok) return s;
+  Vector6d force, temperature, no_play, direction;
+  if (const Status s = resolve_inputs(model, out.legs, inputs, force, temperature); s != Status::Ok)
+    return fail(out.limit, s);
+  Vector6d travel;
+  effects_travel(model, out.compensated, out.length_error, force, temperature, play, travel, no_play, direction,
+                 &out.effects);
+  out.compensated = travel;
+  return drive_commands(model, out);
+}
+
+Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, const LegInputs& inputs, PlayState* play,
+                      Vector6d& command, LimitReport& report) noexcept {
+  if (strategy != Strategy::Compensated || !model.has_leg_effects())
+    return motor_commands(model, pose, strategy, command, report);
+  if (!pose.is_finite()) return fail(report, Status::NonFiniteInput);
+  // The twist-compensated travel u0 in registers (every limit checked), else through a LegState
+  // (which names the leg and limit); the legs' state for their forces either way.
+  LegState legs;
+  Vector6d u0, twist_term;
+  if (const Status s = inverse_kinematics(model, placement_from_pose(pose), legs); s != Status::Ok)
+    return fail(report, s);
+  const Vector6d& offset = model.geometry().length_offset;
+  if (commands_in_lanes(model, pose, model.has_twist(), u0)) {
+    twist_term = legs.length - offset - u0;
+  } else {
+    if (const Status s = check_limits(model, legs, report); s != Status::Ok) return s;
+    Vector6d dtheta;
+    if (const Status s = twist(model, legs, dtheta); s != Status::Ok) return fail(report, s);
+    length_error(model, dtheta, twist_term);
+    u0 = legs.length - offset - twist_term;
+  }
+  Vector6d force, temperature, travel, no_play, direction;
+  if (const Status s = resolve_inputs(model, legs, inputs, force, temperature); s != Status::Ok) return fail(report, s);
+  effects_travel(model, u0, twist_term, force, temperature, play, travel, no_play, direction, nullptr);
+  if (const Status s = check_stroke(model, travel, report); s != Status::Ok) return s;
+  report = LimitReport{};
+  command = model.motor_from_travel(travel);
+  if (play != nullptr) advance_play(*play, no_play, direction);
+  return Status::Ok;
 }
 
 Status detail::commands_through_state(const Model& model, const Pose& pose, bool compensated, Vector6d& command,

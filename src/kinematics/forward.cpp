@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "hexatwist/kinematics/compensation.hpp"
 #include "hexatwist/kinematics/twist.hpp"
 #include "kinematics/gauss_jordan.hpp"
 #include "kinematics/geometry.hpp"
@@ -129,8 +130,11 @@ std::string_view check_fk_options(const FkOptions& o) noexcept {
   return {};
 }
 
-Status forward_kinematics(const Model& model, const Vector6d& motor_or_geometric, LengthKind kind,
-                          const Placement& guess, FkResult& out, const FkOptions& options) noexcept {
+namespace {
+
+// Forward kinematics of rigid legs (the legs' effects left out): the Newton iteration.
+Status forward_rigid(const Model& model, const Vector6d& motor_or_geometric, LengthKind kind, const Placement& guess,
+                     FkResult& out, const FkOptions& options) noexcept {
   // Motor-side lengths as the nut's travel (the drives' reference and scale, theory §4): the
   // equations below are in it.
   const Vector6d lengths = kind == LengthKind::Motor ? model.travel_from_motor(motor_or_geometric) : motor_or_geometric;
@@ -248,6 +252,55 @@ Status forward_kinematics(const Model& model, const Vector6d& motor_or_geometric
     std::swap(legs, trial);
     std::swap(J, J_trial);
   }
+}
+
+// Most passes of the effects' fixed point: each moves E by the change of the forces and of the
+// twist over the last pass's step, a few parts in 1e4 of it, so that three passes usually end it.
+constexpr int kMaxEffectPasses = 8;
+// Where E has settled [m]: far below the solve's own tolerance (1e-12).
+constexpr double kEffectTolerance = 1e-14;
+
+}  // namespace
+
+Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKind kind, const Placement& guess,
+                          FkResult& out, const FkOptions& options) noexcept {
+  if (kind == LengthKind::Motor && model.has_leg_effects())
+    return forward_kinematics(model, lengths, LegInputs{}, nullptr, guess, out, options, nullptr);
+  return forward_rigid(model, lengths, kind, guess, out, options);
+}
+
+Status forward_kinematics(const Model& model, const Vector6d& motor, const LegInputs& inputs, const Vector6d* direction,
+                          const Placement& guess, FkResult& out, const FkOptions& options,
+                          LegEffects* effects) noexcept {
+  if (!model.has_leg_effects()) return forward_rigid(model, motor, LengthKind::Motor, guess, out, options);
+  // The legs' effects add E to the nut's travel u (leg_effects.hpp); E depends on the pose through
+  // the forces and the twist only, so that a fixed point of rigid solves finds the pose: each pass
+  // solves with the last E and evaluates E at its solution.
+  const Vector6d travel = model.travel_from_motor(motor);
+  const Vector6d d = direction != nullptr ? *direction : play_direction(model, PlayState{}, travel);
+  const Vector6d& scale = model.geometry().drive_scale;
+  LegEffects e;
+  Vector6d E = Vector6d::Zero();
+  Placement start = guess;
+  Status first = Status::Ok;
+  for (int pass = 0; pass < kMaxEffectPasses; ++pass) {
+    const Status s = forward_rigid(model, motor + E.cwiseQuotient(scale), LengthKind::Motor, start, out, options);
+    if (s != Status::Ok && s != Status::AssemblyModeChanged) return s;
+    if (pass == 0) first = s;  // the mode is the guess's or not: later passes start at the solution
+    Vector6d dtheta, twist_term, force, temperature;
+    if (const Status t = twist(model, out.legs, dtheta); t != Status::Ok) return t;
+    length_error(model, dtheta, twist_term);
+    if (const Status r = resolve_inputs(model, out.legs, inputs, force, temperature); r != Status::Ok) return r;
+    effect_lengths(model, travel, twist_term, force, temperature, d, e);
+    const double change = (e.total - E).cwiseAbs().maxCoeff();
+    E = e.total;
+    start = out.placement;
+    if (change <= kEffectTolerance) {
+      if (effects != nullptr) *effects = e;
+      return first;
+    }
+  }
+  return Status::NoConvergence;
 }
 
 Status fk_tracker_set(const Model& model, const Placement& x, LengthKind kind, FkTracker& tracker) noexcept {

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "hexatwist/error.hpp"
+#include "hexatwist/kinematics/leg_effects.hpp"
 #include "hexatwist/kinematics/limits.hpp"
 #include "kinematics/geometry.hpp"
 #include "kinematics/twist_internal.hpp"
@@ -67,8 +68,35 @@ constexpr double kMaxDriveScaleError = 0.5;
 Model::Model(const ModelSpec& spec) : spec_(spec) {
   check_limits_spec();
   for (int i = 0; i < kLegs; ++i) build_leg(i);
+  for (int i = 0; i < kLegs; ++i) build_leg_effects(i);
   lay_out_geometry();
   check_home_and_reference();
+  set_reference_force();
+}
+
+void Model::set_reference_force() {
+  const StaticLoadSpec& load = spec_.static_load;
+  if (!load.present) {
+    for (int i = 0; i < kLegs; ++i)
+      if (legs_[static_cast<std::size_t>(i)].compliance != 0.0)
+        fail(
+            fmt::format("leg {}: stiffness: the legs' forces need the load they carry (a configuration's load and "
+                        "mechanism sections)",
+                        i + 1));
+    return;
+  }
+  require_finite(load.gravity, "static_load.gravity");
+  require_finite(load.mass, "static_load.mass");
+  require_finite(load.rod_mass, "static_load.rod_mass");
+  require_finite(load.leg_moment, "static_load.leg_moment");
+  require_point(load.center_of_mass_P, "static_load.center_of_mass");
+  if (!(load.gravity >= 0.0 && load.mass >= 0.0 && load.rod_mass >= 0.0))
+    fail(fmt::format("static_load: expected gravity, mass and rod mass >= 0, got {}, {}, {}", load.gravity, load.mass,
+                     load.rod_mass));
+  LegState home;
+  if (inverse_kinematics(*this, Placement{}, home) != Status::Ok ||
+      static_leg_forces(*this, load, home, reference_force_) != Status::Ok)
+    fail("legs: the legs' static forces at home cannot be computed");
 }
 
 void Model::check_limits_spec() {
@@ -94,6 +122,10 @@ void Model::check_limits_spec() {
                      lim.jacobian_condition_max));
   require_point(spec.observation_P, "observation_point");
   require_point(spec.pivot_P, "pivot");
+  require_finite(spec.reference_temperature, "reference_temperature");
+  if (!(spec.reference_temperature >= kMinTemperature && spec.reference_temperature <= kMaxTemperature))
+    fail(fmt::format("reference_temperature: expected {:g} to {:g} degC, got {} degC", kMinTemperature, kMaxTemperature,
+                     spec.reference_temperature));
 
   // The bounds as every limit check compares them, with the tolerance of limits.hpp.
   cos_bend_max_ = std::cos(lim.bend_max) - kLimitTolerance;
@@ -212,6 +244,39 @@ void Model::build_leg_axes(int i) {
   }
 }
 
+void Model::build_leg_effects(int i) {
+  const LegSpec& ls = spec_.legs[static_cast<std::size_t>(i)];
+  Leg& leg = legs_[static_cast<std::size_t>(i)];
+  const std::string who = fmt::format("leg {}", i + 1);
+  // Plausible ranges (docs/theory/kinematics.md §4b): beyond them a value is a typing error.
+  if (std::isnan(ls.stiffness) || !(ls.stiffness >= kMinStiffness))
+    fail(fmt::format("{}: stiffness: expected {:g} N/m (1 N/um) or more, or infinity (rigid), got {} N/m", who,
+                     kMinStiffness, ls.stiffness));
+  if (std::isfinite(ls.stiffness) && ls.stiffness > kMaxStiffness)
+    fail(fmt::format("{}: stiffness: expected at most {:g} N/m (a stiffer leg is rigid: leave it out), got {} N/m", who,
+                     kMaxStiffness, ls.stiffness));
+  require_finite(ls.play, who + ": play");
+  if (!(ls.play >= 0.0 && ls.play <= kMaxPlay))
+    fail(fmt::format("{}: play: expected 0 to {:g} m, got {} m", who, kMaxPlay, ls.play));
+  if (!(ls.home_direction == 1.0 || ls.home_direction == -1.0))
+    fail(fmt::format("{}: home_direction: expected +1 (lengthening into home) or -1, got {}", who, ls.home_direction));
+  for (const auto& [value, name] :
+       {std::pair{ls.length_expansion, "length_expansion"}, std::pair{ls.lead_expansion, "lead_expansion"}}) {
+    require_finite(value, fmt::format("{}: {}", who, name));
+    if (!(value >= kMinExpansion && value <= kMaxExpansion))
+      fail(fmt::format("{}: {}: expected {:g} to {:g} per kelvin, got {}", who, name, kMinExpansion, kMaxExpansion,
+                       value));
+  }
+  leg.compliance = std::isfinite(ls.stiffness) ? 1.0 / ls.stiffness : 0.0;
+  leg.play = ls.play;
+  leg.home_direction = ls.home_direction;
+  leg.length_expansion = ls.length_expansion;
+  leg.lead_expansion = ls.lead_expansion;
+  has_stiffness_ = has_stiffness_ || leg.compliance != 0.0;
+  has_play_ = has_play_ || leg.play != 0.0;
+  has_thermal_ = has_thermal_ || leg.length_expansion != 0.0 || leg.lead_expansion != 0.0;
+}
+
 void Model::lay_out_geometry() {
   for (int i = 0; i < kLegs; ++i) {
     const Leg& leg = legs_[static_cast<std::size_t>(i)];
@@ -228,6 +293,11 @@ void Model::lay_out_geometry() {
     geometry_.has_axes[i] = axes ? 1.0 : 0.0;
     geometry_.drive_scale[i] = leg.drive_scale;
     geometry_.home_command[i] = leg.home_command;
+    geometry_.compliance[i] = leg.compliance;
+    geometry_.half_play[i] = 0.5 * leg.play;
+    geometry_.home_direction[i] = leg.home_direction;
+    geometry_.thermal_length[i] = leg.length_expansion * leg.length_home;
+    geometry_.lead_expansion[i] = leg.lead_expansion;
     condition_length_ = std::max(i == 0 ? 0.0 : condition_length_, leg.arm_P.norm());
   }
   if (!(condition_length_ > 0.0))

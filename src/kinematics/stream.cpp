@@ -92,6 +92,12 @@ std::string_view check_stream_settings(const StreamSettings& s) noexcept {
   if (!(std::isfinite(s.period) && s.period > 0.0)) return "period must be a positive, finite time [s]";
   if (!(s.max_velocity > 0.0)) return "max_velocity must be positive [m/s] (infinite for no limit)";
   if (!(s.max_acceleration > 0.0)) return "max_acceleration must be positive [m/s^2] (infinite for no limit)";
+  for (int i = 0; i < kLegs; ++i) {
+    const double t = s.inputs.temperature[i];
+    if (!(std::isnan(t) || (t >= kMinTemperature && t <= kMaxTemperature)))
+      return "inputs.temperature must be from -60 to 200 degC, or NaN for the reference temperature";
+    if (std::isinf(s.inputs.force[i])) return "inputs.force must be finite [N], or NaN for the static force";
+  }
   return check_fk_options(s.fk);
 }
 
@@ -187,7 +193,9 @@ Status advance(const Model& model, const StreamSettings& s, StreamState& state, 
   LimitReport report;
   const LengthKind kind = command_kind(model, s.strategy);
   const Vector6d lengths = kind == LengthKind::Geometric ? Vector6d(next + model.geometry().length_offset) : next;
-  Status st = forward_kinematics(model, lengths, kind, state.placement, state.fk, s.fk);
+  Status st = kind == LengthKind::Motor && model.has_leg_effects()
+                  ? forward_kinematics(model, lengths, s.inputs, &state.play.direction, state.placement, state.fk, s.fk)
+                  : forward_kinematics(model, lengths, kind, state.placement, state.fk, s.fk);
   if (st == Status::Ok) st = check_limits(model, state.fk.legs, report);
   if (st == Status::Ok) st = check_stroke(model, next, report);
   if (st != Status::Ok) {
@@ -219,7 +227,8 @@ Status start_stream(const Model& model, const StreamSettings& settings, const Po
   state.velocity.setZero();
   LimitReport report;
   Vector6d command;
-  const Status st = motor_commands(model, pose, settings.strategy, command, report);
+  start_play(model, model.home_command(), state.play);
+  const Status st = motor_commands(model, pose, settings.strategy, settings.inputs, &state.play, command, report);
   if (st != Status::Ok) return st;
   state.command = state.target = command;
   state.placement = state.target_placement = placement_from_pose(pose);
@@ -232,7 +241,7 @@ Status stream_pose(const Model& model, const StreamSettings& settings, const Pos
   out = StreamOutput{};
   out.input = ++state.inputs;
   Vector6d command;
-  out.status = motor_commands(model, pose, settings.strategy, command, out.limit);
+  out.status = motor_commands(model, pose, settings.strategy, settings.inputs, &state.play, command, out.limit);
   if (out.status != Status::Ok) return reject(model, settings, state, out);
   state.target = command;
   state.target_placement = placement_from_pose(pose);

@@ -5,6 +5,7 @@
 
 #include "dynamics/mechanism_internal.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
+#include "hexatwist/kinematics/leg_effects.hpp"
 #include "hexatwist/simulation/servo.hpp"
 
 namespace hexatwist {
@@ -31,6 +32,18 @@ Vector6d plant_lengths(const Model& model, const Vector6d& travel, bool twist_in
   return twist_in_plant ? model.motor_from_travel(travel) : Vector6d(travel + model.geometry().length_offset);
 }
 
+// Forward kinematics of the plant: on a model whose legs have effects (theory §4b), at their
+// static forces and the reference temperature, with the play's directions from the nuts' dead
+// band, which `nuts` follows along the run.
+Status plant_fk(const Model& model, const Vector6d& lengths, LengthKind kind, const Placement& guess, NutGap& nuts,
+                FkResult& fk) noexcept {
+  if (kind == LengthKind::Motor && model.has_leg_effects()) {
+    const Vector6d direction = follow_nuts(model, lengths, nuts);
+    return forward_kinematics(model, lengths, LegInputs{}, &direction, guess, fk);
+  }
+  return forward_kinematics(model, lengths, kind, guess, fk);
+}
+
 // The targets of a whole trajectory, computed (and checked) before the loop runs.
 struct Plan {
   std::vector<Vector6d> command;          // motor-side target [m]
@@ -51,10 +64,21 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   CommandReport report;
   Vector6d still;
   const double torque_limit = rig.servo().torque_limit;
+  // The compensated commands of legs with play follow each leg's direction along the run, from
+  // home where homing left it (theory §4b).
+  PlayState play;
+  start_play(model, model.home_command(), play);
   for (std::size_t k = 0; k < n; ++k) {
     if (const Status s = compute_commands(model, trajectory.poses[k], report); s != Status::Ok)
       return fail(issue, s, k, trajectory, report.limit);
     command[k] = compensated ? report.compensated : report.conventional;
+    if (compensated && model.has_play()) {
+      LimitReport limit;
+      if (const Status s =
+              motor_commands(model, trajectory.poses[k], Strategy::Compensated, LegInputs{}, &play, command[k], limit);
+          s != Status::Ok)
+        return fail(issue, s, k, trajectory, limit);
+    }
     if (!check_holding) continue;
     // Every motor must at least be able to hold the mechanism standing still at every pose.
     if (const Status s = holding_torque(rig, trajectory.poses[k], still); s != Status::Ok)
@@ -106,8 +130,9 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   FkResult fk;
   Placement guess = placement_from_pose(trajectory.poses[0]);
   const Vector3d& obs = model.spec().observation_P;
+  NutGap nuts;
   for (std::size_t k = 0; k < n; ++k) {
-    if (const Status s = forward_kinematics(model, plant_lengths(model, travel[k], twist_in_plant), kind, guess, fk);
+    if (const Status s = plant_fk(model, plant_lengths(model, travel[k], twist_in_plant), kind, guess, nuts, fk);
         s != Status::Ok)
       return fail(issue, s, k, trajectory);
     guess = fk.placement;
@@ -169,8 +194,9 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
   drives.speed = plan.reference[0].speed;
   Vector6d motor = model.length_home() + gain.cwiseProduct(drives.angle);
   FkResult fk;
-  if (const Status s = forward_kinematics(model, plant_lengths(model, motor, options.twist_in_plant), kind,
-                                          placement_from_pose(trajectory.poses[0]), fk);
+  NutGap nuts;
+  if (const Status s = plant_fk(model, plant_lengths(model, motor, options.twist_in_plant), kind,
+                                placement_from_pose(trajectory.poses[0]), nuts, fk);
       s != Status::Ok)
     return fail(issue, s, 0, trajectory);
   // The mechanism's load on the motors (docs/theory.md §9, §14), at the start and then once per
@@ -225,8 +251,7 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
     motor_acceleration = (drives.speed - speed_before) / rig.control_period();
     motor = model.length_home() + gain.cwiseProduct(drives.angle);
     const Placement previous = fk.placement;  // warm start from the last tick
-    if (const Status s =
-            forward_kinematics(model, plant_lengths(model, motor, options.twist_in_plant), kind, previous, fk);
+    if (const Status s = plant_fk(model, plant_lengths(model, motor, options.twist_in_plant), kind, previous, nuts, fk);
         s != Status::Ok)
       return fail(issue, s, k + 1, trajectory);
   }

@@ -282,6 +282,56 @@ static void test_invalid_arguments(const hexatwist_model* m) {
   CHECK(strcmp(hexatwist_status_name(HEXATWIST_INVALID_ARGUMENT), "invalid_argument") == 0, "name");
 }
 
+/* The legs' effects (docs/theory/kinematics.md §4b): the defaults are the plain call, warm legs are
+   commanded shorter by their growth, a reversal crosses the play, and none of it allocates. */
+static void test_leg_effects(void) {
+  char error[256];
+  hexatwist_model* m = hexatwist_model_from_yaml(
+      "symmetric: {Ra: 1.2, Rb: 1.5, da: 0.2, db: 0.3, H: 1.511}\n"
+      "screw: {lead: 0.010, thread: right, driven_side: base}\n"
+      "limits: {length_min: 1.4, length_max: 2.45}\n"
+      "leg_effects: {play: 50.0e-6, length_expansion: 11.5e-6, lead_expansion: 11.0e-6}\n",
+      "effects.yaml", error, sizeof error);
+  CHECK(m != NULL, "effects model: %s", error);
+  if (!m) return;
+  double up[6] = {0, 0, 0.1, 0, 0, 0}, down[6] = {0, 0, 0.099, 0, 0, 0};
+  double plain[6], under[6], warm[6], plain_down[6], c_up[6], c_down[6];
+  hexatwist_limit limit;
+  CHECK(hexatwist_motor_commands(m, up, HEXATWIST_COMPENSATED, plain, &limit) == HEXATWIST_OK, "plain");
+  CHECK(hexatwist_motor_commands_under(m, up, HEXATWIST_COMPENSATED, NULL, NULL, under, &limit) == HEXATWIST_OK &&
+            max_abs_diff(plain, under, 6) == 0.0,
+        "the defaults are the plain call's");
+  hexatwist_leg_inputs in = hexatwist_leg_inputs_default();
+  for (int i = 0; i < 6; ++i) in.temperature[i] = 22.0;
+  CHECK(hexatwist_motor_commands_under(m, up, HEXATWIST_COMPENSATED, &in, NULL, warm, &limit) == HEXATWIST_OK, "warm");
+  for (int i = 0; i < 6; ++i)
+    CHECK(plain[i] - warm[i] > 40e-6 && plain[i] - warm[i] < 50e-6, "leg %d: 2 K shorten the command by %g m", i + 1,
+          plain[i] - warm[i]);
+  hexatwist_play_state play;
+  hexatwist_play_start(m, &play);
+  CHECK(hexatwist_motor_commands(m, down, HEXATWIST_COMPENSATED, plain_down, &limit) == HEXATWIST_OK, "plain down");
+  const long before = allocations;
+  const hexatwist_status s_up = hexatwist_motor_commands_under(m, up, HEXATWIST_COMPENSATED, NULL, &play, c_up, &limit);
+  const hexatwist_status s_down =
+      hexatwist_motor_commands_under(m, down, HEXATWIST_COMPENSATED, NULL, &play, c_down, &limit);
+  CHECK(!PROBE || allocations == before, "%ld allocations in the real-time calls", allocations - before);
+  CHECK(s_up == HEXATWIST_OK && s_down == HEXATWIST_OK, "up and down");
+  CHECK(max_abs_diff(c_up, plain, 6) == 0.0, "up from home: the homing's side, no play term");
+  for (int i = 0; i < 6; ++i) {
+    CHECK(play.direction[i] == -1.0, "leg %d: shortening", i + 1);
+    CHECK(fabs(c_down[i] - (plain_down[i] - 50e-6)) < 1e-15, "leg %d: the reversal crosses the play (%g)", i + 1,
+          c_down[i] - plain_down[i]);
+  }
+  in.temperature[0] = INFINITY;
+  CHECK(hexatwist_motor_commands_under(m, up, HEXATWIST_COMPENSATED, &in, NULL, warm, &limit) ==
+            HEXATWIST_NON_FINITE_INPUT,
+        "an infinite temperature");
+  CHECK(hexatwist_motor_commands_under(NULL, up, HEXATWIST_COMPENSATED, NULL, NULL, warm, &limit) ==
+            HEXATWIST_INVALID_ARGUMENT,
+        "no model");
+  hexatwist_model_free(m);
+}
+
 static void test_no_allocation(const hexatwist_model* m) {
   if (!PROBE) return;
   char error[64];
@@ -327,6 +377,7 @@ int main(void) {
   test_limits(m);
   test_tracking(m);
   test_invalid_arguments(m);
+  test_leg_effects();
   test_no_allocation(m);
   hexatwist_model_free(m);
   printf("%d passed, %d failed\n", passed, failed);

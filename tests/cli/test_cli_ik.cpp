@@ -103,3 +103,59 @@ TEST(Cli, PoseOutsideALimitExitsThreeAndEmitsNoCommand) {
 }
 
 }  // namespace
+
+// ---- the legs' effects (theory §4b) ----------------------------------------------------------
+
+// The seed configuration with a leg_effects block (it has the load that a stiffness needs).
+std::string seed_with_effects(const std::string& name, const std::string& block) {
+  std::ifstream in(std::string(HEXATWIST_SOURCE_DIR) + "/configs/seed.yaml");
+  std::stringstream s;
+  s << in.rdbuf() << "\nleg_effects:\n" << block;
+  return write_file(name, s.str());
+}
+
+TEST(Cli, IkWithLegEffectsReportsEachEffectAndCompensatesIt) {
+  const std::string config =
+      seed_with_effects("effects.yaml", "  stiffness: 2.0e8\n  length_expansion: 11.5e-6\n  lead_expansion: 11.0e-6\n");
+  const Outcome plain = run({"ik", "--pose=0.05,0,0.1,0,0,5", "--json"});
+  const Outcome warm = run({"ik", "--config", config, "--pose=0.05,0,0.1,0,0,5", "--temperature-c", "22", "--json"});
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  ASSERT_EQ(warm.code, 0) << warm.err;
+  const YAML::Node p = json(plain), w = json(warm);
+  for (std::size_t i = 0; i < 6; ++i) {
+    SCOPED_TRACE("leg " + std::to_string(i + 1));
+    const YAML::Node leg = w["legs"][i];
+    EXPECT_EQ(leg["temperature"].as<double>(), 22.0);
+    EXPECT_LT(leg["force"].as<double>(), -2.0e3) << "the load compresses every leg (2.9 kN here)";
+    // The command is the rigid one less the effects' growth, to the lead's expansion of it.
+    const double shift = p["legs"][i]["command_compensated"].as<double>() - leg["command_compensated"].as<double>();
+    EXPECT_NEAR(shift, leg["effect"].as<double>(), 1e-9);
+    EXPECT_NEAR(leg["effect"].as<double>(),
+                leg["effect_load"].as<double>() + leg["effect_thermal"].as<double>() + leg["effect_play"].as<double>(),
+                1e-15);
+    EXPECT_GT(leg["effect_thermal"].as<double>(), 40e-6) << "2 K on a 1.9 m steel leg";
+  }
+  const Outcome text = run({"ik", "--config", config, "--temperature-c", "22"});
+  EXPECT_NE(text.out.find("leg effects"), std::string::npos) << text.out;
+  for (const char* bad : {"500", "nan", "1,2,3"}) {
+    const Outcome r = run({"ik", "--config", config, "--temperature-c", bad});
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_EQ(r.err.rfind("hexatwist: error: --temperature-c", 0), 0u) << r.err;
+  }
+}
+
+TEST(Cli, LinuxcncRefusesPlayItCannotFollowNamingTheBacklash) {
+  const std::string config =
+      seed_with_effects("play.yaml", "  play: [50.0e-6, 40.0e-6, 60.0e-6, 50.0e-6, 20.0e-6, 80.0e-6]\n");
+  const Outcome r = run({"linuxcnc", "--config", config, "--out", (temp_dir() / "play.ini").string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("[JOINT_5]BACKLASH = 0.08"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(temp_dir() / "play.ini"));
+}
+
+TEST(Cli, IdentifyNamesAnUnknownEffect) {
+  const Outcome r = run({"identify", "--points", "x.csv", "--test", "Rz", "--effects", "load,warp"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--effects"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("'warp'"), std::string::npos) << r.err;
+}

@@ -87,6 +87,21 @@ typedef struct hexatwist_command_report {
                                             1 far away, 0 on the limit, negative past it [-] */
 } hexatwist_command_report;
 
+/** The legs' conditions for a model with leg effects (docs/theory/kinematics.md §4b); start from
+ * hexatwist_leg_inputs_default(). */
+typedef struct hexatwist_leg_inputs {
+  double force[HEXATWIST_LEGS];       /**< axial force, tension positive [N]; NaN = the static load's */
+  double temperature[HEXATWIST_LEGS]; /**< temperature [degC]; NaN = the model's reference */
+} hexatwist_leg_inputs;
+
+/** Each leg's direction of its last motion, for its play (caller-owned, one per controller; start it
+ * with hexatwist_play_start after homing). */
+typedef struct hexatwist_play_state {
+  int started;                      /**< 0: each leg approached straight from home */
+  double direction[HEXATWIST_LEGS]; /**< +1 lengthening, -1 shortening */
+  double last[HEXATWIST_LEGS];      /**< the last travel before its play term [m] */
+} hexatwist_play_state;
+
 /** Forward-kinematics settings; start from hexatwist_fk_default_options(). A value outside its range
  * (NaN included) makes the call return HEXATWIST_INVALID_ARGUMENT, as the library, the CLI and Python
  * refuse it. */
@@ -146,6 +161,10 @@ void hexatwist_model_home_commands(const hexatwist_model* model, double motor[HE
 /** Stroke limits of the legs, shortest and longest [m] (either pointer may be NULL). */
 void hexatwist_model_stroke(const hexatwist_model* model, double* length_min, double* length_max);
 
+/** Each leg's play [m] (its `leg_effects` block; 0 without), written to `play`; returns non-zero if a
+ * leg has play (docs/theory/kinematics.md §4b). */
+int hexatwist_model_play(const hexatwist_model* model, double play[HEXATWIST_LEGS]);
+
 /* ---- Real-time calls ----------------------------------------------------------------------- */
 
 /** Motor-side commands for `pose` [m, rad] with `strategy`, every limit checked. `command` [m]
@@ -153,6 +172,22 @@ void hexatwist_model_stroke(const hexatwist_model* model, double* length_min, do
 hexatwist_status hexatwist_motor_commands(const hexatwist_model* model, const double pose[6],
                                           hexatwist_strategy strategy, double command[HEXATWIST_LEGS],
                                           hexatwist_limit* limit);
+
+/** Default leg conditions: every force and temperature NaN (the static load, the reference). */
+hexatwist_leg_inputs hexatwist_leg_inputs_default(void);
+
+/** Starts `play` where homing leaves the legs: at the drives' reference, each leg's direction its
+ * home_direction. */
+void hexatwist_play_start(const hexatwist_model* model, hexatwist_play_state* play);
+
+/** hexatwist_motor_commands under the conditions `inputs` (NULL: the defaults) with the play's
+ * directions from `play` (NULL: each leg approached from home), moved on to this command on
+ * HEXATWIST_OK. For a model without leg effects, or the conventional strategy, the same command as
+ * hexatwist_motor_commands. HEXATWIST_NON_FINITE_INPUT for an infinite force or temperature. */
+hexatwist_status hexatwist_motor_commands_under(const hexatwist_model* model, const double pose[6],
+                                                hexatwist_strategy strategy, const hexatwist_leg_inputs* inputs,
+                                                hexatwist_play_state* play, double command[HEXATWIST_LEGS],
+                                                hexatwist_limit* limit);
 
 /** Lengths, twist, length error, both commands and the limit check for `pose` (paper Eq. 1-12).
  * On a status other than HEXATWIST_OK the commands must not be sent. */

@@ -36,6 +36,9 @@ struct IdentificationOptions {
   LeadEffect lead_effect = LeadEffect::TwistAndTravel;  ///< measurement model of the lead
   LeadFit leads = LeadFit::Shared;                      ///< one lead, or one per leg
   AxisFit axes = AxisFit::Auto;                         ///< which U-joint axes (Geometry)
+  /// The legs' effects fitted besides the geometry (theory §13b): the load's deflection, the play
+  /// and the legs' drift over the run (heat).
+  EffectFit effects{};
   /// Auto: an axis direction is fitted when the data determine both its angles to this [rad].
   double axis_sd_max = deg2rad(0.1);
   /// The tracker's noise per coordinate [m]; NaN = its scatter at rest (tracker_scatter), which

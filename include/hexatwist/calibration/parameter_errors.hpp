@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 
 #include "hexatwist/kinematics/model.hpp"
 
@@ -35,13 +36,21 @@ struct ParameterErrors {
   LegVectors base_axis_rotation = LegVectors::Zero();
   /// Small rotation of each platform U-joint's fixed axis [rad, P] (rows: legs).
   LegVectors platform_axis_rotation = LegVectors::Zero();
+  /// The real legs' effects (kinematics/leg_effects.hpp) where the nominal model has none or others:
+  /// each leg's axial stiffness [N/m] (NaN = the nominal one; inf = rigid), play [m] (NaN = the
+  /// nominal one), and the expansions of the length between the joints and of the lead [1/K]
+  /// (NaN = the nominal ones). A machine is never exactly its model: these make it so in `synth`.
+  Vector6d stiffness = Vector6d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Vector6d play = Vector6d::Constant(std::numeric_limits<double>::quiet_NaN());
+  double length_expansion = std::numeric_limits<double>::quiet_NaN();
+  double lead_expansion = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The real platform's model: `nominal` with the joints and axes moved, every leg's lead scaled by
 /// 1 + lead_error_i while its drive keeps the nominal lead (LegSpec::drive_lead) and reference
 /// (LegSpec::home_command), the thread hands flipped if flip_twist_sign, the zero offsets added to
-/// the length offsets and the observation point moved. Motor-side forward kinematics of the
-/// nominal model's commands on it gives the pose the real platform takes. Throws hexatwist::Error
+/// the length offsets, the observation point moved and the legs' effects that `errors` gives set. Motor-side forward
+/// kinematics of the nominal model's commands on it gives the pose the real platform takes. Throws hexatwist::Error
 /// (from Model) if that model is invalid, e.g. a lead error <= -1.
 Model real_model(const Model& nominal, const ParameterErrors& errors);
 

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -35,19 +36,45 @@ enum class LeadFit {
   PerLeg,
 };
 
+/// Which of the legs' effects (kinematics/leg_effects.hpp) an identification fits besides the
+/// geometry, each as a shift of the legs' lengths linear in its parameters (theory §13b).
+struct EffectFit {
+  /// One compliance c for every leg [m/N]: the deflection c (F - F_ref) under the configuration's
+  /// static load, F the static force at the station's pose (the nominal model's).
+  bool load = false;
+  /// Each leg's play b_i [m]: -(b_i / 2)(d - d_home), d the direction of the leg's approach to the
+  /// station (from the stations' order: a leg approached from both sides determines its play).
+  bool play = false;
+  /// Each leg's length drift over the run a_i [m] and its curvature q_i [m], and the screws' common
+  /// lead drift r [-]: a_i s + q_i s^2 + r s (u_i - h_i), s the run's time fraction (0 at the first
+  /// observation, 1 at the last), u_i - h_i the travel from the drive's reference: the legs and
+  /// screws warming as the motors and the hall do, at any rate that levels off or speeds up; the
+  /// offsets and the lead are the legs' at the run's start.
+  bool heat = false;
+  bool any() const noexcept { return load || play || heat; }
+  /// Number of parameters: 1 + 6 + 13 at most.
+  int count() const noexcept { return (load ? 1 : 0) + (play ? kLegs : 0) + (heat ? 2 * kLegs + 1 : 0); }
+  /// "load,play,heat" (those fitted), "none" without any.
+  std::string names() const;
+};
+
+/// The effects a comma-separated list names: "load", "play", "heat" in any order, or "none".
+/// Throws hexatwist::Error naming the word that is none of them.
+EffectFit effect_fit(std::string_view names);
+
 /// One flag per U-joint fixed axis: legs 1..6 at the base, then legs 1..6 at the platform.
 using AxisSelection = std::array<bool, 2 * kLegs>;
 
 /// The layout of the parameter vector theta (caller-owned, built once per identification).
 /// Order: leads (one, or one per leg where the nominal leads differ or LeadFit::PerLeg), the six zero offsets, the
-/// base joints (12 gauge coordinates), the platform joints (12), the selected axes (2 each),
-/// three coordinates per target [m, P], the tracker rotation dw [rad, B] and translation [m, B].
-/// Joints and axes only in the Geometry model.
+/// legs' effects (EffectFit: compliance, plays, drifts and their curvatures), the base joints (12 gauge coordinates),
+/// the platform joints (12), the selected axes (2 each), three coordinates per target [m, P], the tracker rotation dw
+/// [rad, B] and translation [m, B]. Joints and axes only in the Geometry model.
 class ParameterSet {
  public:
   /// The layout for `nominal` (its leads and `leads` decide one or six lead parameters).
   ParameterSet(const Model& nominal, CalibrationModel model, LeadEffect lead_effect, const AxisSelection& axes,
-               int targets, LeadFit leads = LeadFit::Shared);
+               int targets, LeadFit leads = LeadFit::Shared, EffectFit effects = {});
   ParameterSet() = default;
 
   CalibrationModel model() const noexcept { return model_; }
@@ -59,6 +86,15 @@ class ParameterSet {
   int lead_index() const noexcept { return 0; }
   int lead_count() const noexcept { return lead_count_; }
   int offset_index() const noexcept { return offset_; }
+  /// The legs' effects fitted and their parameters' indices (-1 where not fitted): the compliance,
+  /// the first of the six plays, the first of the six drifts, the first of their six curvatures
+  /// (the lead drift follows them).
+  const EffectFit& effects() const noexcept { return effects_; }
+  int effect_index() const noexcept { return offset_ + kLegs; }  ///< the first effect's parameter
+  int compliance_index() const noexcept { return compliance_; }
+  int play_index() const noexcept { return play_; }
+  int drift_index() const noexcept { return drift_; }
+  int curvature_index() const noexcept { return curvature_; }
   /// First gauge coordinate of the base / platform joints; -1 in the Basic model.
   int base_index() const noexcept { return base_; }
   int platform_index() const noexcept { return platform_; }
@@ -95,7 +131,11 @@ class ParameterSet {
   /// configured, -1: every one flipped): the nominal specification with the joints, axes, leads,
   /// threads, zero offsets and target 0 (the observation point) replaced. The drives keep the
   /// nominal model's reference (home_command) and, with TwistAndTravel, its drive lead (theory §4).
-  ModelSpec platform(const Eigen::VectorXd& theta, double sign) const;
+  /// The fitted effects: with `with_effects` the stiffness 1 / c (rigid where c <= 0) and the plays
+  /// (at least 0) replace the nominal ones (the corrected platform; the drift belongs to the run,
+  /// not the platform); without it the legs are rigid and play-free in those effects, which the
+  /// identification applies as length shifts (the measurement model).
+  ModelSpec platform(const Eigen::VectorXd& theta, double sign, bool with_effects = false) const;
 
   /// Target t's position in theta [m, P].
   Vector3d target(const Eigen::VectorXd& theta, int t) const { return theta.segment<3>(target_ + 3 * t); }
@@ -110,6 +150,8 @@ class ParameterSet {
   CalibrationModel model_ = CalibrationModel::Basic;
   LeadEffect lead_effect_ = LeadEffect::TwistAndTravel;
   AxisSelection axes_{};
+  EffectFit effects_{};
+  int compliance_ = -1, play_ = -1, drift_ = -1, curvature_ = -1;
   int lead_count_ = 1, offset_ = 1, base_ = -1, platform_ = -1, axis_ = -1, axis_count_ = 0, target_ = 7, targets_ = 1,
       rotation_ = 10, size_ = 16;
   Eigen::MatrixXd base_basis_, platform_basis_;

@@ -26,6 +26,11 @@ struct SynthesisOptions {
   /// More targets on the platform besides the observation point, measured at every sample after
   /// it, named T2, T3, ... in the log [m, P of the real platform].
   std::vector<Vector3d> extra_targets_P;
+  /// Each leg's temperature rise over the run above the real model's reference temperature [K]:
+  /// the legs warm along 1 - exp(-t / T) scaled to reach it at the run's end T (a motor's and a
+  /// screw's warm-up, whose time constant is of the run's length). It matters where the real
+  /// legs expand (ParameterErrors' expansions).
+  Vector6d temperature_rise = Vector6d::Zero();
 };
 
 /// A synthetic log and its truth.
@@ -51,7 +56,10 @@ Vector6d random_zero_offsets(double bound, std::uint64_t seed);
 /// controller and its encoders know only the nominal model) and, at every tracker sample, maps
 /// the motors' positions through the real platform: twist-aware forward kinematics of real_model
 /// (its joints, leads, offsets and the drives' reference and scale; warm-started) gives the real
-/// pose, and there the real observation point and every extra target;
+/// pose, and there the real observation point and every extra target; the real legs' effects act
+/// there too: the static load's deflection at that pose, the temperatures of `temperature_rise`,
+/// and the play as lost motion between motor and nut (a dead band followed at every control tick
+/// from home, where the homing left each nut on its home_direction's side);
 /// it is moved into the tracker frame (random_tracker_frame(seed)) and gets Gaussian noise
 /// (portable generator: the same seed gives the same log everywhere). Returns the simulation's
 /// status (Ok, or where it stopped in `issue`; forward kinematics failing on the real platform is

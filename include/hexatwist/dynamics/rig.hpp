@@ -83,6 +83,10 @@ struct MechanismSpec {
   double back_efficiency = 0.80;  ///< screw efficiency, load driving the motor [-]
 };
 
+/// The static load a rig's legs carry, for their deflection (kinematics/leg_effects.hpp): the
+/// load's weight and centre of mass and the legs' bodies. The Rig puts it into its model.
+StaticLoadSpec static_load_spec(const LoadSpec& load, const MechanismSpec& mechanism) noexcept;
+
 /// Rates of the simulation.
 struct SimulationSpec {
   double control_rate = 1000.0;  ///< servo (controller) rate [Hz]
@@ -108,6 +112,7 @@ class Rig {
   Rig(Model model, const ServoSpec& servo, const LoadSpec& load, const SimulationSpec& simulation,
       const MechanismSpec& mechanism = {});
 
+  /// The platform, with the static load of this rig's load and mechanism (static_load_spec).
   const Model& model() const noexcept { return model_; }
   /// The servo, with the envelope's derived values filled in.
   const ServoSpec& servo() const noexcept { return servo_; }

@@ -2,6 +2,7 @@
 // (Eq. 11-12): what the servo must reach on the motor side.
 #pragma once
 
+#include "hexatwist/kinematics/leg_effects.hpp"
 #include "hexatwist/kinematics/limits.hpp"
 #include "hexatwist/kinematics/twist.hpp"
 
@@ -9,8 +10,10 @@ namespace hexatwist {
 
 /// How motor-side commands are formed.
 enum class Strategy {
-  Conventional,  ///< command = IK length - length_offset; the twist is ignored
-  Compensated,   ///< command = IK length - length_offset - twist_gain * dtheta, Eq. (12)
+  Conventional,  ///< command = IK length - length_offset; the twist (and the legs' effects) ignored
+  /// command = IK length - length_offset - twist_gain * dtheta, Eq. (12), less the legs' effects
+  /// where the model has them (leg_effects.hpp: deflection, thermal expansion, play)
+  Compensated,
 };
 
 /// Length error of each leg caused by its twist, Eq. (10) with the configured sign:
@@ -23,8 +26,10 @@ struct CommandReport {
   Vector6d twist = Vector6d::Zero();         ///< dtheta relative to home [rad]
   Vector6d length_error = Vector6d::Zero();  ///< Eq. (10) [m]
   Vector6d conventional = Vector6d::Zero();  ///< motor-side command, twist ignored [m]
-  Vector6d compensated = Vector6d::Zero();   ///< motor-side command, Eq. (12) [m]
+  Vector6d compensated = Vector6d::Zero();   ///< motor-side command, Eq. (12), the legs' effects included [m]
   LimitReport limit;                         ///< first limit violated, if any
+  /// The legs' effects at the pose for the compensated command (zero where the model has none).
+  LegEffects effects;
 };
 
 /// Full computation for a pose: IK, twist, Eq. (10), both commands and the limit check (pose
@@ -32,9 +37,22 @@ struct CommandReport {
 /// must not be sent.
 [[nodiscard]] Status compute_commands(const Model& model, const Pose& pose, CommandReport& out) noexcept;
 
+/// The same under the conditions `inputs`, with the play's direction from `play` (null: each leg
+/// approached straight from home, the stateless default of the functions without it). `play` is
+/// not moved on (motor_commands does that).
+[[nodiscard]] Status compute_commands(const Model& model, const Pose& pose, const LegInputs& inputs,
+                                      const PlayState* play, CommandReport& out) noexcept;
+
 /// Real-time path: the motor-side commands for one strategy [m], limits checked. `command` is
 /// written only when the result is Ok; `report` says which leg and limit otherwise.
 [[nodiscard]] Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, Vector6d& command,
                                     LimitReport& report) noexcept;
+
+/// The real-time command of a model with leg effects (leg_effects.hpp) under `inputs`; `play`
+/// (may be null: each leg approached from home) gives the direction of each leg's last motion and
+/// is moved on to this command when the result is Ok. For a model without effects, or the
+/// Conventional strategy, the command of the overload above.
+[[nodiscard]] Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, const LegInputs& inputs,
+                                    PlayState* play, Vector6d& command, LimitReport& report) noexcept;
 
 }  // namespace hexatwist

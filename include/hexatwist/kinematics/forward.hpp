@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include "hexatwist/kinematics/kinematics.hpp"
+#include "hexatwist/kinematics/leg_effects.hpp"
 
 namespace hexatwist {
 
@@ -83,6 +84,17 @@ struct FkTracker {
 /// case; on failure `out.placement` is the best iterate.
 [[nodiscard]] Status forward_kinematics(const Model& model, const Vector6d& lengths, LengthKind kind,
                                         const Placement& guess, FkResult& out, const FkOptions& options = {}) noexcept;
+
+/// Forward kinematics of the drives' motor-side lengths `motor` [m] on a model whose legs have
+/// effects (leg_effects.hpp): the pose at which the real legs, under `inputs` (forces at the pose,
+/// temperatures) and with the play's directions `direction` (null: each leg approached straight
+/// from home, the sense of its travel from the drive's reference), have the lengths the drives
+/// hold. A fixed point of rigid solves (the effects change with the pose through the forces and the
+/// twist only), to 1e-14 m of E; `effects` (may be null) receives them at the solution. Statuses
+/// as above. The overload above calls this one with the defaults for motor-side lengths.
+[[nodiscard]] Status forward_kinematics(const Model& model, const Vector6d& motor, const LegInputs& inputs,
+                                        const Vector6d* direction, const Placement& guess, FkResult& out,
+                                        const FkOptions& options = {}, LegEffects* effects = nullptr) noexcept;
 
 /// Forward kinematics along a motion: from tracker.last (home while !tracker.valid), Ok only when
 /// converged on the same assembly mode as the tracker's (home's while !valid) and with the

@@ -34,10 +34,36 @@ struct LegSpec {
   /// HOME value, about which a drive scale acts [m]. NaN = the command at home, length at home
   /// minus length_offset.
   double home_command = std::numeric_limits<double>::quiet_NaN();
+
+  // What a real leg adds to its geometry (docs/theory/kinematics.md §4b, "Heat, load and play"). Each
+  // acts relative to the reference state: the platform at home after homing, at the reference
+  // temperature, under the configuration's static load; there the commands are those without it.
+  /// Axial stiffness between the joint centres (screw, nut, bearings, tubes and the joints' axial
+  /// compliance in series): the leg's length changes by F / stiffness under its axial force F
+  /// [N/m]. Infinity = rigid (the default); plausible 1e6..1e11 (1 to 100,000 N/um).
+  double stiffness = std::numeric_limits<double>::infinity();
+  /// Lost motion of the nut and the joints along the leg: the nut lags the motor by play / 2 in
+  /// the direction of the last motion [m]. 0 = none; plausible 0..1e-3.
+  double play = 0.0;
+  /// Direction of the last motion when the drive reached its reference (homing): +1 the leg
+  /// lengthening, -1 shortening [-].
+  double home_direction = 1.0;
+  /// Thermal expansion of the length between the joints at home [1/K], and of the screw's lead
+  /// (the nut's travel from the reference and the twist term) [1/K]. 0 = none; plausible -2e-5..1e-4
+  /// (steel 11.5e-6, aluminium 23e-6).
+  double length_expansion = 0.0;
+  double lead_expansion = 0.0;
 };
 
 /// Default of LimitSpec::jacobian_condition_max (docs/theory.md §6: chosen on the seed platform).
 inline constexpr double kDefaultJacobianConditionMax = 50.0;
+
+/// Plausible ranges of the legs' effects and of the reference temperature (theory §4b): a Model
+/// refuses values outside them, naming the field; the CLI checks its options against the same.
+inline constexpr double kMinStiffness = 1e6, kMaxStiffness = 1e11;         ///< [N/m] (inf: rigid)
+inline constexpr double kMaxPlay = 1e-3;                                   ///< [m]
+inline constexpr double kMinExpansion = -2e-5, kMaxExpansion = 1e-4;       ///< [1/K]
+inline constexpr double kMinTemperature = -60.0, kMaxTemperature = 200.0;  ///< [degC]
 
 /// Tolerance of every limit check (limits.hpp, docs/theory.md §6): a value on a bound, or within
 /// 4 ulp of it (relative, 4 * 2^-52 = 8.9e-16 of the bound), is inside the limit. Rounding on the
@@ -60,6 +86,21 @@ struct LimitSpec {
   double jacobian_condition_max = kDefaultJacobianConditionMax;
 };
 
+/// What gravity pulls on, for the legs' static axial forces (leg_effects.hpp): the load on the
+/// platform and every leg's two bodies (housing on the base joint, rod on the platform joint). A
+/// configuration fills it from its load and mechanism sections, as the Rig does (dynamics/rig.hpp);
+/// without it the legs' forces are unknown and a finite stiffness cannot be compensated.
+struct StaticLoadSpec {
+  bool present = false;                          ///< false: no load known
+  double gravity = 9.81;                         ///< gravitational acceleration, along -z of B [m/s^2]
+  double mass = 0.0;                             ///< platform and payload [kg]
+  Vector3d center_of_mass_P = Vector3d::Zero();  ///< their centre of mass [m, P]
+  double rod_mass = 0.0;                         ///< each leg's rod, on the platform joint [kg]
+  /// Each leg's housing mass times its centre's distance from the base joint, less the rod's mass
+  /// times its centre's distance from the platform joint [kg m] (theory §4b).
+  double leg_moment = 0.0;
+};
+
 /// Everything a Model is built from. Frames: B is the base frame; P is the platform frame, equal
 /// to B translated by `home_height` along z at home.
 struct ModelSpec {
@@ -69,6 +110,12 @@ struct ModelSpec {
   LimitSpec limits;                           ///< motion limits
   Vector3d observation_P = Vector3d::Zero();  ///< observation point "A" [m, P]
   Vector3d pivot_P = Vector3d::Zero();        ///< point about which pose rotations act [m, P]
+  /// Temperature at which the geometry holds, the reference of the legs' thermal expansion [degC];
+  /// plausible -60..200.
+  double reference_temperature = 20.0;
+  /// The static load the legs carry at the reference state (their forces at home are the
+  /// deflection's zero).
+  StaticLoadSpec static_load;
 };
 
 /// A leg with everything that depends only on the geometry precomputed.
@@ -91,6 +138,11 @@ struct Leg {
   double length_offset;      ///< real minus motor-side length at zero twist [m]
   double drive_scale;        ///< real nut travel per commanded motor-side length, lead / drive_lead [-]
   double home_command;       ///< motor-side length the drive reads at its reference (homing) [m]
+  double compliance;         ///< 1 / stiffness; 0 for a rigid leg [m/N]
+  double play;               ///< lost motion along the leg [m]
+  double home_direction;     ///< direction of the homing approach, +1 or -1 [-]
+  double length_expansion;   ///< of the length between the joints at home [1/K]
+  double lead_expansion;     ///< of the lead [1/K]
 };
 
 /// The same numbers in the layout of the library's vectorised kernels: eight lanes per quantity
@@ -128,7 +180,12 @@ struct LegGeometry {
   Vector6d has_axes;           ///< 1 for legs whose U-joint axes are given, else 0
   Vector6d drive_scale;        ///< real nut travel per commanded motor-side length [-]
   Vector6d home_command;       ///< motor-side length the drives read at their reference [m]
-  LegLanes lanes;              ///< all of the above, padded to eight lanes
+  Vector6d compliance;         ///< 1 / stiffness, 0 for rigid legs [m/N]
+  Vector6d half_play;          ///< play / 2 [m]
+  Vector6d home_direction;     ///< direction of the homing approach, +1 or -1 [-]
+  Vector6d thermal_length;     ///< length_expansion * length at home: growth of the length per kelvin [m/K]
+  Vector6d lead_expansion;     ///< growth of the lead per kelvin, relative [1/K]
+  LegLanes lanes;              ///< the geometry above the legs' effects, padded to eight lanes
 };
 
 /// The reference of the cheap proof that the Jacobian's condition is within the limit
@@ -177,6 +234,17 @@ class Model {
     if (!has_drive_scale_) return travel;
     return geometry_.home_command + (travel - geometry_.home_command).cwiseQuotient(geometry_.drive_scale);
   }
+  /// True if a leg has a finite stiffness, play or thermal expansion (leg_effects.hpp): the commands
+  /// and forward kinematics then take the legs' forces, temperatures and directions into account.
+  bool has_leg_effects() const noexcept { return has_stiffness_ || has_play_ || has_thermal_; }
+  bool has_stiffness() const noexcept { return has_stiffness_; }  ///< a leg has a finite stiffness
+  bool has_play() const noexcept { return has_play_; }            ///< a leg has play
+  bool has_thermal() const noexcept { return has_thermal_; }      ///< a leg has thermal expansion
+  /// ModelSpec::reference_temperature [degC].
+  double reference_temperature() const noexcept { return spec_.reference_temperature; }
+  /// The legs' static axial forces at home under spec().static_load, tension positive: the
+  /// deflection's zero [N]. Zero without a static load.
+  const Vector6d& reference_force() const noexcept { return reference_force_; }
   /// The legs one per row (the same numbers as leg(i), laid out for vectorised code).
   const LegGeometry& geometry() const noexcept { return geometry_; }
   /// cos(bend_max), precomputed for the limit check, less kLimitTolerance (a cosine of unit
@@ -198,7 +266,9 @@ class Model {
  private:
   void check_limits_spec();
   void build_leg(int i);
-  void build_leg_axes(int i);  // the U-joints' fixed axes and the twist at home (lead > 0)
+  void build_leg_axes(int i);     // the U-joints' fixed axes and the twist at home (lead > 0)
+  void build_leg_effects(int i);  // stiffness, play, thermal expansion (leg_effects.hpp)
+  void set_reference_force();     // the static forces at home (spec_.static_load)
   void lay_out_geometry();
   void check_home_and_reference();
 
@@ -216,6 +286,10 @@ class Model {
   ConditionReference condition_reference_;
   bool has_twist_ = false;
   bool has_drive_scale_ = false;
+  bool has_stiffness_ = false;
+  bool has_play_ = false;
+  bool has_thermal_ = false;
+  Vector6d reference_force_ = Vector6d::Zero();
 };
 
 /// Joint positions and axes of a "symmetric" platform: the seed's parameters, Eq. (6), joints in

@@ -16,6 +16,7 @@
 
 #include "hexatwist/kinematics/compensation.hpp"
 #include "hexatwist/kinematics/forward.hpp"
+#include "hexatwist/kinematics/leg_effects.hpp"
 
 namespace hexatwist {
 
@@ -78,6 +79,10 @@ struct StreamSettings {
   double max_velocity = std::numeric_limits<double>::infinity();      ///< per-leg command rate [m/s]
   double max_acceleration = std::numeric_limits<double>::infinity();  ///< per-leg command acceleration [m/s^2]
   FkOptions fk;  ///< forward kinematics that checks a rate-limited command
+  /// The legs' conditions for the compensated commands of a model with leg effects (theory §4b):
+  /// each leg's temperature [degC] (NaN = the reference) and force [N] (NaN = the static force of
+  /// the configuration's load at the pose); the play's directions are the stream's own.
+  LegInputs inputs;
 
   /// True if either rate limit is finite.
   bool rate_limited() const noexcept;
@@ -101,6 +106,7 @@ struct StreamState {
   Placement placement;                   ///< pose the last emitted command means (warm start for FK)
   Placement target_placement;            ///< the last accepted pose
   std::uint64_t inputs = 0;              ///< inputs processed
+  PlayState play;                        ///< each leg's direction of motion (start_stream: homing's)
   FkResult fk;                           ///< scratch
 };
 
