@@ -37,7 +37,8 @@ IdentificationOptions library_options(const IdentifyOptions& o) {
   io.model = o.model == "basic" ? CalibrationModel::Basic : CalibrationModel::Geometry;
   io.lead_effect = o.lead_effect == "twist" ? LeadEffect::TwistOnly : LeadEffect::TwistAndTravel;
   io.axes = o.axes == "none" ? AxisFit::None : o.axes == "all" ? AxisFit::All : AxisFit::Auto;
-  io.effects = effect_fit(o.effects);
+  io.auto_effects = o.effects == "auto";
+  if (!io.auto_effects) io.effects = effect_fit(o.effects);
   io.tracker_noise = o.tracker_noise_um * 1e-6;
   io.folds = o.folds;
   return io;
@@ -150,6 +151,8 @@ std::string text_report(const Report& r) {
                    r.ps().lead_effect() == LeadEffect::TwistAndTravel
                        ? "travel (the drives turn the screws by the nominal lead's angles)"
                        : "twist only (the drives' travel is right)");
+  if (r.ps().effects().any() || !id.effects_choice.empty())
+    t += fmt::format("legs' effects: {}\n", id.effects_choice.empty() ? r.ps().effects().names() : id.effects_choice);
   const SignFit& plus = id.fits[0];
   const SignFit& minus = id.fits[1];
   t += fmt::format("thread sense: as configured cost {:.4g} m^2{}, flipped cost {:.4g} m^2{}: {}, cost ratio {:.3g}\n",
@@ -319,6 +322,7 @@ std::string json_report(const Report& r, const std::string& failure, bool writte
   if (!id.hint.empty()) j.field("hint", id.hint);
   j.field("model", r.nominal.spec().name).field("config", model_source(r.o.run.model)).field("points", r.o.log.points);
   j.field("calibration_model", model_name(r.ps().model())).field("lead_effect", r.o.lead_effect);
+  j.field("effects", r.ps().effects().names()).field("effects_choice", id.effects_choice);
   j.field("log_points", static_cast<int>(r.log.points_T.size())).field("observations", id.observations);
   j.field("stations", id.stations).field("groups", id.groups).field("settle", r.set.settle);
   j.field("strategy", r.o.run.strategy);
@@ -524,8 +528,9 @@ Command make_identify_command(CLI::App& root) {
   app->add_option("--effects", o->effects,
                   "The legs' effects fitted besides the geometry, comma-separated: load (one compliance under the "
                   "configuration's load), play (each leg's, from approaches from both sides), heat (each leg's drift "
-                  "over the run and a common curvature); none")
+                  "over the run and a common curvature); none; auto: those the data show (each at 5 sigma)")
       ->check([](const std::string& v) {
+        if (v == "auto") return std::string();
         try {
           (void)effect_fit(v);
           return std::string();

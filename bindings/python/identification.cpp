@@ -136,6 +136,8 @@ py::dict result(const Identification& id, Status s) {
   d["reason"] = id.reason;
   d["hint"] = id.hint;
   d["fitted"] = id.fitted;
+  d["effects"] = id.parameters.effects().names();
+  d["effects_choice"] = id.effects_choice;
   const ParameterSet& ps = id.parameters;
   py::list names;
   for (int k = 0; k < ps.size(); ++k) names.append(ps.name(k));
@@ -231,15 +233,16 @@ py::dict result(const Identification& id, Status s) {
 py::dict identify_py(const Model& model, const py::object& motor, const py::object& points, const py::object& targets,
                      const std::string& calibration, const std::string& lead_effect, const std::string& axes,
                      const py::object& tracker_noise, int folds, int accuracy_poses, const std::string& effects,
-                     const py::object& times, const py::object& directions) {
+                     const py::object& times, const py::object& approach) {
   std::size_t nm = 0, np = 0;
   const std::vector<double> m = rows(motor, 6, "motor", nm);
   const std::vector<double> p = rows(points, 3, "points", np);
   if (nm != np) raise_input("motor and points: expected as many rows");
   const std::vector<int> target = targets_of(targets, nm);
   IdentificationOptions o = options_of(calibration, lead_effect, axes, tracker_noise, folds, accuracy_poses);
+  o.auto_effects = effects == "auto";
   try {
-    o.effects = effect_fit(effects);
+    if (!o.auto_effects) o.effects = effect_fit(effects);
   } catch (const Error& e) {
     raise_input(e.what());
   }
@@ -250,17 +253,17 @@ py::dict identify_py(const Model& model, const py::object& motor, const py::obje
     t = rows(times, 1, "times", nt);
     if (nt != nm) raise_input("times: expected one per observation");
   }
-  if (!directions.is_none()) {
+  if (!approach.is_none()) {
     std::size_t nd = 0;
-    d = rows(directions, 6, "directions", nd);
-    if (nd != nm) raise_input("directions: expected one row per observation");
+    d = rows(approach, 6, "approach", nd);
+    if (nd != nm) raise_input("approach: expected one row per observation");
   }
   for (std::size_t k = 0; k < nm; ++k) {
     obs[k].motor = Eigen::Map<const Vector6d>(m.data() + 6 * k);
     obs[k].p_T = Eigen::Map<const Vector3d>(p.data() + 3 * k);
     obs[k].target = target[k];
     if (!t.empty()) obs[k].time = t[k];
-    if (!d.empty()) obs[k].direction = Eigen::Map<const Vector6d>(d.data() + 6 * k);
+    if (!d.empty()) obs[k].approach = Eigen::Map<const Vector6d>(d.data() + 6 * k);
   }
   Identification id;
   Status s;
@@ -284,7 +287,7 @@ void expose_identification(py::module_& m) {
         py::arg("targets") = py::none(), py::arg("calibration") = "geometry", py::arg("lead_effect") = "travel",
         py::arg("axes") = "auto", py::arg("tracker_noise") = py::none(), py::arg("folds") = 5,
         py::arg("accuracy_poses") = 1000, py::arg("effects") = "none", py::arg("times") = py::none(),
-        py::arg("directions") = py::none());
+        py::arg("approach") = py::none());
   m.def("_corrected_config", &corrected_config_py, py::arg("rig"), py::arg("corrected"), py::arg("header") = "");
 }
 

@@ -116,11 +116,11 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
   py::array_t<double> motor({static_cast<py::ssize_t>(k), py::ssize_t{6}}),
       pts({static_cast<py::ssize_t>(k), py::ssize_t{3}});
   py::array_t<int> tg(static_cast<py::ssize_t>(k));
-  py::array_t<double> time(static_cast<py::ssize_t>(k)), direction({static_cast<py::ssize_t>(k), py::ssize_t{6}});
+  py::array_t<double> time(static_cast<py::ssize_t>(k)), approach({static_cast<py::ssize_t>(k), py::ssize_t{6}});
   for (std::size_t i = 0; i < k; ++i) {
     std::copy(set.observations[i].motor.data(), set.observations[i].motor.data() + 6, motor.mutable_data() + 6 * i);
-    std::copy(set.observations[i].direction.data(), set.observations[i].direction.data() + 6,
-              direction.mutable_data() + 6 * i);
+    std::copy(set.observations[i].approach.data(), set.observations[i].approach.data() + 6,
+              approach.mutable_data() + 6 * i);
     time.mutable_data()[i] = set.observations[i].time;
     std::copy(set.observations[i].p_T.data(), set.observations[i].p_T.data() + 3, pts.mutable_data() + 3 * i);
     tg.mutable_data()[i] = set.observations[i].target;
@@ -130,7 +130,7 @@ py::dict observations(const Model& model, const py::array& t, const py::array& p
   d["points"] = pts;
   d["targets"] = tg;
   d["time"] = time;
-  d["direction"] = direction;
+  d["approach"] = approach;
   d["index"] = py::cast(set.points);
   d["stations"] = set.poses;
   return d;

@@ -177,7 +177,7 @@ def _identify(model: Model, motor: npt.ArrayLike, points: npt.ArrayLike, targets
               calibration: str = "geometry", lead_effect: str = "travel", axes: str = "auto",
               tracker_noise: float | None = None, folds: int = 5, accuracy_poses: int = 1000,
               effects: str = "none", times: npt.ArrayLike | None = None,
-              directions: npt.ArrayLike | None = None) -> _Raw: ...
+              approach: npt.ArrayLike | None = None) -> _Raw: ...
 def _plan_stations(rig: _RigLike = None, count: int = 20, seed: int = 1, strategy: str = "compensated",
                    translation: float = 0.25, rotation: float = ..., candidates: int = 3000,
                    calibration: str = "geometry", noise: float = 1e-05, points_per_station: int = 75,

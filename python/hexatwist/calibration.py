@@ -81,9 +81,9 @@ class Observations(Result):
     """(K,) target indices (0: the observation point)."""
     time: FloatArray
     """(K,) each observation's time in the run [s] (for identify's heat effect)."""
-    direction: FloatArray
-    """(K, 6) each leg's direction of approach to the station, +1 lengthening, -1 shortening (for
-    identify's play effect)."""
+    approach: FloatArray
+    """(K, 6) each leg's approach to the station: the last monotone run of its command, positive
+    lengthening, negative shortening [m] (for identify's play effect)."""
     index: IntArray
     """(K,) each observation's row in the log (0-based)."""
     stations: int
@@ -196,6 +196,10 @@ class Identification(Result):
     hint: str
     """What to do about it (may be empty)."""
     fitted: bool
+    effects: str
+    """The legs' effects fitted, "load,play,heat" or a part of it, or "none" (theory §13b)."""
+    effects_choice: str
+    """With ``effects="auto"``: how they were chosen, one line ("" otherwise)."""
     parameter_names: tuple[str, ...]
     calibration: Literal["geometry", "basic"]
     nominal: FloatArray
@@ -412,7 +416,7 @@ def identify(model: Model, motor: ArrayLike, points: ArrayLike, targets: ArrayLi
              calibration: Literal["geometry", "basic"] = "geometry", lead_effect: Literal["travel", "twist"] = "travel",
              axes: Literal["auto", "none", "all"] = "auto", tracker_noise: float | None = None, folds: int = 5,
              accuracy_poses: int = 1000, effects: str = "none", times: ArrayLike | None = None,
-             directions: ArrayLike | None = None) -> Identification:
+             approach: ArrayLike | None = None) -> Identification:
     """Calibrates the platform (identification.hpp, theory §13) from observations ``motor`` (K, 6) [m],
     ``points`` (K, 3) [m, T] and their ``targets`` (K,) int (None: all the observation point), with the
     library's decisions: the same status and estimate as ``hexatwist identify`` (whose defaults these are).
@@ -421,13 +425,14 @@ def identify(model: Model, motor: ArrayLike, points: ArrayLike, targets: ArrayLi
     tracker frame) or "basic" (the joints as configured); ``lead_effect`` "travel" | "twist"; ``axes``
     "auto" | "none" | "all"; ``tracker_noise`` [m] (None: the scatter at rest); ``folds`` of the
     cross-validation (0: none). ``effects``: the legs' effects fitted besides the geometry (theory §13b),
-    "load", "play", "heat" comma-separated or "none", as ``hexatwist identify --effects``; heat needs each
-    observation's ``times`` (K,) [s], play their ``directions`` (K, 6) of approach (both as
-    ``observations_at_rest`` gives them; without directions, the stations' order decides). A refusal is
+    "load", "play", "heat" comma-separated, "none", or "auto" (those the data show at 5 sigma), as
+    ``hexatwist identify --effects``; heat needs each
+    observation's ``times`` (K,) [s], play their ``approach`` (K, 6) [m] (both as
+    ``observations_at_rest`` gives them; without it, the stations' order decides). A refusal is
     the status (with a reason and a hint), not an exception."""
     column = None if times is None else np.asarray(times, dtype=np.float64).reshape(-1, 1)
     return _identification(_core._identify(model, motor, points, targets, calibration, lead_effect, axes,
-                                           tracker_noise, folds, accuracy_poses, effects, column, directions))
+                                           tracker_noise, folds, accuracy_poses, effects, column, approach))
 
 
 def register_points(points_T: ArrayLike, points_B: ArrayLike, max_condition: float = 1e4) -> Registration:

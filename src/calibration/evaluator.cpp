@@ -140,26 +140,47 @@ Eigen::Matrix<double, 3, Eigen::Dynamic> point_sensitivity(const ParameterSet& s
   return G;
 }
 
+void play_terms(const Model& nominal, const Vector6d& approach, const Vector6d& play, Vector6d& coefficient,
+                Vector6d& constant, Vector6d& direction) noexcept {
+  for (int i = 0; i < kLegs; ++i) {
+    const double sense = approach[i] >= 0.0 ? 1.0 : -1.0, run = std::abs(approach[i]);
+    const double home = nominal.geometry().home_direction[i];
+    if (play[i] <= run) {
+      coefficient[i] = -0.5 * (sense - home);
+      constant[i] = 0.0;
+      direction[i] = sense;
+    } else {
+      coefficient[i] = 0.5 * (sense + home);
+      constant[i] = -sense * run;
+      direction[i] = sense * (2.0 * run / play[i] - 1.0);
+    }
+  }
+}
+
 EffectRegressors effect_regressors(const ParameterSet& set, std::span<const Observation> observations,
                                    const ObservationGroups& groups, const std::vector<Vector6d>& station_motor) {
   EffectRegressors out;
   const Model nominal(set.nominal());
   const std::size_t stations = station_motor.size();
-  // Each leg's direction: the sense of its last change of command, from home in the homing direction.
-  // Where the observations do not say (Observation::direction 0).
+  // Each leg's approach: the observations', or where they do not say (Observation::approach 0) the
+  // sense of its last change of command between stations, from home in the homing direction, as a
+  // run longer than any play.
   std::vector<Vector6d> given(stations, Vector6d::Zero());
   for (std::size_t g = 0; g < groups.station.size(); ++g)
-    given[static_cast<std::size_t>(groups.station[g])] = observations[groups.first[g]].direction;
+    given[static_cast<std::size_t>(groups.station[g])] = observations[groups.first[g]].approach;
   Vector6d last = nominal.home_command(), direction = nominal.geometry().home_direction;
   for (std::size_t s = 0; s < stations; ++s) {
     const Vector6d& m = station_motor[s];
+    Vector6d approach;
     for (int i = 0; i < kLegs; ++i) {
       if (std::abs(m[i] - last[i]) > kSameCommand) direction[i] = m[i] > last[i] ? 1.0 : -1.0;
-      if (given[s][i] != 0.0) direction[i] = given[s][i];
       last[i] = m[i];
+      approach[i] = given[s][i] != 0.0 ? given[s][i] : direction[i] * 2.0 * kMaxPlay;
+      if (given[s][i] != 0.0) direction[i] = given[s][i] > 0.0 ? 1.0 : -1.0;
     }
-    out.direction.push_back(direction);
+    out.approach.push_back(approach);
   }
+  out.constant.assign(stations, Vector6d::Zero());
   const EffectFit& fit = set.effects();
   out.regressors.assign(stations, Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, fit.count()));
   if (!fit.any()) return out;
@@ -197,10 +218,7 @@ EffectRegressors effect_regressors(const ParameterSet& set, std::span<const Obse
       guess = fk.placement;
       r.col(k++) = force - nominal.reference_force();
     }
-    if (fit.play) {
-      for (int i = 0; i < kLegs; ++i) r(i, k + i) = -0.5 * (out.direction[s][i] - nominal.geometry().home_direction[i]);
-      k += kLegs;
-    }
+    if (fit.play) k += kLegs;  // play_terms, at each evaluation's plays
     if (fit.heat) {
       const double f = (time[s] - t0) / (t1 - t0);
       for (int i = 0; i < kLegs; ++i) {
@@ -242,19 +260,28 @@ Status Evaluator::evaluate(const Eigen::VectorXd& theta, double sign, const Rigi
   std::vector<FkResult> fk(stations);
   const int fitted = set_.effects().count();
   const Eigen::VectorXd effect_theta = theta.segment(set_.effect_index(), fitted);
+  // The plays: fitted ones from theta, the configuration's own otherwise.
+  Vector6d play = 2.0 * model.geometry().half_play;
+  if (set_.play_index() >= 0) play = theta.segment<kLegs>(set_.play_index());
   for (std::size_t s = 0; s < stations; ++s) {
     if (skipped(s)) continue;
+    Vector6d coefficient, constant, direction;
+    play_terms(model, effects_.approach[s], play, coefficient, constant, direction);
+    if (set_.play_index() >= 0) {
+      const int column = set_.play_index() - set_.effect_index();
+      for (int i = 0; i < kLegs; ++i) effects_.regressors[s](i, column + i) = coefficient[i];
+      effects_.constant[s] = constant;
+    }
     // The fitted effects shift the legs' lengths, so the nut's travel: the drives' command by that
     // over their scale. The configuration's own effects act at the station's approach direction.
     Vector6d motor = station_motor_[s];
     if (fitted > 0) {
-      const Vector6d shift = effects_.regressors[s] * effect_theta;
+      const Vector6d shift = effects_.regressors[s] * effect_theta + effects_.constant[s];
       for (int i = 0; i < kLegs; ++i) motor[i] += shift[i] / model.leg(i).drive_scale;
     }
-    const Status st =
-        model.has_leg_effects()
-            ? forward_kinematics(model, motor, LegInputs{}, &effects_.direction[s], poses_[s], fk[s], fk_options_)
-            : forward_kinematics(model, motor, LengthKind::Motor, poses_[s], fk[s], fk_options_);
+    const Status st = model.has_leg_effects()
+                          ? forward_kinematics(model, motor, LegInputs{}, &direction, poses_[s], fk[s], fk_options_)
+                          : forward_kinematics(model, motor, LengthKind::Motor, poses_[s], fk[s], fk_options_);
     if (st != Status::Ok && st != Status::AssemblyModeChanged) {
       failed_station_ = static_cast<int>(s);
       return st;

@@ -33,15 +33,26 @@ Status pose_sensitivity(const Model& candidate, const ParameterSet& set, const F
                         Eigen::Matrix<double, 6, Eigen::Dynamic>& dx_dtheta,
                         const Eigen::Matrix<double, 6, Eigen::Dynamic>* effects = nullptr);
 
-/// The legs' effects at each station (theory §13b): each leg's direction of approach (from the
-/// stations' order, starting from home in the homing direction), and the regressors whose product
-/// with the effects' parameters (ParameterSet::effect_index() on) is each leg's length shift [m].
+/// The legs' effects at each station (theory §13b): each leg's approach (Observation::approach; from
+/// the stations' order where unknown, starting from home in the homing direction), and the
+/// regressors whose product with the effects' parameters (ParameterSet::effect_index() on), plus
+/// `constant`, is each leg's length shift [m]. The play's columns and constant depend on the plays
+/// themselves (a play longer than the approach leaves the nut partway): play_terms sets them.
 struct EffectRegressors {
   Status status = Status::Ok;  ///< NotIdentifiable where an effect cannot be modelled (reason says why)
   std::string reason;
-  std::vector<Vector6d> direction;                                   ///< per station [-]
+  std::vector<Vector6d> approach;                                    ///< per station, signed run [m]
   std::vector<Eigen::Matrix<double, 6, Eigen::Dynamic>> regressors;  ///< per station, 6 x count
+  std::vector<Vector6d> constant;                                    ///< per station [m]
 };
+
+/// Each leg's play term at a station with approach `approach` [m] (signed run) for the plays `play`
+/// [m]: E = -(b/2)(d - d_home) with the nut's direction d = sign(run) where b <= |run|, and
+/// sign(run)(2|run|/b - 1) where the run ends inside the gap (the nut dragged from the far side):
+/// E = coefficient b + constant in either case, written to `coefficient` and `constant`; `direction`
+/// receives d.
+void play_terms(const Model& nominal, const Vector6d& approach, const Vector6d& play, Vector6d& coefficient,
+                Vector6d& constant, Vector6d& direction) noexcept;
 
 /// The regressors of set.effects() for the stations of `groups` (station_motor: each station's
 /// commands): load needs the nominal model's static load, heat the observations' times.

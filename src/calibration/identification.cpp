@@ -341,8 +341,75 @@ Status fit_both_senses(const Model& nominal, ParameterSet& set, std::span<const 
 
 }  // namespace
 
+namespace {
+
+// Forward selection of the legs' effects (IdentificationOptions::auto_effects, theory §13b).
+Status identify_choosing_effects(const Model& nominal, std::span<const Observation> observations, Identification& out,
+                                 const IdentificationOptions& options) {
+  IdentificationOptions trial = options;
+  trial.auto_effects = false;
+  trial.folds = 0;
+  trial.accuracy_poses = 0;
+  trial.effects = EffectFit{};
+  Identification base;
+  (void)identify(nominal, observations, base, trial);
+  std::string log;
+  if (base.fitted && std::isfinite(base.fit_statistic)) {
+    for (;;) {
+      const EffectFit chosen = trial.effects;
+      EffectFit best = chosen;
+      bool found = false;
+      Identification best_fit;
+      double best_z = options.effect_sigmas;
+      std::string tried;
+      for (int e = 0; e < 3; ++e) {
+        EffectFit candidate = chosen;
+        bool& flag = e == 0 ? candidate.load : e == 1 ? candidate.play : candidate.heat;
+        if (flag) continue;
+        flag = true;
+        IdentificationOptions o = trial;
+        o.effects = candidate;
+        Identification r;
+        (void)identify(nominal, observations, r, o);
+        const char* name = e == 0 ? "load" : e == 1 ? "play" : "heat";
+        if (!r.fitted || r.status == Status::NotIdentifiable || !std::isfinite(r.fit_statistic)) {
+          tried += fmt::format("{}{} cannot be fitted", tried.empty() ? "" : ", ", name);
+          continue;
+        }
+        // The drop of the fit statistic is chi-square on the effect's parameters if it is absent.
+        const double dof = candidate.count() - chosen.count();
+        const double z = (base.fit_statistic - r.fit_statistic - dof) / std::sqrt(2.0 * dof);
+        tried += fmt::format("{}{} {:.1f} sigma", tried.empty() ? "" : ", ", name, z);
+        if (z > best_z) {
+          found = true;
+          best_z = z;
+          best = candidate;
+          best_fit = std::move(r);
+        }
+      }
+      if (!tried.empty())
+        log += fmt::format("{}{}{}", log.empty() ? "" : "; then ", chosen.any() ? "with " + chosen.names() + ": " : "",
+                           tried);
+      if (!found) break;
+      trial.effects = best;
+      base = std::move(best_fit);
+    }
+  }
+  IdentificationOptions final_options = options;
+  final_options.auto_effects = false;
+  final_options.effects = trial.effects;
+  const Status s = identify(nominal, observations, out, final_options);
+  out.effects_choice =
+      fmt::format("auto: {} (each effect's drop of the fit statistic, {:g} sigma needed: {})", trial.effects.names(),
+                  options.effect_sigmas, log.empty() ? "the data could not be fitted without effects" : log);
+  return s;
+}
+
+}  // namespace
+
 Status identify(const Model& nominal, std::span<const Observation> observations, Identification& out,
                 const IdentificationOptions& options) {
+  if (options.auto_effects) return identify_choosing_effects(nominal, observations, out, options);
   out = Identification{};
   const ObservationGroups groups = group_observations(observations);
   out.observations = static_cast<int>(observations.size());
@@ -427,9 +494,9 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
                     options.fit_sigmas, w.station + 1, w.count, 1e3 * w.mean_error),
         set.model() == CalibrationModel::Basic
             ? "the joint geometry is off: identify the joint centres too, the geometry model (--model geometry)"
-            : "an error the model does not have: legs that warm, deflect under the load or have play (fit them: "
-              "--effects heat,load,play), another configuration, log, run or strategy than the machine's, a servo "
-              "still moving (a longer settle time), or U-joint axes (fit them all: --axes all)");
+            : "an error the model does not have: legs that warm, deflect under the load or have play (--effects "
+              "auto fits those the data show), another configuration, log, run or strategy than the machine's, a "
+              "servo still moving (a longer settle time), or U-joint axes (fit them all: --axes all)");
   }
   // Is the thread sense decided? The rejected sense must fit worse than the noise explains.
   {

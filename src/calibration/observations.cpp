@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -58,13 +59,15 @@ double tracker_scatter(const ObservationGroups& groups) noexcept {
 
 namespace {
 
-// Each leg's direction of approach to the pose `at` held at time t: walking back along the
-// commanded trajectory, the sense of the first difference of 1 um or more in its command (0 where
-// the trajectory never moved it so far).
-Vector6d approach_direction(const Model& model, const TimedPoses& commanded, double t, const Pose& at,
-                            const Vector6d& motor, Strategy strategy) {
+// Each leg's approach to the pose `at` held at time t: walking back along the commanded
+// trajectory, the last monotone run of its command (a reversal of 1 um or more ends it), followed
+// back until it reaches 1 mm (kMaxPlay: longer than any play) or the trajectory's start; 0 where the
+// trajectory never moved the leg so far.
+Vector6d approach_runs(const Model& model, const TimedPoses& commanded, double t, const Pose& at, const Vector6d& motor,
+                       Strategy strategy) {
   constexpr double kMoved = 1e-6;  // [m]
-  Vector6d direction = Vector6d::Zero();
+  Vector6d sense = Vector6d::Zero(), extreme = motor;
+  std::array<bool, kLegs> done{};
   auto it = std::upper_bound(commanded.t.begin(), commanded.t.end(), t);
   for (auto j = static_cast<std::ptrdiff_t>(it - commanded.t.begin()) - 1; j >= 0; --j) {
     const Pose& p = commanded.poses[static_cast<std::size_t>(j)];
@@ -74,12 +77,24 @@ Vector6d approach_direction(const Model& model, const TimedPoses& commanded, dou
     if (motor_commands(model, p, strategy, m, limit) != Status::Ok) continue;
     bool all = true;
     for (int i = 0; i < kLegs; ++i) {
-      if (direction[i] == 0.0 && std::abs(motor[i] - m[i]) >= kMoved) direction[i] = motor[i] > m[i] ? 1.0 : -1.0;
-      all = all && direction[i] != 0.0;
+      const auto k = static_cast<std::size_t>(i);
+      if (done[k]) continue;
+      if (sense[i] == 0.0) {
+        if (std::abs(motor[i] - m[i]) >= kMoved) {
+          sense[i] = motor[i] > m[i] ? 1.0 : -1.0;
+          extreme[i] = m[i];
+        }
+      } else if (sense[i] * (m[i] - extreme[i]) < 0.0) {
+        extreme[i] = m[i];  // further back along the run
+      } else if (sense[i] * (m[i] - extreme[i]) > kMoved) {
+        done[k] = true;  // the run began at the extreme
+      }
+      if (sense[i] != 0.0 && std::abs(motor[i] - extreme[i]) >= kMaxPlay) done[k] = true;
+      all = all && done[k];
     }
     if (all) break;
   }
-  return direction;
+  return motor - extreme;
 }
 
 }  // namespace
@@ -106,9 +121,9 @@ ObservationSet observations_at_rest(const Model& model, const TimedPoses& comman
     if (set.points.empty() ||
         (desired[k].to_vector() - desired[set.points.back()].to_vector()).cwiseAbs().maxCoeff() > detail::kSamePose) {
       ++set.poses;
-      o.direction = approach_direction(model, commanded, times[k], desired[k], o.motor, strategy);
+      o.approach = approach_runs(model, commanded, times[k], desired[k], o.motor, strategy);
     } else {
-      o.direction = set.observations.back().direction;
+      o.approach = set.observations.back().approach;
     }
     set.observations.push_back(o);
     set.points.push_back(k);

@@ -65,7 +65,7 @@ std::vector<Observation> observe_with_effects(const EffectsCase& c, const std::v
       Observation o;
       o.motor = command;
       o.time = t;
-      o.direction = direction;
+      o.approach = direction;  // a 1 m run: longer than any play
       o.p_T = apply(X_TB, platform_point_B(real, fk.placement, c.truth.targets[0])) +
               sigma * Vector3d(gaussian(rng), gaussian(rng), gaussian(rng));
       out.push_back(o);
@@ -115,6 +115,32 @@ TEST(IdentificationEffects, LoadPlayAndHeatAreRefusedWithoutThemAndRecoveredWith
     EXPECT_EQ(leg.length_expansion, 0.0);
   }
   EXPECT_NO_THROW(Model{id.corrected});
+}
+
+TEST(IdentificationEffects, AutoChoosesTheEffectsTheDataShowAndNoneOtherwise) {
+  std::mt19937_64 rng(kSeed + 504);
+  EffectsCase c = effects_case(rng);
+  // Softer legs than the other tests' (100 N/um): at 200 N/um the load shows at 1.4 sigma only
+  // here (50 stations of 6 points), and auto rightly leaves it out.
+  for (LegSpec& leg : c.real_spec.legs) leg.stiffness = 1.0e8;
+  const Model& nominal = c.config.rig.model();
+  const Model real(c.real_spec);
+  const std::vector<Pose> stations = random_station_poses(nominal, real, 50, 0.25, deg2rad(15), rng);
+  IdentificationOptions options;
+  options.folds = 0;
+  options.accuracy_poses = 50;
+  options.auto_effects = true;
+  Identification id;
+  ASSERT_EQ(identify(nominal, observe_with_effects(c, stations, 6, 10e-6, rng), id, options), Status::Ok) << id.reason;
+  EXPECT_EQ(id.parameters.effects().names(), "load,play,heat") << id.effects_choice;
+  // The same platform without the effects: none is chosen (each below 5 sigma).
+  EffectsCase rigid = c;
+  rigid.real_spec = c.truth.spec;
+  Identification plain;
+  ASSERT_EQ(identify(nominal, observe_with_effects(rigid, stations, 6, 10e-6, rng), plain, options), Status::Ok)
+      << plain.reason;
+  EXPECT_EQ(plain.parameters.effects().names(), "none") << plain.effects_choice;
+  EXPECT_EQ(plain.effects_choice.rfind("auto: none", 0), 0u) << plain.effects_choice;
 }
 
 TEST(IdentificationEffects, TheEffectsColumnsMatchCentralDifferences) {

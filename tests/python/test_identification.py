@@ -116,3 +116,29 @@ def test_a_time_offset_outside_the_run_is_refused_by_both_naming_the_parameter(l
     assert message[len("point log:2:1: "):-len(" [time_offset]")] in cli.stderr
     with pytest.raises(hexatwist.InputError, match=r"settle.*\[settle\]$"):
         hexatwist.observations_at_rest(model, stations.t, stations.poses, log.stamps, log.points, settle=-1.0)
+
+
+def test_the_legs_effects_are_chosen_and_fitted_alike_by_python_and_the_cli(tmp_path):
+    # A machine whose legs warm 1 K, deflect at 200 N/um and have 50 um of play (theory §13b): the CLI's
+    # --effects auto and Python's effects="auto", with the times and approaches observations_at_rest
+    # gives, choose the same effects and reach the same estimate bit for bit; without them, refused.
+    run("synth", "--stations", "30", "--station-seed", "4", "--joint-errors-mm", "0.5", "--seed", "6",
+        "--temperature-rise-k", "1", "--stiffness-n-per-um", "200", "--play-um", "50", "--out", "w.csv",
+        cwd=tmp_path)
+    cli = json.loads(run("identify", "--points", "w.csv", "--stations", "30", "--station-seed", "4", "--json",
+                         "--no-figures", "--effects", "auto", cwd=tmp_path).stdout)
+    model = hexatwist.default_model()
+    log = hexatwist.read_point_log(str(tmp_path / "w.csv"))
+    stations = hexatwist.stations_run(count=30, seed=4)
+    obs = hexatwist.observations_at_rest(model, stations.t, stations.poses, log.stamps, log.points)
+    assert obs.time.shape == (len(obs.motor),) and obs.approach.shape == (len(obs.motor), 6)
+    assert (obs.approach > 0).any(axis=0).all() and (obs.approach < 0).any(axis=0).all(), "both sides"
+    py = hexatwist.identify(model, obs.motor, obs.points, effects="auto", times=obs.time, approach=obs.approach)
+    assert cli["status"] == "ok" and py.status == "ok", py.reason
+    assert cli["effects"] == py.effects and py.effects != "none", py.effects_choice
+    assert cli["effects_choice"] == py.effects_choice
+    np.testing.assert_array_equal([p["estimate"] for p in cli["estimate"]["parameters"]], py.estimate)
+    plain = hexatwist.identify(model, obs.motor, obs.points)
+    assert plain.status == "model_mismatch" and "--effects auto" in plain.hint
+    with pytest.raises(ValueError, match="warp"):
+        hexatwist.identify(model, obs.motor, obs.points, effects="heat,warp")

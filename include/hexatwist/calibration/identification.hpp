@@ -39,6 +39,12 @@ struct IdentificationOptions {
   /// The legs' effects fitted besides the geometry (theory §13b): the load's deflection, the play
   /// and the legs' drift over the run (heat).
   EffectFit effects{};
+  /// Choose the effects from the data instead (theory §13b): forward selection from none, adding
+  /// the effect whose fit statistic drops most, while it drops by more than `effect_sigmas` normal
+  /// deviates of its chi-square (the drop's degrees of freedom: the effect's parameters); an effect
+  /// the data cannot carry (undetermined, or missing what it needs) is left out. `effects` is ignored.
+  bool auto_effects = false;
+  double effect_sigmas = 5.0;
   /// Auto: an axis direction is fitted when the data determine both its angles to this [rad].
   double axis_sd_max = deg2rad(0.1);
   /// The tracker's noise per coordinate [m]; NaN = its scatter at rest (tracker_scatter), which
@@ -168,6 +174,8 @@ struct Identification {
   std::string undetermined;  ///< the parameters that enter the undetermined combinations
   CrossValidation cross_validation;
   AccuracyPrediction accuracy;
+  /// With IdentificationOptions::auto_effects: how the effects were chosen, one line ("" otherwise).
+  std::string effects_choice;
 
   Identification() { axis_sd.fill(std::numeric_limits<double>::quiet_NaN()); }
 };

@@ -24,10 +24,11 @@ struct Observation {
   /// When it was taken [s] (the trajectory's time): the time of the legs' drift (EffectFit::heat);
   /// NaN = unknown.
   double time = std::numeric_limits<double>::quiet_NaN();
-  /// Each leg's direction of approach to the station, +1 lengthening, -1 shortening: the sense of
-  /// its commanded motor-side length's last change (EffectFit::play); 0 = unknown (then the
-  /// stations' order decides).
-  Vector6d direction = Vector6d::Zero();
+  /// Each leg's approach to the station (EffectFit::play): the length of the last monotone run of
+  /// its commanded motor-side length before the station, positive lengthening, negative shortening
+  /// [m]; a play longer than the run leaves the nut partway across its gap. 0 = unknown (then the
+  /// stations' order gives the direction, the run taken as longer than any play).
+  Vector6d approach = Vector6d::Zero();
 };
 
 /// The observations in groups: one station (a run of consecutive observations with the same
@@ -74,10 +75,11 @@ inline constexpr std::size_t kMinObservations = 6;
 /// The points of `log` taken while the commanded pose had been still for `settle` seconds (0 =
 /// every point), each with the motor-side lengths that the nominal `model` commands for the
 /// commanded pose under `strategy`: what the drives were told, which is where they stand once the
-/// servo has settled, and each leg's direction of approach: the sense of the last change of its
-/// command along the commanded trajectory before the station (1 um or more). Throws hexatwist::Error with one line
-/// naming the log, and the line of a point at fault, for: a point outside the trajectory's time span, a settle time
-/// that is not finite and >= 0, a commanded pose outside a limit, fewer than kMinObservations points at rest.
+/// servo has settled, and each leg's approach: the last monotone run of its command along the
+/// commanded trajectory before the station (followed back to 1 mm, the longest plausible play). Throws hexatwist::Error
+/// with one line naming the log, and the line of a point at fault, for: a point outside the trajectory's time span, a
+/// settle time that is not finite and >= 0, a commanded pose outside a limit, fewer than kMinObservations points at
+/// rest.
 ObservationSet observations_at_rest(const Model& model, const TimedPoses& commanded, const PointLog& log,
                                     const TimeAlignment& time, Strategy strategy, double settle);
 
