@@ -24,7 +24,7 @@ struct IdentifyOptions {
   std::string model = "geometry";
   std::string lead_effect = "travel";
   std::string axes = "auto";
-  std::string effects = "none";
+  std::string effects = "auto";
   double tracker_noise_um = std::numeric_limits<double>::quiet_NaN();
   int folds = 5;
   std::string out = "identified.yaml";

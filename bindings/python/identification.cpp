@@ -286,7 +286,7 @@ void expose_identification(py::module_& m) {
   m.def("_identify", &identify_py, py::arg("model"), py::arg("motor"), py::arg("points"),
         py::arg("targets") = py::none(), py::arg("calibration") = "geometry", py::arg("lead_effect") = "travel",
         py::arg("axes") = "auto", py::arg("tracker_noise") = py::none(), py::arg("folds") = 5,
-        py::arg("accuracy_poses") = 1000, py::arg("effects") = "none", py::arg("times") = py::none(),
+        py::arg("accuracy_poses") = 1000, py::arg("effects") = "auto", py::arg("times") = py::none(),
         py::arg("approach") = py::none());
   m.def("_corrected_config", &corrected_config_py, py::arg("rig"), py::arg("corrected"), py::arg("header") = "");
 }

@@ -176,7 +176,7 @@ def _observations_at_rest(model: Model, t: npt.ArrayLike, poses: npt.ArrayLike, 
 def _identify(model: Model, motor: npt.ArrayLike, points: npt.ArrayLike, targets: npt.ArrayLike | None = None,
               calibration: str = "geometry", lead_effect: str = "travel", axes: str = "auto",
               tracker_noise: float | None = None, folds: int = 5, accuracy_poses: int = 1000,
-              effects: str = "none", times: npt.ArrayLike | None = None,
+              effects: str = "auto", times: npt.ArrayLike | None = None,
               approach: npt.ArrayLike | None = None) -> _Raw: ...
 def _plan_stations(rig: _RigLike = None, count: int = 20, seed: int = 1, strategy: str = "compensated",
                    translation: float = 0.25, rotation: float = ..., candidates: int = 3000,

@@ -415,7 +415,7 @@ def _identification(d: dict[str, Any]) -> Identification:
 def identify(model: Model, motor: ArrayLike, points: ArrayLike, targets: ArrayLike | None = None, *,
              calibration: Literal["geometry", "basic"] = "geometry", lead_effect: Literal["travel", "twist"] = "travel",
              axes: Literal["auto", "none", "all"] = "auto", tracker_noise: float | None = None, folds: int = 5,
-             accuracy_poses: int = 1000, effects: str = "none", times: ArrayLike | None = None,
+             accuracy_poses: int = 1000, effects: str = "auto", times: ArrayLike | None = None,
              approach: ArrayLike | None = None) -> Identification:
     """Calibrates the platform (identification.hpp, theory §13) from observations ``motor`` (K, 6) [m],
     ``points`` (K, 3) [m, T] and their ``targets`` (K,) int (None: all the observation point), with the
@@ -428,7 +428,8 @@ def identify(model: Model, motor: ArrayLike, points: ArrayLike, targets: ArrayLi
     "load", "play", "heat" comma-separated, "none", or "auto" (those the data show at 5 sigma), as
     ``hexatwist identify --effects``; heat needs each
     observation's ``times`` (K,) [s], play their ``approach`` (K, 6) [m] (both as
-    ``observations_at_rest`` gives them; without it, the stations' order decides). A refusal is
+    ``observations_at_rest`` gives them; without times, heat is left out, and without approaches the
+    stations' order decides; pass both to reach the CLI's result). A refusal is
     the status (with a reason and a hint), not an exception."""
     column = None if times is None else np.asarray(times, dtype=np.float64).reshape(-1, 1)
     return _identification(_core._identify(model, motor, points, targets, calibration, lead_effect, axes,

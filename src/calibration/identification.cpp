@@ -352,9 +352,12 @@ Status identify_choosing_effects(const Model& nominal, std::span<const Observati
   trial.accuracy_poses = 0;
   trial.effects = EffectFit{};
   Identification base;
-  (void)identify(nominal, observations, base, trial);
   std::string log;
-  if (base.fitted && std::isfinite(base.fit_statistic)) {
+  // On the basic model the joints' errors would go into the effects: none is chosen there.
+  if (options.model == CalibrationModel::Geometry) (void)identify(nominal, observations, base, trial);
+  if (options.model != CalibrationModel::Geometry)
+    log = "the basic model keeps the joints as configured, whose errors the effects would absorb";
+  else if (base.fitted && std::isfinite(base.fit_statistic)) {
     for (;;) {
       const EffectFit chosen = trial.effects;
       EffectFit best = chosen;
@@ -372,7 +375,11 @@ Status identify_choosing_effects(const Model& nominal, std::span<const Observati
         Identification r;
         (void)identify(nominal, observations, r, o);
         const char* name = e == 0 ? "load" : e == 1 ? "play" : "heat";
-        if (!r.fitted || r.status == Status::NotIdentifiable || !std::isfinite(r.fit_statistic)) {
+        // An effect the solve cannot carry (undetermined, not converging: one that absorbs another
+        // error of the model) is left out.
+        const bool usable =
+            r.status == Status::Ok || r.status == Status::ModelMismatch || r.status == Status::SignUndecided;
+        if (!r.fitted || !usable || !std::isfinite(r.fit_statistic)) {
           tried += fmt::format("{}{} cannot be fitted", tried.empty() ? "" : ", ", name);
           continue;
         }

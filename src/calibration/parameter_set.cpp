@@ -29,8 +29,11 @@ Eigen::MatrixXd gauge_basis(const LegVectors& points) {
 
 std::string EffectFit::names() const {
   std::string out;
-  for (const auto& [on, name] : {std::pair{load, "load"}, std::pair{play, "play"}, std::pair{heat, "heat"}})
-    if (on) out += (out.empty() ? "" : ",") + std::string(name);
+  for (const auto& [on, name] : {std::pair{load, "load"}, std::pair{play, "play"}, std::pair{heat, "heat"}}) {
+    if (!on) continue;
+    if (!out.empty()) out += ',';
+    out += name;
+  }
   return out.empty() ? "none" : out;
 }
 

@@ -230,7 +230,8 @@ TEST(LegEffects, AModelWithoutEffectsIsUnchangedByTheStaticLoadItCarries) {
   ModelSpec bare = seed_model().spec();
   bare.static_load = StaticLoadSpec{};
   const Model without(bare);
-  const Model& with = default_config().rig.model();
+  const Config config = default_config();
+  const Model& with = config.rig.model();
   ASSERT_TRUE(with.spec().static_load.present);
   ASSERT_FALSE(with.has_leg_effects());
   std::mt19937_64 rng(kSeed + 404);
@@ -260,7 +261,8 @@ TEST(LegEffects, ImplausibleValuesAreRefusedNamingTheField) {
            {"  reference_temperature: 900\n", "leg_effects.reference_temperature"},
            {"  stifness: 2e8\n", "leg_effects.stifness"}}) {
     SCOPED_TRACE(block);
-    expect_error_line([&] { (void)seed_with_effects(block); }, "effects.yaml:", {field});
+    const std::string text = block;  // clang 14 cannot capture a structured binding
+    expect_error_line([&] { (void)seed_with_effects(text); }, "effects.yaml:", {field});
   }
 }
 

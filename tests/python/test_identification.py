@@ -40,7 +40,8 @@ def python_identification(log_path, **options):
     stations = hexatwist.stations_run(count=30, seed=4)
     obs = hexatwist.observations_at_rest(model, stations.t, stations.poses, log.stamps, log.points,
                                          targets=log.targets)
-    return model, hexatwist.identify(model, obs.motor, obs.points, obs.targets, **options)
+    return model, hexatwist.identify(model, obs.motor, obs.points, obs.targets, times=obs.time,
+                                     approach=obs.approach, **options)
 
 
 def test_python_and_the_cli_reach_the_same_estimate_bit_for_bit(log_dir):

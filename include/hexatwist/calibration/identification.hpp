@@ -30,7 +30,8 @@ enum class AxisFit {
   All,   ///< every axis
 };
 
-/// Settings of identify. The defaults are the CLI's.
+/// Settings of identify. The defaults are the CLI's and Python's, but for auto_effects: they choose
+/// the effects (`--effects auto`, `effects="auto"`); a C++ caller asks for it.
 struct IdentificationOptions {
   CalibrationModel model = CalibrationModel::Geometry;  ///< which parameters
   LeadEffect lead_effect = LeadEffect::TwistAndTravel;  ///< measurement model of the lead
@@ -42,7 +43,8 @@ struct IdentificationOptions {
   /// Choose the effects from the data instead (theory §13b): forward selection from none, adding
   /// the effect whose fit statistic drops most, while it drops by more than `effect_sigmas` normal
   /// deviates of its chi-square (the drop's degrees of freedom: the effect's parameters); an effect
-  /// the data cannot carry (undetermined, or missing what it needs) is left out. `effects` is ignored.
+  /// the data cannot carry (undetermined, or missing what it needs) is left out; none on the Basic
+  /// model (its joints' errors would go into the effects). `effects` is ignored.
   bool auto_effects = false;
   double effect_sigmas = 5.0;
   /// Auto: an axis direction is fitted when the data determine both its angles to this [rad].
