@@ -51,7 +51,10 @@ EffectFit effect_fit(std::string_view names) {
     else if (word == "heat")
       fit.heat = true;
     else
-      throw Error(fmt::format("effects: '{}' is not one of load, play, heat (a comma-separated list) or none", word));
+      throw Error(
+          fmt::format("effects: '{}' is not one of load, play, heat (a comma-separated list), none, or auto (identify: "
+                      "those the data show)",
+                      word));
     begin = end + 1;
   }
   return fit;
