@@ -6,7 +6,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+source scripts/ccache.sh
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release "${ccache_flags[@]}" >/dev/null
 if [ ! -f build/build.ninja ] || [ ! -x build/hexatwist ]; then
   echo "hexatwist: building in build/ (the first build takes a few minutes on 2 cores)" >&2
 fi

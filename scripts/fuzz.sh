@@ -13,6 +13,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift $(( $# > 0 ? 1 : 0 ))
 bash scripts/setup.sh
+source scripts/ccache.sh
 
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
@@ -24,7 +25,7 @@ fi
 
 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DHEXATWIST_FUZZ=ON \
   -DHEXATWIST_BUILD_APPS=OFF -DHEXATWIST_BUILD_TESTS=OFF -DHEXATWIST_BUILD_BENCHMARKS=OFF \
-  -DHEXATWIST_BUILD_EXAMPLES=OFF >/dev/null
+  -DHEXATWIST_BUILD_EXAMPLES=OFF "${ccache_flags[@]}" >/dev/null
 cmake --build build-fuzz -- -j2
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:strict_string_checks=1:check_initialization_order=1}

@@ -5,7 +5,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake ninja-build pkg-config     # toolchain
+  build-essential cmake ninja-build pkg-config ccache  # toolchain (ccache: scripts/ccache.sh)
   libeigen3-dev libyaml-cpp-dev libcli11-dev libfmt-dev   # library and CLI
   libceres-dev                                      # identification (nonlinear least squares)
   libgtest-dev libgmock-dev libbenchmark-dev        # tests and benchmarks
@@ -15,6 +15,7 @@ packages=(
   clang-format python3-mypy                         # the format check and the Python stubs' type check (tests)
   linuxcnc-uspace linuxcnc-uspace-dev               # the LinuxCNC kinematics module and its tests (LinuxCNC 2.9)
   python3-pytest                                    # the tests that drive LinuxCNC and the Python package (Debian's python3)
+  python3-jsonschema                                # the JSON outputs validated against docs/schemas/ (tests)
   pybind11-dev python3-pybind11 python3-dev python3-numpy  # the Python package (bindings/python)
   python3-matplotlib python3-dask python3-distributed     # its examples and the Dask helper
 )

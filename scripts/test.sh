@@ -14,6 +14,7 @@ stage_done() {
 }
 
 bash scripts/build.sh
+source scripts/ccache.sh
 ctest --test-dir build --output-on-failure -j2
 stage_done "Release build and tests"
 
@@ -28,15 +29,17 @@ fi
 # where the Release build, on a CPU with AVX-512, runs the one-packet form.
 # The examples are left to the Release stage (their library calls run here in the tests).
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DHEXATWIST_SANITIZE=ON \
-  -DHEXATWIST_BUILD_BENCHMARKS=OFF -DHEXATWIST_BUILD_EXAMPLES=OFF -DHEXATWIST_ARCH=x86-64-v3 >/dev/null
+  -DHEXATWIST_BUILD_BENCHMARKS=OFF -DHEXATWIST_BUILD_EXAMPLES=OFF -DHEXATWIST_ARCH=x86-64-v3 "${ccache_flags[@]}" >/dev/null
 env "${sanitizer_env[@]}" cmake --build build-asan -- -j2
 # Left to the Release stage, to keep CI within its time (this build runs ~25x slower):
 # - the README's printed digits, which are the Release build's (the same commands run here in their
 #   own tests; this build, without AVX-512 and at -O1, differs in an identification's last digits);
+# - the JSON outputs against their schemas (the same writer in both builds);
 # - statistics that repeat one computation over many seeds, platforms or grids, whose code paths
 #   the other tests of the same file run here once.
 release_only=(
   'CliReadme[.]'
+  'Docs[.]EveryJsonOutputIsValidAgainstItsSchema$'
   'WorkspaceVolume[.]SymmetriesOfTheSeedGiveEqualVolumesWithinTheStatedError$'
   'WorkspaceVolume[.]AgreesWithAnIndependentMonteCarloEstimateToOnePercent$'
   'WorkspaceVolume[.]StatedErrorBoundsTheErrorAgainstAFinerGrid$'

@@ -22,6 +22,7 @@ enum ExitCode : int {
   kExitOutOfLimit = 3,     ///< a pose outside a limit, or a forward-kinematics failure
   kExitOutputFailed = 4,   ///< an output file or figure could not be written
   kExitNotIdentified = 5,  ///< identify: the data do not determine the parameters, or the solver did not converge
+  kExitInterrupted = 6,    ///< SIGINT, SIGTERM or SIGHUP ended the run; it was rolled back (signals.hpp)
 };
 
 /// A failure the tool reports as one line on stderr with its exit code.

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "cli_common.hpp"
+#include "signals.hpp"
 
 extern char** environ;
 
@@ -114,15 +115,25 @@ ClusterArrays run_cluster_job(const std::string& scheduler, const std::string& r
   std::string arg0 = python, arg1 = "-m", arg2 = "hexatwist.cluster";
   char* argv[] = {arg0.data(), arg1.data(), arg2.data(), nullptr};
   pid_t pid = 0;
-  const int rc = python.find('/') != std::string::npos
-                     ? posix_spawn(&pid, python.c_str(), &actions, nullptr, argv, environ)
-                     : posix_spawnp(&pid, python.c_str(), &actions, nullptr, argv, environ);
+  int rc = 0;
+  // A signal stops the client with the run and removes its message file.
+  const signals::Undo remove_err = [](void* path) noexcept { ::unlink(static_cast<const char*>(path)); };
+  void* const err_context = const_cast<char*>(err_path.c_str());
+  {
+    const signals::Critical critical;
+    signals::add_undo(remove_err, err_context);
+    rc = python.find('/') != std::string::npos ? posix_spawn(&pid, python.c_str(), &actions, nullptr, argv, environ)
+                                               : posix_spawnp(&pid, python.c_str(), &actions, nullptr, argv, environ);
+    if (rc == 0) signals::add_child(pid);
+  }
   posix_spawn_file_actions_destroy(&actions);
   ::close(in_pipe[0]);
   ::close(out_pipe[1]);
   if (rc != 0) {
     ::close(in_pipe[1]);
     ::close(out_pipe[0]);
+    const signals::Critical critical;
+    signals::remove_undo(remove_err, err_context);
     std::error_code ec;
     fs::remove(err_path, ec);
     throw ExitError(kExitBadInput, fmt::format("--scheduler: cannot run Python '{}' (HEXATWIST_PYTHON): {}",
@@ -144,6 +155,10 @@ ClusterArrays run_cluster_job(const std::string& scheduler, const std::string& r
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
+  {
+    const signals::Critical critical;
+    signals::remove_child(pid);
+  }
   std::string err;
   {
     std::ifstream e(err_path, std::ios::binary);
@@ -151,8 +166,12 @@ ClusterArrays run_cluster_job(const std::string& scheduler, const std::string& r
     s << e.rdbuf();
     err = s.str();
   }
-  std::error_code ec;
-  fs::remove(err_path, ec);
+  {
+    const signals::Critical critical;
+    signals::remove_undo(remove_err, err_context);
+    std::error_code ec;
+    fs::remove(err_path, ec);
+  }
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   if (code == 0) return parse(out);
   const std::string why = printable(last_line(err));

@@ -7,6 +7,7 @@
 
 #include "cli_common.hpp"
 #include "json.hpp"
+#include "schemas.hpp"
 
 namespace hexatwist::cli {
 namespace {
@@ -52,7 +53,10 @@ std::string config_json(const Model& model, const ModelOptions& source) {
   const ModelSpec& spec = model.spec();
   const LimitSpec& lim = spec.limits;
   JsonWriter j;
-  j.begin_object().field("status", "ok").field("name", spec.name).field("source", model_source(source));
+  j.begin_document(schema::kConfig)
+      .field("status", "ok")
+      .field("name", spec.name)
+      .field("source", model_source(source));
   j.field("home_height", spec.home_height);
   j.key("pivot").vector(spec.pivot_P);
   j.key("observation_point").vector(spec.observation_P);

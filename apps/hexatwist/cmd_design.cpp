@@ -11,6 +11,7 @@
 #include "design_options.hpp"
 #include "json.hpp"
 #include "output_files.hpp"
+#include "schemas.hpp"
 
 namespace hexatwist::cli {
 namespace {
@@ -86,7 +87,7 @@ void evaluation_json(JsonWriter& j, const DesignEvaluation& e) {
 std::string report_json(const Model& model, const DesignCommandOptions& o, const RequiredPoses& req,
                         const DesignOptions& d, const AxisDesign& r) {
   JsonWriter j;
-  j.begin_object();
+  j.begin_document(schema::kDesign);
   j.field("command", "design");
   j.field("units", "SI: m, rad, m^3; lead_sensitivity in m per unit relative lead error; margins are shares");
   j.field("config", model_source(o.model));

@@ -12,6 +12,7 @@
 #include "figures.hpp"
 #include "json.hpp"
 #include "output_files.hpp"
+#include "schemas.hpp"
 #include "study_report.hpp"
 
 namespace hexatwist::cli {
@@ -95,7 +96,7 @@ std::string summary_json(const Rig& rig, const DynamicsOptions& o, const Traject
                          const std::vector<std::string>& files) {
   const ServoSpec& servo = rig.servo();
   JsonWriter j;
-  j.begin_object();
+  j.begin_document(schema::kDynamics);
   j.field("command", "dynamics");
   j.field("units", "SI: s, N m, rad/s, W, J; shares and usages are ratios");
   j.field("config", model_source(o.model));

@@ -6,6 +6,7 @@
 
 #include "cli_common.hpp"
 #include "json.hpp"
+#include "schemas.hpp"
 
 namespace hexatwist::cli {
 namespace {
@@ -43,7 +44,7 @@ int run_fk(const FkOptionsCli& o) {
 
   if (o.json) {
     JsonWriter j;
-    j.begin_object().field("status", to_string(final_status)).field("lengths_kind", kind_name);
+    j.begin_document(schema::kFk).field("status", to_string(final_status)).field("lengths_kind", kind_name);
     j.key("pose");
     status == Status::Ok ? j.vector(q) : j.null();
     j.field("iterations", result->iterations).field("residual", result->residual);

@@ -13,6 +13,7 @@
 #include "json.hpp"
 #include "output_files.hpp"
 #include "run_options.hpp"
+#include "schemas.hpp"
 
 namespace hexatwist::cli {
 namespace {
@@ -316,7 +317,7 @@ void json_estimate(JsonWriter& j, const Identification& id) {
 std::string json_report(const Report& r, const std::string& failure, bool written) {
   const Identification& id = r.id;
   JsonWriter j;
-  j.begin_object().field("command", "identify").field("status", failure.empty() ? "ok" : "failed");
+  j.begin_document(schema::kIdentify).field("command", "identify").field("status", failure.empty() ? "ok" : "failed");
   j.field("identification", to_string(id.status));
   if (!failure.empty()) j.field("reason", failure);
   if (!id.hint.empty()) j.field("hint", id.hint);
@@ -402,7 +403,18 @@ std::string corrected_config(const IdentifyOptions& o, const Model& model, const
                                       ? std::string(seed_config_yaml())
                                       : read_text_file(o.run.model.config, "--config", "config file");
   ModelSpec corrected = id.corrected;
-  corrected.name = fmt::format("{} (identified from {})", model.spec().name, o.log.points);
+  // The name says what was identified, so that a number in the original name (a nominal lead)
+  // is not taken for the identified one.
+  double lead_min = corrected.legs[0].lead, lead_max = lead_min;
+  for (const LegSpec& leg : corrected.legs) {
+    lead_min = std::min(lead_min, leg.lead);
+    lead_max = std::max(lead_max, leg.lead);
+  }
+  const std::string leads = lead_max - lead_min < 5e-10
+                                ? fmt::format("lead {:.6g} mm", 1e3 * lead_min)
+                                : fmt::format("leads {:.6g} to {:.6g} mm", 1e3 * lead_min, 1e3 * lead_max);
+  corrected.name = fmt::format("{} (identified from {}: {}; the identified values below replace the name's)",
+                               model.spec().name, o.log.points, leads);
   const std::string header = fmt::format(
       "corrected by hexatwist identify ({} model) from {} ({} points at rest at {} stations, rms {:.4f} -> {:.4f} "
       "mm):\njoint centres, leads, thread hands, length_offsets and observation_point identified; home_commands and\n"

@@ -7,6 +7,7 @@
 
 #include "cli_common.hpp"
 #include "json.hpp"
+#include "schemas.hpp"
 
 namespace hexatwist::cli {
 namespace {
@@ -45,7 +46,7 @@ int run_ik(const IkOptions& o) {
 
   if (o.json) {
     JsonWriter j;
-    j.begin_object().field("status", to_string(status)).field("model", model.spec().name);
+    j.begin_document(schema::kIk).field("status", to_string(status)).field("model", model.spec().name);
     j.key("pose").vector(pose.to_vector());
     j.key("limit");
     write_limit_json(j, report->limit);

@@ -26,6 +26,7 @@ struct MeasureOptions {
   std::string out = "measure-out";
   double register_until = std::numeric_limits<double>::quiet_NaN();
   std::size_t register_first = 0;
+  bool register_first_given = false;
   double settle = 0.25;
   bool no_figures = false;
   bool no_csv = false;
@@ -46,6 +47,11 @@ int run_measure(const MeasureOptions& o) {
   Run run = build_run(config, o.run);
 
   check_option(o.settle >= 0.0, "--settle", o.settle, "a time >= 0 [s]");
+  // 0 points is no window (not "the default one"): refused, never replaced.
+  if (o.register_first_given && o.register_first == 0)
+    throw ExitError(kExitBadInput,
+                    "--register-first 0: expected a number of points >= 1 (the points that register "
+                    "the tracker frame)");
   check_option(o.settle < run.test.trajectory.duration(), "--settle", o.settle,
                fmt::format("a time shorter than the run ({:g} s): no point can be still for longer [s]",
                            run.test.trajectory.duration()));
@@ -127,7 +133,8 @@ Command make_measure_command(CLI::App& root) {
   auto* until =
       app->add_option("--register-until", o->register_until,
                       "Register on the points with t <= SECONDS (default with --test: the calibration moves)");
-  auto* first = app->add_option("--register-first", o->register_first, "Or on the first N points of the log");
+  auto* first = app->add_option("--register-first", o->register_first, "Or on the first N points of the log (N >= 1)")
+                    ->each([o](const std::string&) { o->register_first_given = true; });
   until->excludes(first);
   app->add_option("--settle", o->settle,
                   "Of those, only points whose commanded pose has been still for this long [s]; 0 = all")

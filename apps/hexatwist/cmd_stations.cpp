@@ -9,8 +9,10 @@
 #include <memory>
 
 #include "cli_common.hpp"
+#include "hexatwist/io/gcode.hpp"
 #include "json.hpp"
 #include "output_files.hpp"
+#include "schemas.hpp"
 
 namespace hexatwist::cli {
 namespace {
@@ -26,8 +28,20 @@ struct StationsOptions {
   int points_per_station = 75;
   double rate = 100.0;
   std::string out;
+  std::string gcode;       // the run as a LinuxCNC program
+  std::string stream_out;  // the run as `hexatwist stream` input
   bool json = false;
 };
+
+// The run as `hexatwist stream` input: one pose per control period, x,y,z [m], roll,pitch,yaw [deg].
+std::string stream_input(const Trajectory& run) {
+  std::string s;
+  s.reserve(run.poses.size() * 64);
+  for (const Pose& p : run.poses)
+    s += fmt::format("{},{},{},{},{},{}\n", p.position.x(), p.position.y(), p.position.z(), rad2deg(p.rpy[0]),
+                     rad2deg(p.rpy[1]), rad2deg(p.rpy[2]));
+  return s;
+}
 
 // The library's spec from the options, each checked with its own name (exit 2).
 StationPlanSpec plan_spec(const Model& model, const StationsOptions& o) {
@@ -112,6 +126,13 @@ std::string text_report(const StationsOptions& o, const Model& model, const Stat
       "wrote {}: home, the {} stations, home; {:g} s at each, straight jerk-limited moves, {:.2f} s at {:g} Hz (read "
       "by synth and identify with --trajectory)\n",
       o.out, plan.planned.stations.size(), spec.run.dwell, run.duration(), o.rate);
+  if (!o.gcode.empty())
+    t += fmt::format(
+        "wrote {}: the same run as a LinuxCNC program (mm, deg; each move timed as planned, G93) for hexatwistkins\n",
+        o.gcode);
+  if (!o.stream_out.empty())
+    t += fmt::format("wrote {}: the same run as stream input, one pose per {:g} ms (hexatwist stream --rate {:g})\n",
+                     o.stream_out, 1e3 * run.dt, 1.0 / run.dt);
   return t;
 }
 
@@ -135,7 +156,7 @@ void quality_json(JsonWriter& j, const StationsQuality& q) {
 std::string json_report(const StationsOptions& o, const Model& model, const StationPlanSpec& spec,
                         const StationPlan& plan, const Trajectory& run) {
   JsonWriter j;
-  j.begin_object()
+  j.begin_document(schema::kStations)
       .field("command", "stations")
       .field("model", model.spec().name)
       .field("config", model_source(o.model));
@@ -153,7 +174,7 @@ std::string json_report(const StationsOptions& o, const Model& model, const Stat
   j.key("random");
   quality_json(j, plan.random);
   j.key("run").begin_object().field("out", o.out).field("rate", o.rate).field("duration", run.duration());
-  j.field("dwell", spec.run.dwell).end_object();
+  j.field("dwell", spec.run.dwell).field("gcode", o.gcode).field("stream_out", o.stream_out).end_object();
   return j.end_object().str();
 }
 
@@ -161,6 +182,8 @@ int run_stations(const StationsOptions& o) {
   OutputFiles files("stations");
   files.input("--config", o.model.config);
   files.output("--out", o.out);
+  files.output("--gcode", o.gcode);
+  files.output("--stream-out", o.stream_out);
   const Config config = load_config_from(o.model);
   const Model& model = config.rig.model();
   const Strategy strategy = o.strategy == "conventional" ? Strategy::Conventional : Strategy::Compensated;
@@ -185,6 +208,15 @@ int run_stations(const StationsOptions& o) {
     throw ExitError(kExitOutOfLimit, fmt::format("the planned run: {}; nothing was written", e.what()));
   }
   files.add(o.out, format_trajectory_csv(run, every));
+  if (!o.gcode.empty()) {
+    std::vector<Vector6d> waypoints{Vector6d::Zero()};
+    waypoints.insert(waypoints.end(), plan.planned.stations.begin(), plan.planned.stations.end());
+    waypoints.push_back(Vector6d::Zero());
+    files.add(o.gcode, waypoint_program(model, waypoints, spec.run.limits, spec.run.dwell,
+                                        fmt::format("stations --count {} --seed {} on {}: the run of {}", o.count,
+                                                    o.seed, model_source(o.model), o.out)));
+  }
+  if (!o.stream_out.empty()) files.add(o.stream_out, stream_input(run));
   files.commit();
   files.finish(o.json ? json_report(o, model, spec, plan, run) : text_report(o, model, spec, plan, run));
   return kExitOk;
@@ -226,6 +258,12 @@ Command make_stations_command(CLI::App& root) {
   app->add_option("--rate", o->rate, "Rows of the run per second [Hz]; must divide the control rate")
       ->capture_default_str();
   app->add_option("--out", o->out, "The run to write (t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad)")->required();
+  app->add_option("--gcode", o->gcode,
+                  "Also write the run as a LinuxCNC G-code program for hexatwistkins (X Y Z mm, Z absolute; A B C "
+                  "deg): the same stations and times, each move timed with G93, a dwell at each station");
+  app->add_option("--stream-out", o->stream_out,
+                  "Also write the run as hexatwist stream input: one pose per control period, x,y,z [m], "
+                  "roll,pitch,yaw [deg]");
   app->add_flag("--json", o->json, "Print the plan as JSON (SI units)");
   return {app, [o] { return run_stations(*o); }};
 }

@@ -17,23 +17,11 @@
 #include <optional>
 
 #include "cli_common.hpp"
+#include "signals.hpp"
 #include "udp.hpp"
 
 namespace hexatwist::cli {
 namespace {
-
-volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_stop_signal(int) { g_stop = 1; }
-
-// SIGINT and SIGTERM end the stream cleanly (the summary is printed); a blocking read returns.
-void install_stop_handlers() {
-  struct sigaction sa {};
-  sa.sa_handler = on_stop_signal;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = 0;  // no SA_RESTART: read() and poll() return EINTR
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-}
 
 struct StreamOptions {
   ModelOptions model;
@@ -54,6 +42,7 @@ struct StreamOptions {
   int rt_priority = 0;
   int cpu = -1;                  // -1 = any
   int receive_buffer = 4 << 20;  // bytes
+  std::string accept_from = "any";
   bool busy_poll = false;
   bool quiet = false;
 };
@@ -99,7 +88,7 @@ class LineReader {
       const ssize_t n = ::read(fd_, buf_.data() + end_, buf_.size() - end_);
       if (n < 0) {
         if (errno == EINTR) {
-          if (g_stop) return Result::Interrupted;
+          if (signals::stop_requested()) return Result::Interrupted;
           continue;
         }
         throw ExitError(kExitBadInput, fmt::format("--input: reading stdin: {}", std::strerror(errno)));
@@ -150,32 +139,46 @@ void check_settings(const Model& model, const StreamSettings& s, const StreamOpt
   if (why.starts_with("max_acceleration: "))
     throw ExitError(kExitBadInput, fmt::format("--max-acceleration {:g} with --rate {:g}: {}", o.max_acceleration,
                                                o.rate, why.substr(18)));
+  if (why.starts_with("on_reject: "))
+    throw ExitError(kExitBadInput, fmt::format("--on-reject {} with --max-velocity or --max-acceleration: {}",
+                                               o.on_reject, why.substr(11)));
   throw ExitError(kExitBadInput, fmt::format("stream settings: {}", why));
 }
 
-// Where answers go: stdout (flushed whenever no further input is waiting) or one datagram each.
+// Where answers go: stdout (whole answers in a buffer of its own, written out whenever no further
+// input is waiting; a write interrupted by a signal is resumed, so an answer is never cut) or one
+// datagram each.
 class AnswerSink {
  public:
   explicit AnswerSink(std::optional<UdpSocket> udp) : udp_(std::move(udp)) {}
 
   void write(std::string_view line) {
     if (!udp_) {
-      if (std::fwrite(line.data(), 1, line.size(), stdout) != line.size())
-        throw ExitError(kExitOutputFailed, fmt::format("--output: writing stdout: {}", std::strerror(errno)));
+      if (used_ + line.size() > buffer_.size()) flush();
+      std::memcpy(buffer_.data() + used_, line.data(), line.size());  // an answer fits: kMaxOutputLength
+      used_ += line.size();
       return;
     }
     if (!line.empty() && line.back() == '\n') line.remove_suffix(1);  // a datagram is one answer
-    if (!udp_->send(line)) ++refused_;
+    (void)udp_->send(line);                                           // a refusal is counted by the socket
   }
   void flush() {
-    if (!udp_ && std::fflush(stdout) != 0)
-      throw ExitError(kExitOutputFailed, fmt::format("--output: writing stdout: {}", std::strerror(errno)));
+    for (std::size_t done = 0; done < used_;) {
+      const ssize_t n = ::write(STDOUT_FILENO, buffer_.data() + done, used_ - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0)
+        throw ExitError(kExitOutputFailed,
+                        fmt::format("--output: writing stdout: {}", n < 0 ? std::strerror(errno) : "nothing written"));
+      done += static_cast<std::size_t>(n);
+    }
+    used_ = 0;
   }
-  std::uint64_t refused() const { return refused_; }
+  std::uint64_t refused() const { return udp_ ? udp_->refused() : 0; }
 
  private:
   std::optional<UdpSocket> udp_;
-  std::uint64_t refused_ = 0;
+  std::array<char, 1 << 16> buffer_{};
+  std::size_t used_ = 0;
 };
 
 // True unless the kernel lets real-time tasks run without limit (sched_rt_runtime_us = -1).
@@ -223,6 +226,9 @@ constexpr const char* kDefaultUdpOutput = "udp://127.0.0.1:9001";
 struct Endpoints {
   std::optional<UdpSocket> in, out;
   std::string in_text = "stdin", out_text = "stdout";
+  std::optional<UdpAddress> sender;  // --accept-from: the one sender taken
+  int receive_buffer = 0;            // granted by the kernel [bytes]
+  bool open_to_network = false;      // bound beyond loopback and taking any sender
 };
 
 Endpoints open_endpoints(const StreamOptions& o) {
@@ -230,8 +236,10 @@ Endpoints open_endpoints(const StreamOptions& o) {
   if (is_udp(o.input)) {
     const UdpAddress local = parse_udp_address(o.input, "--input");
     e.in = UdpSocket::bound(local, "--input");
-    e.in->set_receive_buffer(o.receive_buffer, "--receive-buffer");
+    e.receive_buffer = e.in->set_receive_buffer(o.receive_buffer, "--receive-buffer");
     e.in_text = udp_text(local.host, e.in->local_port());  // the port it got, also for port 0
+    if (o.accept_from != "any") e.sender = parse_udp_address(o.accept_from, "--accept-from");
+    e.open_to_network = !is_loopback(local) && !e.sender;
   } else if (o.input != "stdin" && o.input != "-") {
     throw ExitError(kExitBadInput,
                     fmt::format("--input: '{}' is neither stdin nor udp://HOST:PORT", printable(o.input)));
@@ -287,10 +295,11 @@ UdpSocket::Received receive_datagram(UdpSocket& in, const StreamOptions& o, std:
   if (o.busy_poll) {
     const auto since = std::chrono::steady_clock::now();
     const auto idle = std::chrono::duration<double>(o.idle_timeout > 0 ? o.idle_timeout : 1e300);
-    while (!g_stop && (r = in.try_receive(datagram, size, truncated)) == UdpSocket::Received::Timeout &&
+    while (!signals::stop_requested() &&
+           (r = in.try_receive(datagram, size, truncated)) == UdpSocket::Received::Timeout &&
            std::chrono::steady_clock::now() - since < idle) {
     }
-    if (g_stop) r = UdpSocket::Received::Interrupted;
+    if (signals::stop_requested()) r = UdpSocket::Received::Interrupted;
   } else {
     r = in.receive(datagram, size, truncated);
   }
@@ -329,12 +338,21 @@ int run_stream(const StreamOptions& o) {
   if (o.cpu < -1) throw ExitError(kExitBadInput, fmt::format("--cpu {}: expected a CPU number >= 0", o.cpu));
   pin_to_cpu(o.cpu);
   enter_realtime(o.rt_priority);
+  if (ends.open_to_network)  // warned even with --quiet
+    std::fprintf(stderr,
+                 "hexatwist stream: warning: --input %s takes poses from every host that reaches this machine; "
+                 "--accept-from udp://HOST:PORT takes them from one sender only\n",
+                 in_text.c_str());
   if (in_udp && !o.quiet) {
-    std::fprintf(stderr, "hexatwist stream: listening on %s, answering to %s\n", in_text.c_str(), out_text.c_str());
+    std::fprintf(stderr,
+                 "hexatwist stream: listening on %s (receive buffer: %d bytes asked, %d granted by the kernel), "
+                 "taking poses from %s, answering to %s\n",
+                 in_text.c_str(), o.receive_buffer, ends.receive_buffer,
+                 ends.sender ? ends.sender->text.c_str() : "any sender", out_text.c_str());
     std::fflush(stderr);
   }
   AnswerSink sink(std::move(ends.out));
-  install_stop_handlers();
+  signals::stop_on_request();  // a stop ends the stream at an input boundary, with its summary
 
   if (o.header && format == StreamFormat::Csv) sink.write(kStreamCsvHeader);
   std::array<char, kMaxOutputLength> answer{};
@@ -346,8 +364,9 @@ int run_stream(const StreamOptions& o) {
   if (in_udp && o.idle_timeout > 0 && !o.busy_poll)  // at most about 23 days, the range of the timeout in ms
     in_udp->set_receive_timeout(std::max(1, static_cast<int>(std::min(o.idle_timeout, 2e6) * 1000.0)));
   std::string stop_reason = "end of input";
+  std::uint64_t ignored = 0;
 
-  while (!g_stop && (o.count == 0 || state->inputs < o.count)) {
+  while (!signals::stop_requested() && (o.count == 0 || state->inputs < o.count)) {
     std::string_view line;
     if (in_udp) {
       const auto r = receive_datagram(*in_udp, o, datagram, line);
@@ -356,6 +375,10 @@ int run_stream(const StreamOptions& o) {
         break;
       }
       if (r == UdpSocket::Received::Interrupted) break;
+      if (ends.sender && !same_sender(*ends.sender, in_udp->sender())) {
+        ++ignored;  // not the one sender taken: no input, no answer
+        continue;
+      }
     } else {
       if (!reader.has_complete_line()) sink.flush();  // about to wait: what was answered goes out now
       const auto r = reader.next(line);
@@ -368,10 +391,20 @@ int run_stream(const StreamOptions& o) {
     ++by_action[static_cast<std::size_t>(out.action)];
   }
   sink.flush();
-  if (g_stop) stop_reason = "signal";
+  if (signals::stop_requested()) stop_reason = signals::stop_signal_name();
   if (o.count != 0 && state->inputs >= o.count) stop_reason = fmt::format("--count {}", o.count);
 
-  if (!o.quiet) print_summary(*state, by_status, by_action, stop_reason, sink.refused(), out_text);
+  if (!o.quiet) {
+    print_summary(*state, by_status, by_action, stop_reason, sink.refused(), out_text);
+    if (in_udp && in_udp->dropped() > 0)
+      std::fprintf(stderr,
+                   "hexatwist stream: %llu datagrams were dropped by the kernel before they were read (its receive "
+                   "buffer was full: --receive-buffer, net.core.rmem_max)\n",
+                   static_cast<unsigned long long>(in_udp->dropped()));
+    if (ignored > 0)
+      std::fprintf(stderr, "hexatwist stream: %llu datagrams from other senders were ignored (--accept-from %s)\n",
+                   static_cast<unsigned long long>(ignored), ends.sender->text.c_str());
+  }
   const std::uint64_t rejected = state->inputs - by_status[0];
   return rejected == 0 ? kExitOk : kExitOutOfLimit;
 }
@@ -390,7 +423,7 @@ void check_mode(StreamOptions& o, const CLI::App& app) {
   if (app.count("--cpu") > 0 && o.cpu < 0)
     throw ExitError(kExitBadInput, fmt::format("--cpu {}: expected a CPU number >= 0", o.cpu));
   if (!is_udp(o.input))
-    for (const char* udp_only : {"--idle-timeout", "--receive-buffer", "--busy-poll"})
+    for (const char* udp_only : {"--idle-timeout", "--receive-buffer", "--busy-poll", "--accept-from"})
       if (app.count(udp_only) > 0)
         throw ExitError(kExitBadInput, fmt::format("{}: only with --input udp://HOST:PORT", udp_only));
   if (app.count("--rate") > 0 && o.max_velocity == 0 && o.max_acceleration == 0)
@@ -424,7 +457,8 @@ Command make_stream_command(CLI::App& root) {
       "input,status,command,m1..m6,leg,value,bound,detail (CSV) or the same as a JSON object: command is new, held "
       "or none, m1..m6 are the motor-side commands [m]. A command outside a limit is never sent; a rejected pose "
       "(outside a limit, non-finite, malformed) is answered with its status and the input's number. Ends at end of "
-      "input, --count, --idle-timeout or SIGINT/SIGTERM, with a summary on stderr; exit 0 if every input was "
+      "input, --count, --idle-timeout or SIGINT/SIGTERM/SIGHUP (the answer in progress is finished), with a summary on "
+      "stderr; exit 0 if every input was "
       "accepted, 3 if any was rejected.");
   add_model_options(*app, o->model);
   app->add_option("--input", o->input,
@@ -468,6 +502,11 @@ Command make_stream_command(CLI::App& root) {
   app->add_flag("--busy-poll", o->busy_poll,
                 "UDP: spin on a non-blocking receive instead of sleeping between datagrams (lower latency; one CPU "
                 "at 100 %)");
+  app->add_option("--accept-from", o->accept_from,
+                  "UDP: take poses only from this sender, udp://HOST:PORT (port 0: any of its ports); datagrams of "
+                  "others are counted and not answered. Default any: every sender that reaches --input (with the "
+                  "default loopback --input, the processes of this machine; another --input address is warned about)")
+      ->capture_default_str();
   app->add_flag("--quiet", o->quiet, "no summary on stderr");
   return {app, [o, app] {
             check_mode(*o, *app);

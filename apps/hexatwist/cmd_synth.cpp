@@ -15,6 +15,7 @@
 #include "json.hpp"
 #include "output_files.hpp"
 #include "run_options.hpp"
+#include "schemas.hpp"
 #include "study_report.hpp"
 
 namespace hexatwist::cli {
@@ -45,7 +46,7 @@ std::string truth_json(const Config& config, const SynthOptions& o, const Run& r
   const Model& model = config.rig.model();
   const Model real = real_model(model, so.errors);
   JsonWriter j;
-  j.begin_object()
+  j.begin_document(schema::kTruth)
       .field("command", "synth")
       .field("model", model.spec().name)
       .field("config", model_source(o.run.model))

@@ -16,6 +16,7 @@
 #include "figures.hpp"
 #include "json.hpp"
 #include "output_files.hpp"
+#include "schemas.hpp"
 #include "study_report.hpp"
 
 namespace hexatwist::cli {
@@ -181,7 +182,7 @@ std::string summary_json(const Model& model, const ToleranceCommandOptions& o, c
                          const ToleranceSigmas& s, const CalibrationChoice& calibration, const ToleranceSummary& sm,
                          int workers, double seconds, const std::vector<std::string>& files) {
   JsonWriter j;
-  j.begin_object();
+  j.begin_document(schema::kTolerance);
   j.field("command", "tolerance");
   j.field("units", "SI: m, rad; lead relative");
   j.field("config", model_source(o.model));

@@ -17,6 +17,7 @@
 #include "figures.hpp"
 #include "json.hpp"
 #include "output_files.hpp"
+#include "schemas.hpp"
 #include "study_report.hpp"
 
 namespace hexatwist::cli {
@@ -225,7 +226,7 @@ Vector3d map_position(const WorkspaceMap& m, std::size_t k) {
 std::string summary_json(const Model& model, const WorkspaceCommandOptions& o, const Results& r,
                          const std::vector<std::string>& files) {
   JsonWriter j;
-  j.begin_object();
+  j.begin_document(schema::kWorkspace);
   j.field("command", "workspace");
   j.field("units", "SI: m, m^2, m^3, rad");
   j.field("config", model_source(o.model));

@@ -22,6 +22,7 @@
 
 #include "cli_common.hpp"
 #include "figure_script.hpp"
+#include "signals.hpp"
 
 extern char** environ;
 
@@ -68,12 +69,17 @@ class ScratchDir {
     if (::mkdtemp(tmpl.data()) == nullptr)
       throw ExitError(kExitOutputFailed, fmt::format("cannot create a temporary directory in '{}': {}",
                                                      printable(base.string()), std::strerror(errno)));
+    const signals::Critical critical;
     path_ = tmpl;
+    signals::add_undo(&ScratchDir::undo, this);
   }
   ~ScratchDir() {
+    const signals::Critical critical;
+    signals::remove_undo(&ScratchDir::undo, this);
     std::error_code ec;
     fs::remove_all(path_, ec);
   }
+  static void undo(void* self) noexcept { signals::remove_flat_dir(static_cast<ScratchDir*>(self)->path_.c_str()); }
   ScratchDir(const ScratchDir&) = delete;
   ScratchDir& operator=(const ScratchDir&) = delete;
   const fs::path& path() const { return path_; }
@@ -124,16 +130,26 @@ int run_gnuplot(const std::string& gnuplot, const fs::path& script, const fs::pa
   std::string arg0 = gnuplot, arg1 = "--default-settings", arg2 = script.string();
   char* argv[] = {arg0.data(), arg1.data(), arg2.data(), nullptr};
   pid_t pid = 0;
-  const int rc = posix_spawn(&pid, gnuplot.c_str(), &actions, nullptr, argv, environ);
+  int rc = 0;
+  {
+    const signals::Critical critical;  // a signal now stops gnuplot with the run
+    rc = posix_spawn(&pid, gnuplot.c_str(), &actions, nullptr, argv, environ);
+    if (rc == 0) signals::add_child(pid);
+  }
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0)
     throw ExitError(kExitOutputFailed,
                     fmt::format("cannot run gnuplot '{}': {}", printable(gnuplot), std::strerror(rc)));
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR)
+    if (errno != EINTR) {
+      const signals::Critical critical;
+      signals::remove_child(pid);
       throw ExitError(kExitOutputFailed, fmt::format("waiting for gnuplot failed: {}", std::strerror(errno)));
+    }
   }
+  const signals::Critical critical;
+  signals::remove_child(pid);
   return status;
 }
 

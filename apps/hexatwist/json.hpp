@@ -17,6 +17,12 @@ namespace hexatwist::cli {
 class JsonWriter {
  public:
   JsonWriter& begin_object() { return open('{', true); }
+  /// A document: an object whose first field names its schema and version (schemas.hpp).
+  JsonWriter& begin_document(std::string_view schema) {
+    begin_object();
+    key("schema");
+    return value(schema);
+  }
   JsonWriter& end_object() { return close('}'); }
   /// An array; `multiline` puts each element on its own line (for arrays of objects).
   JsonWriter& begin_array(bool multiline = false) { return open('[', multiline); }

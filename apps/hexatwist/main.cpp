@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "cli_common.hpp"
+#include "signals.hpp"
 
 namespace {
 
@@ -28,12 +29,14 @@ void print_error(std::string_view prefix, std::string_view message) {
 
 int main(int argc, char** argv) {
   using namespace hexatwist::cli;
+  signals::install();
   CLI::App app{
       "hexatwist: twist-aware kinematics of lead-screw Stewart platforms.\n"
       "Poses are typed as x,y,z [m] and roll,pitch,yaw [deg] (R = Rz*Ry*Rx); all JSON output is SI (m, rad).\n"
       "Exit codes: 0 ok, 2 bad input, 3 pose outside a limit, numerical failure or (dynamics) a motor outside its "
       "envelope, 4 output not written, 5 identify: "
-      "the data do not determine the parameters."};
+      "the data do not determine the parameters, 6 stopped by SIGINT, SIGTERM or SIGHUP (rolled back: nothing "
+      "written)."};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
   const std::vector<Command> commands = add_commands(app);
@@ -78,20 +81,28 @@ int main(int argc, char** argv) {
   }
   try {
     for (const Command& c : commands)
-      if (c.app->parsed()) return c.run();
+      if (c.app->parsed()) {
+        const int code = c.run();
+        signals::stop_on_request();  // the outcome is decided: a signal now changes nothing
+        return code;
+      }
   } catch (const ExitError& e) {
+    signals::stop_on_request();  // the run was rolled back; its error is the outcome
     print_error("hexatwist: error: ", e.what());
     return e.code();
   } catch (const hexatwist::ParameterError& e) {
+    signals::stop_on_request();
     // The library names the parameter at fault; the command line names it as its option.
     std::string option = "--" + e.parameter();
     std::replace(option.begin(), option.end(), '_', '-');
     print_error("hexatwist: error: ", fmt::format("{} [{}]", e.what(), option));
     return kExitBadInput;
   } catch (const hexatwist::Error& e) {
+    signals::stop_on_request();
     print_error("hexatwist: error: ", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {
+    signals::stop_on_request();
     print_error("hexatwist: internal error: ", e.what());
     return 1;
   }

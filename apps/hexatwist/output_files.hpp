@@ -4,12 +4,18 @@
 // byte as it was.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace hexatwist::cli {
+
+/// The manifest of a report folder's run: hidden, written by the transaction itself.
+inline constexpr const char* kRunManifest = ".hexatwist-run.json";
+/// Its schema (docs/schemas/run.schema.json).
+inline constexpr const char* kRunManifestSchema = "hexatwist.run/1";
 
 /// True if `a` and `b` name the same file: compared as files, not as strings (relative and
 /// absolute paths, `..`, symbolic links, hard links; files that do not exist yet by their resolved
@@ -18,18 +24,26 @@ bool same_file(const std::string& a, const std::string& b);
 
 /// One run's output files, put in place as a transaction:
 ///  1. input() and output() declare what the run reads and writes; an output that is an input or
-///     another output (as a file, same_file) is refused at once, ExitError(2), before any work.
-///     folder() declares a report folder: created if missing, and the report of an earlier run in
-///     it (the files its summary.json lists, and its summaries) is noted.
+///     another output (as a file, same_file), or a symbolic link, is refused at once,
+///     ExitError(2), before any work: hexatwist never writes through a link (someone else's link in
+///     a shared folder would make it overwrite that person's file).
+///     folder() declares a report folder: created if missing and locked for this run (a second run
+///     into it is refused, ExitError(2)); the manifest of an earlier run of ours in it
+///     (kRunManifest: each file's name, size and hash, read with a bound) is noted.
 ///  2. add() gives a file's content, external() a temporary stem for files another program draws
-///     (figures); stage() writes every added file whole to a temporary name beside it.
-///  3. commit() moves each file it replaces, and each file of an earlier run in the folder that this
-///     run does not write, aside to a backup name, then renames every temporary into place.
+///     (figures); stage() writes every added file whole to a temporary name beside it (short names
+///     of their own, so that they fit wherever the final name fits).
+///     In a report folder, a file of this run's that is there already must be one of the earlier
+///     run's files as it wrote it; any other is refused, ExitError(2), and left as it is.
+///  3. commit() moves each file it replaces, and each file of the earlier run that this run does
+///     not write and that is still byte for byte what that run wrote, aside to a backup name, then
+///     renames every temporary into place and writes the folder's new manifest. A file hexatwist
+///     cannot show it wrote is never removed: it is left and named.
 ///  4. finish() writes the run's standard output; only once that succeeded are the backups deleted
 ///     (and a note on stderr says what a reused folder held).
-/// Any failure (ExitError(4) naming the file, or an exception that leaves the transaction
-/// unfinished) rolls everything back: this run's files and temporaries removed, every backup
-/// renamed back, folders this run created removed.
+/// Any failure (ExitError(4) naming the file, an exception that leaves the transaction unfinished,
+/// or SIGINT, SIGTERM or SIGHUP at any moment: signals.hpp) rolls everything back: this run's files
+/// and temporaries removed, every backup renamed back, folders this run created removed.
 class OutputFiles {
  public:
   /// `command` names the run in notes ("simulate").
@@ -70,25 +84,35 @@ class OutputFiles {
     std::string option, path;
   };
   struct Pending {
-    std::string path, tmp, content;  // path: the file itself (links followed)
+    std::string path, tmp, content;  // path: the file itself, as named (never through a link)
     std::string shown;               // as the user named it, for messages
     bool staged = false, external = false;
+    std::uint64_t bytes = 0, hash = 0;  // of the content written (the manifest)
   };
   struct Moved {
     std::string path, backup;
   };
+  struct Written {
+    std::string name;
+    std::uint64_t bytes = 0, hash = 0;
+  };
   struct EarlierRun {
-    std::string command;              // its summary's "command"; empty if none
-    std::vector<std::string> listed;  // its files (names in the folder)
+    std::string command;          // its manifest's "command"; empty if none
+    std::vector<Written> listed;  // its files as it wrote them (names in the folder)
     std::vector<std::string> entries;
   };
 
   std::string temporary_beside(const std::string& path, std::string_view kind);
   void check_not_input(std::string_view what, const std::string& path) const;
+  void check_not_link(std::string_view what, const std::string& path) const;
+  void check_replaceable(const std::string& path) const;
   void move_aside(const std::string& path);
   void clear_earlier_run();
   std::string folder_note() const;
+  void add_manifest();
+  void add_pending(const std::string& path, std::string content);
   void roll_back() noexcept;
+  static void undo(void* self) noexcept;  // the signal handler's roll back
 
   std::string command_;
   std::vector<Named> inputs_, outputs_;
@@ -102,6 +126,7 @@ class OutputFiles {
   std::vector<std::string> paths_;
   std::size_t replaced_ = 0, removed_ = 0;
   std::vector<std::string> others_;  // files in the folder that no run of ours describes
+  int lock_ = -1;                    // the folder, locked (flock) for this run
   bool finished_ = false;
 };
 

@@ -81,7 +81,9 @@ void add_log_options(CLI::App& app, LogOptions& o) {
   app.add_option("--units", o.units, "Length unit of x, y, z when their names carry no suffix: mm or m")
       ->check(CLI::IsMember({"mm", "m"}));
   app.add_flag("--index", o.index, "The time column is a sample index; give --rate");
-  app.add_option("--rate", o.rate, "Samples per second of an indexed log [Hz]");
+  app.add_option("--rate", o.rate, "Samples per second of an indexed log [Hz]")->each([&o](const std::string&) {
+    o.rate_given = true;
+  });
   app.add_option("--time-offset", o.time_offset, "The log's time (or index/rate) when the trajectory's time is 0 [s]")
       ->capture_default_str();
 }
@@ -124,9 +126,12 @@ PointLogFormat log_format(const LogOptions& o) {
   f.z_column = names[3];
   if (!o.units.empty()) f.length_unit = o.units == "mm" ? 1e-3 : 1.0;
   f.indexed = o.index;
-  if (o.index && !(o.rate > 0.0 && std::isfinite(o.rate)))
+  if (o.index && !o.rate_given)
     throw ExitError(kExitBadInput, "--index: give the tracker's sample rate with --rate HZ");
-  if (!o.index && o.rate != 0.0) throw ExitError(kExitBadInput, "--rate: only with --index (a log of sample indices)");
+  if (o.index && !(o.rate > 0.0 && std::isfinite(o.rate)))
+    throw ExitError(kExitBadInput,
+                    fmt::format("--rate {:g}: expected the tracker's sample rate, a finite number > 0 [Hz]", o.rate));
+  if (!o.index && o.rate_given) throw ExitError(kExitBadInput, "--rate: only with --index (a log of sample indices)");
   return f;
 }
 

@@ -46,6 +46,7 @@ struct LogOptions {
   std::string units;
   bool index = false;
   double rate = 0.0;
+  bool rate_given = false;  // --rate was given (0 is a value refused, not "none")
   double time_offset = 0.0;
 };
 

@@ -13,6 +13,7 @@
 #include "cli_common.hpp"
 #include "json.hpp"
 #include "output_files.hpp"
+#include "schemas.hpp"
 #include "study_figures.hpp"
 
 namespace hexatwist::cli {
@@ -136,7 +137,7 @@ void measured_json(JsonWriter& j, const ReportedMeasurement& r) {
 std::string summary_json(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests,
                          const std::vector<std::string>& files) {
   JsonWriter j;
-  j.begin_object()
+  j.begin_document(schema::kReport)
       .field("command", o.command)
       .field("model", rig.model().spec().name)
       .field("config", o.config_source)

@@ -5,6 +5,7 @@
 #include <sys/socket.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <string_view>
@@ -32,8 +33,16 @@ UdpAddress parse_udp_address(std::string_view spec, std::string_view option);
 /// The port of a resolved address.
 int udp_port(const UdpAddress& a);
 
+/// True for a loopback address (127/8, ::1, ::ffff:127.x.y.z).
+bool is_loopback(const UdpAddress& address);
+
+/// True if a datagram from `from` is from the sender `allowed` (port 0 in `allowed`: any port).
+/// IPv4 addresses written as IPv6 (::ffff:a.b.c.d) compare as the IPv4 address.
+bool same_sender(const UdpAddress& allowed, const sockaddr_storage& from);
+
 /// True if datagrams sent to `peer` arrive at a socket bound to `local` on `local_port` (the port it
-/// got): the same port, and the same address, or `local` a wildcard address, or both loopback.
+/// got): the same port, and the same address, or `local` a wildcard address, or both loopback;
+/// IPv4 addresses written as IPv6 (::ffff:127.0.0.1) compare as the IPv4 address.
 bool reaches(const UdpAddress& peer, const UdpAddress& local, int local_port);
 
 /// An open UDP socket, closed on destruction.
@@ -65,9 +74,16 @@ class UdpSocket {
   /// As receive, without waiting: Timeout at once when no datagram is there (busy polling).
   Received try_receive(std::span<char> buffer, std::size_t& size, bool& truncated);
 
-  /// Sends one datagram. Returns false if the peer refused it (nobody listening on loopback);
-  /// other failures throw ExitError.
+  /// Sends one datagram. A refusal the kernel reports for an earlier datagram (nobody listening
+  /// on loopback) is counted and this one sent again; false if it is refused too. Other failures
+  /// throw ExitError.
   bool send(std::string_view data);
+  /// Datagrams the peer refused (ICMP port unreachable), as the kernel reported them.
+  std::uint64_t refused() const { return refused_; }
+  /// Datagrams the kernel dropped on arrival since the socket opened (its receive buffer full).
+  std::uint64_t dropped() const;
+  /// The sender of the last datagram received.
+  const sockaddr_storage& sender() const { return sender_; }
 
   /// The port the socket is bound to (useful after binding port 0).
   int local_port() const;
@@ -76,6 +92,8 @@ class UdpSocket {
   explicit UdpSocket(int fd) : fd_(fd) {}
   Received receive_with(std::span<char> buffer, std::size_t& size, bool& truncated, int flags);
   int fd_ = -1;
+  std::uint64_t refused_ = 0, dropped_ = 0;
+  sockaddr_storage sender_{};
 };
 
 }  // namespace hexatwist::cli

@@ -48,6 +48,7 @@
 #include "hexatwist/design/workspace_volume.hpp"
 
 #include "hexatwist/io/config.hpp"
+#include "hexatwist/io/gcode.hpp"
 #include "hexatwist/io/mjcf.hpp"
 #include "hexatwist/io/platform_yaml.hpp"
 #include "hexatwist/io/text_file.hpp"

@@ -119,7 +119,8 @@ LogColumns find_columns(const detail::CsvReader& r, const detail::CsvLine& head,
                          unit_name(suffix->to_si), unit_name(format.length_unit)));
     if (!suffix && !(format.length_unit > 0.0))
       r.fail(head.number, head.text, at, c.name,
-             fmt::format("units missing: '{}' has no unit suffix (_mm or _m) and no length unit was given (mm or m)",
+             fmt::format("units missing: '{}' has no unit suffix (_mm or _m) and no length unit was given (mm or m; "
+                         "--units on the command line)",
                          detail::printable(c.header, 40)));
     c.to_si = suffix ? suffix->to_si : format.length_unit;
   }
@@ -161,6 +162,12 @@ int character_column(std::string_view text, std::size_t offset) {
 }  // namespace
 
 PointLog parse_point_log(std::string_view text, std::string_view source, const PointLogFormat& format) {
+  // A unit is honoured or refused, never ignored: also where every column carries a suffix.
+  if (!(format.length_unit == 0.0 || (std::isfinite(format.length_unit) && format.length_unit > 0.0)))
+    throw ParameterError(fmt::format("{}: length unit: expected metres per unit > 0 (1e-3 for mm, 1 for m) or 0 "
+                                     "for the columns' suffixes, got {}",
+                                     source, format.length_unit),
+                         "length_unit");
   const detail::CsvReader r(source);
   text = detail::without_bom(text);
   const std::vector<detail::CsvLine> lines = detail::csv_lines(text);

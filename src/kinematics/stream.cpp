@@ -92,6 +92,11 @@ std::string_view check_stream_settings(const StreamSettings& s) noexcept {
   if (!(std::isfinite(s.period) && s.period > 0.0)) return "period must be a positive, finite time [s]";
   if (!(s.max_velocity > 0.0)) return "max_velocity must be positive [m/s] (infinite for no limit)";
   if (!(s.max_acceleration > 0.0)) return "max_acceleration must be positive [m/s^2] (infinite for no limit)";
+  // A skipped input leaves the drive holding the last command: it would stop within one period,
+  // whatever the limits say, and jump back to speed after. Hold keeps the limits through rejections.
+  if (s.on_reject == RejectPolicy::Skip && s.rate_limited())
+    return "on_reject: skip leaves the drive without a command for each rejected input, so it stops within one "
+           "period, outside the rate limits; use hold, which keeps moving within the limits";
   for (int i = 0; i < kLegs; ++i) {
     const double t = s.inputs.temperature[i];
     if (!(std::isnan(t) || (t >= kMinTemperature && t <= kMaxTemperature)))

@@ -133,6 +133,19 @@ TEST(CliMeasure, AnIndexedLogGivesTheSameErrors) {
   EXPECT_NEAR(a["rms_error"].as<double>(), b["rms_error"].as<double>(), 1e-12);
   // A 0.2 % lead error: far above the noise.
   EXPECT_GT(a["max_error"].as<double>(), 1e-4);
+  // A value is refused or honoured, never replaced (issue 29): no rate, 0 and -5 are told apart.
+  const std::vector<std::string> base{"measure",   "--trajectory", traj,      "--points", indexed, "--index",
+                                      "--columns", "index,x,y,z",  "--units", "mm",       "--out", "x"};
+  auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run(args);
+  };
+  expect_error(with({}), 2, {"--index", "give the tracker's sample rate with --rate"});
+  for (const char* rate : {"0", "-5"})
+    expect_error(with({"--rate", rate}), 2, {std::string("--rate ") + rate, "a finite number > 0"});
+  expect_error(run({"measure", "--trajectory", traj, "--points", log, "--register-first", "0", "--out", "x"}), 2,
+               {"--register-first 0", ">= 1"});
 }
 
 TEST(CliMeasure, BadPointLogsAreOneLineErrorsWithExitTwo) {

@@ -1,8 +1,14 @@
 // The one writer of every command's files (output_files.hpp): standard output checked, sets of
 // files all or none, outputs compared with inputs as files, reused folders.
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+
+#include <chrono>
 #include <map>
 
 #include "cli_support.hpp"
+#include "command_table.hpp"
 
 using namespace hexatwist::cli_test;
 
@@ -64,7 +70,8 @@ TEST(CliOutputs, AReusedFolderSaysSoAndItsSummaryListsOnlyThisRunsFiles) {
             std::string::npos)
       << second.err;
   EXPECT_NE(second.err.find("notes.txt"), std::string::npos);
-  EXPECT_EQ(folder_entries(out), (std::vector<std::string>{"notes.txt", "summary.json", "summary.md"}));
+  EXPECT_EQ(folder_entries(out),
+            (std::vector<std::string>{".hexatwist-run.json", "notes.txt", "summary.json", "summary.md"}));
   const YAML::Node s = YAML::LoadFile((out / "summary.json").string());
   EXPECT_EQ(s["files"].size(), 0u);
   EXPECT_EQ(read_file(out / "summary.md").find("_compensated.csv"), std::string::npos);
@@ -219,9 +226,176 @@ TEST(CliOutputs, AFolderReusedByAnotherCommandHoldsOnlyThatRunsFilesAndSaysSo) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("the earlier run was simulate"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("1 files replaced, 3 of an earlier run removed"), std::string::npos) << r.err;
-  EXPECT_EQ(folder_entries(out), (std::vector<std::string>{"h2_dynamics.csv", "summary.json"}));
+  EXPECT_EQ(folder_entries(out), (std::vector<std::string>{".hexatwist-run.json", "h2_dynamics.csv", "summary.json"}));
   const YAML::Node s = YAML::LoadFile((out / "summary.json").string());
   EXPECT_EQ(s["command"].as<std::string>(), "dynamics");
+}
+
+// ----- walked across the commands (command_table.hpp): links, locks, other programs' files, names -----
+
+// The --out value of a command of the table ("out" is a report folder; empty: none).
+std::string out_value(const std::vector<std::string>& args) {
+  for (std::size_t k = 0; k + 1 < args.size(); ++k)
+    if (args[k] == "--out") return args[k + 1];
+  return {};
+}
+
+std::vector<std::string> command_line(const std::string& command, const std::vector<std::string>& args) {
+  std::vector<std::string> full{command};
+  full.insert(full.end(), args.begin(), args.end());
+  return full;
+}
+
+TEST(CliOutputs, NoCommandWritesThroughALinkSomeoneElsePlanted) {
+  const Inputs& in = inputs();
+  for (const auto& [command, args] : base_arguments(in)) {
+    const std::string out = out_value(args);
+    if (out.empty()) continue;
+    const fs::path dir = in.dir / ("link-" + command);
+    fs::create_directories(dir);
+    const fs::path victim = dir / "victims-file.txt";
+    std::ofstream(victim) << "the victim's data\n";
+    // A file output is the link; a report folder gets one where its run's manifest goes.
+    fs::path link = dir / out;
+    if (out == "out") {
+      fs::create_directories(dir / out);
+      link = dir / out / ".hexatwist-run.json";
+    }
+    fs::create_symlink(victim, link);
+    const Outcome r = run_in(dir, command_line(command, args));
+    EXPECT_EQ(r.code, 2) << r.command << "\n" << r.err;
+    EXPECT_NE(r.err.find("symbolic link"), std::string::npos) << r.err;
+    EXPECT_EQ(read_file(victim), "the victim's data\n") << command;
+    EXPECT_TRUE(fs::is_symlink(link)) << command;
+    if (out == "out") {
+      EXPECT_EQ(std::distance(fs::directory_iterator(dir / out), fs::directory_iterator()), 1);
+    }
+  }
+}
+
+TEST(CliOutputs, ASecondRunIntoAFolderInUseIsRefusedAndWritesNothing) {
+  const Inputs& in = inputs();
+  int walked = 0;
+  for (const auto& [command, args] : base_arguments(in)) {
+    if (out_value(args) != "out") continue;
+    ++walked;
+    const fs::path dir = in.dir / ("lock-" + command);
+    fs::create_directories(dir / "out");
+    // The other run: a lock on the folder, as a run holds it while it writes.
+    const int fd = ::open((dir / "out").c_str(), O_RDONLY | O_DIRECTORY);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+    const Outcome r = run_in(dir, command_line(command, args));
+    ::close(fd);
+    EXPECT_EQ(r.code, 2) << r.command << "\n" << r.err;
+    EXPECT_NE(r.err.find("--out 'out': another hexatwist run is writing into this folder"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::is_empty(dir / "out")) << command;
+    // Once the other run ended, the same command runs.
+    EXPECT_TRUE(run_in(dir, command_line(command, args)).code == 0) << command;
+  }
+  EXPECT_GE(walked, 6);
+}
+
+TEST(CliOutputs, AReportFolderNeverRemovesOrReplacesAFileHexatwistCannotShowItMade) {
+  const Inputs& in = inputs();
+  for (const auto& [command, args] : base_arguments(in)) {
+    if (out_value(args) != "out") continue;
+    const fs::path dir = in.dir / ("foreign-" + command);
+    const fs::path out = dir / "out";
+    fs::create_directories(out);
+    // Another program's summary and files, and a manifest that claims them with other hashes.
+    std::ofstream(out / "raw.csv") << "t,x\n0,1\n";
+    std::ofstream(out / "notes.txt") << "my notes\n";
+    std::ofstream(out / "summary.json") << R"({"tool": "my-lab-notebook", "files": ["raw.csv", "notes.txt"]})";
+    std::ofstream(out / ".hexatwist-run.json")
+        << "{\n  \"schema\": \"hexatwist.run/1\",\n  \"command\": \"study\",\n  \"files\": [\n"
+           "    {\"name\": \"raw.csv\", \"bytes\": 8, \"fnv1a64\": \"0123456789abcdef\"},\n"
+           "    {\"name\": \"notes.txt\", \"bytes\": 9, \"fnv1a64\": \"0123456789abcdef\"}\n  ]\n}\n";
+    const Outcome r = run_in(dir, command_line(command, args));
+    EXPECT_EQ(read_file(out / "raw.csv"), "t,x\n0,1\n") << command;
+    EXPECT_EQ(read_file(out / "notes.txt"), "my notes\n") << command;
+    // Every report writes summary.json: the other program's is refused, not replaced.
+    EXPECT_EQ(r.code, 2) << r.command << "\n" << r.err;
+    EXPECT_NE(r.err.find("'summary.json', which hexatwist did not write"), std::string::npos) << r.err;
+    EXPECT_EQ(read_file(out / "summary.json"), R"({"tool": "my-lab-notebook", "files": ["raw.csv", "notes.txt"]})");
+    // Without it, the run writes its report, and leaves the other files named.
+    fs::remove(out / "summary.json");
+    const Outcome ok = run_in(dir, command_line(command, args));
+    EXPECT_EQ(ok.code, 0) << ok.err;
+    EXPECT_NE(ok.err.find("2 other files left"), std::string::npos) << ok.err;
+    EXPECT_EQ(read_file(out / "raw.csv"), "t,x\n0,1\n") << command;
+    EXPECT_EQ(read_file(out / "notes.txt"), "my notes\n") << command;
+    // A file of that run changed since (the user's edit) is not replaced either.
+    std::ofstream(out / "summary.json", std::ios::app) << "\n";
+    const std::string edited = read_file(out / "summary.json");
+    const Outcome again = run_in(dir, command_line(command, args));
+    EXPECT_EQ(again.code, 2) << again.err;
+    EXPECT_EQ(read_file(out / "summary.json"), edited) << command;
+  }
+}
+
+TEST(CliOutputs, AnOversizedManifestIsNotReadAndItsFilesAreKept) {
+  const Inputs& in = inputs();
+  const auto base = base_arguments(in);
+  const fs::path dir = in.dir / "big-manifest";
+  const fs::path out = dir / "out";
+  fs::create_directories(out);
+  std::ofstream(out / "raw.csv") << "keep me\n";
+  {
+    // A valid manifest of 2 MiB naming raw.csv with its true size and hash: too long to be ours.
+    std::ofstream m(out / ".hexatwist-run.json");
+    m << "{\n  \"schema\": \"hexatwist.run/1\",\n  \"command\": \"study\",\n  \"files\": [\n";
+    m << "    {\"name\": \"raw.csv\", \"bytes\": 8, \"fnv1a64\": \""
+      << "0000000000000000"
+      << "\"}";
+    for (int k = 0; k < 30000; ++k)
+      m << ",\n    {\"name\": \"pad" << k << "\", \"bytes\": 1, \"fnv1a64\": \"0000000000000000\"}";
+    m << "\n  ]\n}\n";
+  }
+  ASSERT_GT(fs::file_size(out / ".hexatwist-run.json"), std::size_t{1} << 20);
+  const Outcome r = run_in(dir, command_line("study", base.at("study")));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(read_file(out / "raw.csv"), "keep me\n");
+}
+
+TEST(CliOutputs, ATemporaryNameFitsWhereverTheFinalNameFits) {
+  const Inputs& in = inputs();
+  const std::string longest(240, 'n');  // NAME_MAX is 255: room for synth's ".truth.json"
+  for (const auto& [command, args] : base_arguments(in)) {
+    const std::string out = out_value(args);
+    if (out.empty() || out == "out") continue;
+    const fs::path dir = in.dir / ("long-" + command);
+    fs::create_directories(dir);
+    std::vector<std::string> a = args;
+    for (std::string& w : a)
+      if (w == out) w = longest;
+    const Outcome r = run_in(dir, command_line(command, a));
+    const int expected = command == "identify" ? 5 : 0;
+    EXPECT_EQ(r.code, expected) << r.command << "\n" << r.err;
+    if (expected == 0) {
+      EXPECT_TRUE(fs::exists(dir / longest)) << command;
+    }
+  }
+}
+
+TEST(CliOutputs, AConfigurationThatIsAFifoIsReadWithABoundNotWaitedOnForever) {
+  const Inputs& in = inputs();
+  const fs::path dir = in.dir / "fifo";
+  fs::create_directories(dir);
+  const fs::path fifo = dir / "config.yaml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const auto& [command, args] : base_arguments(in)) {
+    std::vector<std::string> a = args;
+    for (std::size_t k = 0; k + 1 < a.size(); ++k)
+      if (a[k] == "--config") a[k + 1] = fifo.string();
+    // No writer: an empty configuration, refused at once (the test's own timeout bounds it).
+    const auto t0 = std::chrono::steady_clock::now();
+    const Outcome r = run_in(dir, command_line(command, a));
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_EQ(r.code, 2) << r.command << "\n" << r.err;
+    EXPECT_NE(r.err.find("config.yaml"), std::string::npos) << r.err;
+    EXPECT_LT(seconds, 30.0) << command;
+  }
 }
 
 }  // namespace

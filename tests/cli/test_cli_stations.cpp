@@ -142,4 +142,52 @@ TEST(CliStations, RangesBeyondTheLimitsExitThreeAndAnUnwritableRunFourLeavingFil
   EXPECT_FALSE(fs::exists(temp_dir() / "full.csv"));
 }
 
+// The same run for the controller: the LinuxCNC program names each station once and moves to it
+// once; the stream input is the run at the control rate, and `stream` answers every pose of it
+// with a command, at rest on a station the station's command of `ik`. (The program's timing and
+// targets: tests/io/test_gcode.cpp; run in LinuxCNC: integrations/linuxcnc/tests.)
+TEST(CliStations, TheRunIsAlsoWrittenAsALinuxcncProgramAndAsStreamInput) {
+  const std::string ngc = (temp_dir() / "plan.ngc").string(), txt = (temp_dir() / "plan.txt").string();
+  const Outcome r = plan("plan-for-controller.csv", {"--gcode", ngc, "--stream-out", txt});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote " + ngc), std::string::npos) << r.out;
+  const std::string program = read_file(ngc);
+  for (int k = 1; k <= 16; ++k)
+    EXPECT_NE(program.find("(station " + std::to_string(k) + " of 16: arrive at t = "), std::string::npos) << k;
+  std::size_t moves = 0;
+  for (std::size_t at = program.find("\nG1 "); at != std::string::npos; at = program.find("\nG1 ", at + 1)) ++moves;
+  EXPECT_EQ(moves, 17u);  // to each station, and home
+  const auto rows = run_rows((temp_dir() / "plan-for-controller.csv").string());
+  const std::string poses = read_file(txt);
+  const auto lines = static_cast<std::size_t>(std::count(poses.begin(), poses.end(), '\n'));
+  // The CSV is at 100 Hz, the stream input at the control rate (1 kHz): ten lines per row.
+  EXPECT_EQ(lines, 10 * (rows.size() - 1) + 1);
+  const Outcome streamed = run({"stream"}, &poses);
+  EXPECT_EQ(streamed.code, 0) << streamed.err;
+  const auto answers = csv_rows(streamed.out);
+  ASSERT_EQ(answers.size(), lines);
+  // Row 150 of the CSV (1.5 s) is at rest on the first station: its line's answer is ik's command.
+  std::size_t row = 0;
+  for (std::size_t k = 1; k < rows.size(); ++k)
+    if (rows[k] != rows[0]) {
+      row = k;
+      break;
+    }
+  while (row + 1 < rows.size() && rows[row + 1] != rows[row]) ++row;  // the arrival at station 1
+  const std::vector<double>& q = rows[row];
+  std::ostringstream pose;
+  pose.precision(17);
+  pose << "--pose=" << q[1] << "," << q[2] << "," << q[3] << "," << q[4] * 180 / kPi << "," << q[5] * 180 / kPi << ","
+       << q[6] * 180 / kPi;
+  const Outcome ik = run({"ik", pose.str(), "--json"});
+  ASSERT_EQ(ik.code, 0) << ik.err;
+  const YAML::Node legs = YAML::Load(ik.out)["legs"];
+  const auto& answer = answers[10 * row];
+  for (int i = 0; i < 6; ++i)
+    EXPECT_NEAR(std::stod(answer[3 + i]), legs[i]["command_compensated"].as<double>(), 1e-9) << answer[0];
+  // The controller's files are outputs like the run: one that is an input or the run is refused.
+  expect_error(plan("plan-clash.csv", {"--gcode", (temp_dir() / "plan-clash.csv").string()}), 2,
+               {"--gcode", "--out", "nothing was written"});
+}
+
 }  // namespace

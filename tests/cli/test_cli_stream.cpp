@@ -1,4 +1,10 @@
 // hexatwist stream: answers on standard output and over UDP.
+#include <fcntl.h>
+#include <signal.h>
+
+#include <chrono>
+#include <thread>
+
 #include "cli_support.hpp"
 
 using namespace hexatwist::cli_test;
@@ -120,15 +126,74 @@ TEST(CliStream, BadOptionsAreOneLineErrors) {
   expect_error(run({"stream", "--busy-poll"}, &none), 2, {"--busy-poll", "udp://"});
   expect_error(run({"stream", "--cpu=100000"}, &none), 2, {"--cpu 100000", "CPUs"});
   expect_error(run({"stream", "--cpu=-3"}, &none), 2, {"--cpu -3", ">= 0"});
+  // A skipped input would leave the drive stopping within one tick: refused with the rate limits.
+  expect_error(run({"stream", "--on-reject=skip", "--max-velocity=0.5", "--max-acceleration=5"}, &none), 2,
+               {"--on-reject skip", "--max-velocity", "hold"});
+  expect_error(run({"stream", "--accept-from=udp://127.0.0.1:0"}, &none), 2, {"--accept-from", "udp://"});
+  // Answers sent where the poses arrive, however the address is spelled (IPv4 written as IPv6).
+  for (const auto& [in, out] :
+       std::vector<std::pair<std::string, std::string>>{{"udp://[::ffff:127.0.0.1]:9541", "udp://127.0.0.1:9541"},
+                                                        {"udp://127.0.0.1:9542", "udp://[::ffff:127.0.0.1]:9542"},
+                                                        {"udp://0.0.0.0:9543", "udp://[::ffff:127.0.0.1]:9543"}})
+    expect_error(run({"stream", "--input=" + in, "--output=" + out}, &none), 2, {"--output", "its own answers"});
+}
+
+// A stop signal while a slow reader holds the stream up: the answer in progress is finished (no
+// line cut mid-number), the summary printed, and the exit code the stream's own.
+TEST(CliStream, AStopSignalFinishesTheAnswerInProgressAndPrintsTheSummary) {
+  std::string poses;
+  for (int k = 0; k < 200000; ++k) poses += "0.001,0,0.05,0,0," + std::to_string(k % 10) + "\n";
+  const std::string in_path = write_file("stop-poses.txt", poses);
+  const std::string err_path = (temp_dir() / "stop-stderr.txt").string();
+  int out[2];
+  ASSERT_EQ(::pipe(out), 0);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int in = ::open(in_path.c_str(), O_RDONLY);
+    const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(in, STDIN_FILENO);
+    ::dup2(out[1], STDOUT_FILENO);
+    ::dup2(err, STDERR_FILENO);
+    ::close(out[0]);
+    ::execl(HEXATWIST_CLI, HEXATWIST_CLI, "stream", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ::close(out[1]);
+  // A slow reader: small reads with pauses, then SIGTERM while the stream waits on the full pipe.
+  std::string got;
+  std::array<char, 512> buf{};
+  for (int k = 0; k < 50; ++k) {
+    const ssize_t n = ::read(out[0], buf.data(), buf.size());
+    if (n > 0) got.append(buf.data(), static_cast<std::size_t>(n));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ::kill(pid, SIGTERM);
+  for (ssize_t n; (n = ::read(out[0], buf.data(), buf.size())) > 0;)
+    got.append(buf.data(), static_cast<std::size_t>(n));
+  ::close(out[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "ended by a signal";
+  EXPECT_EQ(WEXITSTATUS(status), 0) << read_file(err_path);
+  ASSERT_FALSE(got.empty());
+  EXPECT_EQ(got.back(), '\n') << "the last answer is cut: "
+                              << got.substr(got.size() - std::min<std::size_t>(got.size(), 80));
+  const auto rows = csv_rows(got);
+  for (const auto& row : rows) ASSERT_EQ(row.size(), 13u);
+  const std::string err = read_file(err_path);
+  EXPECT_NE(err.find("hexatwist stream: SIGTERM; " + std::to_string(rows.size()) + " inputs"), std::string::npos)
+      << err;
+  EXPECT_LT(rows.size(), 200000u);  // stopped, not at the end of input
 }
 
 // A UDP socket of the test, bound to an ephemeral loopback port.
 struct TestSocket {
   int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  TestSocket() {
+  explicit TestSocket(int port = 0) {
     sockaddr_in a{};
     a.sin_family = AF_INET;
     a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(static_cast<std::uint16_t>(port));
     ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
   }
   ~TestSocket() { ::close(fd); }
@@ -193,5 +258,88 @@ TEST_P(CliStreamUdp, AnswersOneDatagramPerDatagramInOrder) {
   EXPECT_EQ(commands_of(csv_rows(got[0])[0]), commands_of(csv_rows(got[3])[0]));
 }
 INSTANTIATE_TEST_SUITE_P(Receive, CliStreamUdp, ::testing::Values("", "--busy-poll --cpu=0"));
+
+// A stream listening on UDP, started with `options`; its stderr read line by line.
+struct UdpStream {
+  FILE* pipe = nullptr;
+  int port = -1;
+  std::string first_line;
+  explicit UdpStream(const std::string& options) {
+    const std::string command = shell_quote(HEXATWIST_CLI) + " stream --input=udp://127.0.0.1:0 " + options + " 2>&1";
+    pipe = popen(command.c_str(), "r");
+    std::array<char, 1024> line{};
+    while (pipe != nullptr && std::fgets(line.data(), line.size(), pipe) != nullptr) {
+      first_line = line.data();
+      if (first_line.find("listening on") != std::string::npos) break;
+    }
+    const auto at = first_line.find("127.0.0.1:");
+    if (at != std::string::npos) port = std::stoi(first_line.substr(at + 10));
+  }
+  // The rest of its stderr and its exit code, once it ended.
+  std::pair<std::string, int> finish() {
+    std::string rest;
+    std::array<char, 1024> line{};
+    while (std::fgets(line.data(), line.size(), pipe) != nullptr) rest += line.data();
+    const int status = pclose(pipe);
+    return {rest, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+  }
+};
+
+TEST(CliStreamUdpInput, AcceptFromTakesPosesFromOneSenderOnlyAndCountsTheOthers) {
+  TestSocket allowed, other, answers;
+  UdpStream stream("--output=udp://127.0.0.1:" + std::to_string(answers.port()) +
+                   " --accept-from=udp://127.0.0.1:" + std::to_string(allowed.port()) + " --count=2 --idle-timeout=20");
+  ASSERT_GT(stream.port, 0) << stream.first_line;
+  EXPECT_NE(stream.first_line.find("taking poses from udp://127.0.0.1:" + std::to_string(allowed.port())),
+            std::string::npos)
+      << stream.first_line;
+  EXPECT_NE(stream.first_line.find("granted by the kernel"), std::string::npos) << stream.first_line;
+  other.send_to(stream.port, "0,0,0.1,0,0,10");
+  EXPECT_EQ(answers.receive(300), "(timeout)");  // not answered
+  allowed.send_to(stream.port, "0,0,0.1,0,0,10");
+  EXPECT_EQ(answers.receive(10000).rfind("1,ok,new,", 0), 0u);
+  other.send_to(stream.port, "0,0,0.1,0,0,10");
+  allowed.send_to(stream.port, "0,0,0.1,0,0,10");
+  EXPECT_EQ(answers.receive(10000).rfind("2,ok,new,", 0), 0u);
+  const auto [rest, code] = stream.finish();
+  EXPECT_EQ(code, 0) << rest;
+  EXPECT_NE(rest.find("2 datagrams from other senders were ignored"), std::string::npos) << rest;
+}
+
+TEST(CliStreamUdpInput, EveryDatagramIsAnsweredOrCountedAsDroppedByTheKernel) {
+  TestSocket poses;
+  UdpStream stream("--receive-buffer=4096 --idle-timeout=1");
+  ASSERT_GT(stream.port, 0) << stream.first_line;
+  constexpr int kSent = 20000;
+  for (int k = 0; k < kSent; ++k) poses.send_to(stream.port, "0,0,0.1,0,0,10");
+  const auto [rest, code] = stream.finish();
+  EXPECT_EQ(code, 0) << rest;
+  unsigned long long inputs = 0, dropped = 0;
+  const auto summary = rest.find("(--idle-timeout); ");
+  ASSERT_NE(summary, std::string::npos) << rest;
+  ASSERT_EQ(std::sscanf(rest.c_str() + summary, "(--idle-timeout); %llu inputs", &inputs), 1) << rest;
+  if (const auto at = rest.find(" datagrams were dropped by the kernel"); at != std::string::npos)
+    dropped = std::stoull(rest.substr(rest.rfind("hexatwist stream: ", at) + 18));
+  EXPECT_EQ(inputs + dropped, static_cast<unsigned long long>(kSent)) << rest;
+}
+
+TEST(CliStreamUdpInput, ARefusalFromBeforeTheReaderListenedLosesNoLaterAnswer) {
+  int port = 0;
+  {
+    const TestSocket probe;  // a free port, closed again: nobody listens there yet
+    port = probe.port();
+  }
+  TestSocket poses;
+  UdpStream stream("--output=udp://127.0.0.1:" + std::to_string(port) + " --count=2 --idle-timeout=20");
+  ASSERT_GT(stream.port, 0) << stream.first_line;
+  poses.send_to(stream.port, "0,0,0.1,0,0,10");  // answered into a closed port: refused (ICMP)
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const TestSocket answers(port);  // the reader starts
+  poses.send_to(stream.port, "0,0,0.1,0,0,10");
+  EXPECT_EQ(answers.receive(10000).rfind("2,ok,new,", 0), 0u);
+  const auto [rest, code] = stream.finish();
+  EXPECT_EQ(code, 0) << rest;
+  EXPECT_NE(rest.find("1 answers were refused"), std::string::npos) << rest;
+}
 
 }  // namespace

@@ -1,16 +1,11 @@
 # Installs the build tree into a scratch prefix, then configures, builds and runs an outside
 # project that uses find_package(hexatwist). Run by ctest (tests/CMakeLists.txt).
 file(REMOVE_RECURSE "${WORK_DIR}")
-function(step)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "failed (${rc}): ${ARGN}\n${out}\n${err}")
-  endif()
-  set(step_output "${out}" PARENT_SCOPE)
-endfunction()
-# The default component: the library, headers, tool and package files. The LinuxCNC module
-# (component linuxcnc) goes to LinuxCNC's own modules folder, outside any prefix.
-step(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix" --component Unspecified)
+include(${CMAKE_CURRENT_LIST_DIR}/step.cmake)
+# The components runtime (the tool) and dev (the libraries, headers and package files). The
+# LinuxCNC module (component linuxcnc) goes to LinuxCNC's own modules folder, outside any prefix.
+step(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix" --component runtime)
+step(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${WORK_DIR}/prefix" --component dev)
 step(${CMAKE_COMMAND} -S "${SOURCE_DIR}" -B "${WORK_DIR}/build" -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=Release
      "-DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix")
 step(${CMAKE_COMMAND} --build "${WORK_DIR}/build")

@@ -1,7 +1,13 @@
 // The one reader of configuration and data files (text_file.hpp): the whole file, a bound on its
 // size checked while reading (an endless device stops there), and one line naming the path.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
 
 #include <filesystem>
 #include <fstream>
@@ -62,6 +68,32 @@ TEST(TextFile, AFolderAMissingFileAndAnEndlessDeviceAreOneLineEach) {
   const std::string endless = error_of("/dev/zero", kMaxConfigBytes);
   EXPECT_NE(endless.find("/dev/zero: longer than a test file may be, 1048576 bytes"), std::string::npos) << endless;
   for (const std::string& m : {folder, missing, endless}) EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+}
+
+TEST(TextFile, AFifoIsReadWithoutBlockingItsOpen) {
+  const fs::path fifo = scratch() / "config.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // No writer: the open does not wait for one, and the file reads as empty.
+  EXPECT_EQ(read_text_file(fifo.string(), "test file", kMaxConfigBytes), "");
+  // A writer that has written part, and writes the rest while the reader waits: its text, whole.
+  const int keep = ::open(fifo.c_str(), O_RDWR);  // holds the FIFO open while the writer joins
+  ASSERT_GE(keep, 0);
+  const std::string first(50000, 'a'), rest(30000, 'b');
+  ASSERT_EQ(::write(keep, first.data(), first.size()), static_cast<ssize_t>(first.size()));
+  const int writer = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+  ASSERT_GE(writer, 0);
+  ::close(keep);
+  std::string text;
+  std::thread reader([&] { text = read_text_file(fifo.string(), "test file", kMaxConfigBytes); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the reader waits on the open writer
+  for (std::size_t done = 0; done < rest.size();) {
+    const ssize_t n = ::write(writer, rest.data() + done, rest.size() - done);
+    if (n > 0) done += static_cast<std::size_t>(n);
+  }
+  ::close(writer);
+  reader.join();
+  EXPECT_EQ(text.size(), first.size() + rest.size());
+  EXPECT_TRUE(text == first + rest) << "the text read differs from the text written";
 }
 
 }  // namespace

@@ -454,6 +454,7 @@ StreamSettings random_settings(std::mt19937_64& rng) {
   s.period = log_uniform(rng, 1e-4, 1e-2);
   s.max_velocity = rng() % 2 ? kInf : log_uniform(rng, 0.01, 2.0);
   s.max_acceleration = rng() % 2 ? kInf : log_uniform(rng, 0.1, 100.0);
+  if (s.rate_limited()) s.on_reject = RejectPolicy::Hold;  // skip is refused with limits (check_stream_settings)
   return s;
 }
 

@@ -94,6 +94,12 @@ TEST(Stream, SettingsAreValidated) {
   EXPECT_NE(check_stream_settings(limited(-1, kInf)).find("max_velocity"), std::string_view::npos);
   EXPECT_NE(check_stream_settings(limited(std::nan(""), kInf)).find("max_velocity"), std::string_view::npos);
   EXPECT_NE(check_stream_settings(limited(kInf, 0)).find("max_acceleration"), std::string_view::npos);
+  // Skip leaves the drive without a command for a rejected input: no limit could hold then.
+  StreamSettings skip = limited(0.5, 5.0);
+  skip.on_reject = RejectPolicy::Skip;
+  EXPECT_NE(check_stream_settings(skip).find("on_reject"), std::string_view::npos);
+  skip.max_velocity = skip.max_acceleration = kInf;
+  EXPECT_TRUE(check_stream_settings(skip).empty());
   EXPECT_FALSE(StreamSettings{}.rate_limited());
   EXPECT_TRUE(limited(0.1, kInf).rate_limited());
 }

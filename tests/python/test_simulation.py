@@ -70,6 +70,16 @@ def test_point_log_errors_are_one_line():
     assert "\n" not in str(e.value)
 
 
+def test_a_length_unit_is_honoured_or_refused_never_ignored():
+    """Issue 29: a negative unit was ignored where the columns carry their units."""
+    text = "t_s,x_mm,y_mm,z_mm\n0,1,2,3\n0.1,1,2,3\n0.2,1,2,4\n"
+    assert hexatwist.read_point_log(text, length_unit=1e-3)["points"][2][2] == pytest.approx(4e-3)
+    for unit in (-1e-3, float("nan"), float("inf")):
+        with pytest.raises((hexatwist.ConfigError, ValueError)) as e:
+            hexatwist.read_point_log(text, length_unit=unit)
+        assert "length unit" in str(e.value)
+
+
 def test_study_metrics_are_the_clis_side_by_side(tmp_path):
     """Python's study() and `hexatwist study` report the same run with the same library function
     (run_metrics): the errors, the largest torque, the saturated ticks, the following and orientation

@@ -16,10 +16,15 @@ inline constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;
 /// 1 kHz is about 200 MB), read and parsed in about 2 GB.
 inline constexpr std::size_t kMaxDataBytes = std::size_t{256} << 20;
 
+/// Longest wait for more of a file that is a pipe, socket or device [s] (a FIFO whose writer
+/// stalls); a regular file never waits.
+inline constexpr double kMaxWaitSeconds = 10.0;
+
 /// Reads the whole file `path`, at most `max_bytes` bytes (a device such as /dev/zero is cut off
-/// there). Throws hexatwist::Error with one line "PATH: ..." for a directory, a file that cannot
-/// be opened or read ("PATH: cannot read the WHAT: " and the system's reason), or one longer than
-/// `max_bytes`. `what` names the file's role ("configuration file").
+/// there; a FIFO without a writer reads as empty, one whose writer stalls for kMaxWaitSeconds is
+/// refused). The open never blocks. Throws hexatwist::Error with one line "PATH: ..." for a directory, a file that
+/// cannot be opened or read ("PATH: cannot read the WHAT: " and the system's reason), or one longer than `max_bytes`.
+/// `what` names the file's role ("configuration file").
 std::string read_text_file(const std::string& path, std::string_view what, std::size_t max_bytes);
 
 }  // namespace hexatwist

@@ -11,6 +11,9 @@ A plan is {"steps": [step, ...], "pins": [HAL pin names read after each step]}; 
   {"mdi": "G0 X1 Y2 ..."}               one MDI command, run to completion
   {"program": "/abs/file.ngc", "pauses": N}   a G-code program, held N times on its way (feed
                                        hold until the machine stands still) for a snapshot
+  {"program": "/abs/file.ngc", "trace": S}    a G-code program run through, its commanded joints
+                                       recorded every S seconds ("trace": [[t, j1..j6], ...], t
+                                       from the start of the run)
 Without $HEXATWIST_LINUXCNC_PLAN it runs a short demo and prints what it sees.
 """
 import json
@@ -97,19 +100,26 @@ def mdi(text):
     return wait_until(idle, STEP_TIMEOUT)
 
 
-def program(path, pauses, pins):
+def program(path, pauses, pins, trace_every=0.0, trace=None):
     """Runs a G-code program; `pauses` times, every 0.15 s, it holds the feed, waits until the
-    machine stands still on the path, takes a snapshot and resumes."""
+    machine stands still on the path, takes a snapshot and resumes. With `trace_every` > 0 the
+    commanded joints are appended to `trace` as [t, j1..j6] that often, t from AUTO_RUN."""
     samples = []
     command.mode(linuxcnc.MODE_AUTO)
     command.wait_complete()
     command.program_open(path)
     command.wait_complete()
     command.auto(linuxcnc.AUTO_RUN, 0)
+    t_run = time.monotonic()
     end = time.monotonic() + STEP_TIMEOUT
     started = wait_until(lambda: stat.interp_state != linuxcnc.INTERP_IDLE, 5)
     last = time.monotonic()
     while started and time.monotonic() < end and not idle():
+        if trace_every > 0.0:
+            stat.poll()
+            trace.append([time.monotonic() - t_run] + list(stat.joint_position[:6]))
+            time.sleep(trace_every)
+            continue
         if len(samples) < pauses and time.monotonic() - last > 0.15:
             command.auto(linuxcnc.AUTO_PAUSE)
             if wait_until(lambda: stat.paused and stat.current_vel == 0.0, 5):
@@ -135,7 +145,9 @@ def run(plan):
         elif "mdi" in step:
             record["done"] = mdi(step["mdi"])
         elif "program" in step:
-            record["done"], record["samples"] = program(step["program"], step.get("pauses", 0), pins)
+            record["trace"] = []
+            record["done"], record["samples"] = program(step["program"], step.get("pauses", 0), pins,
+                                                        step.get("trace", 0.0), record["trace"])
         # The feedback and the pins settle: the simulated joints reach their commands (a loaded
         # machine may take more than a few servo cycles), then a few cycles more for the pins.
         wait_until(settled, 2.0)

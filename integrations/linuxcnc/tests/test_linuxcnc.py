@@ -368,3 +368,69 @@ def test_a_calibrated_configuration_keeps_the_machines_home_and_runs_unchanged()
     worst_joint, worst_pose = check_pose_steps(run, corrected)
     print("calibrated configuration: worst joint difference %.3g mm, worst FK pose difference %.3g" %
           (worst_joint, worst_pose))
+
+
+def read_run_csv(path):
+    """The rows of a run CSV (stations --out): [t, x, y, z, roll, pitch, yaw] in SI."""
+    rows = []
+    with open(path) as f:
+        next(f)
+        for line in f:
+            rows.append([float(v) for v in line.split(",")])
+    return rows
+
+
+def rests(rows, shortest):
+    """The intervals [t_start, t_end, pose] where the run stands still for at least `shortest` s."""
+    out, start = [], 0
+    for k in range(1, len(rows) + 1):
+        if k == len(rows) or rows[k][1:] != rows[start][1:]:
+            if rows[k - 1][0] - rows[start][0] >= shortest:
+                out.append((rows[start][0], rows[k - 1][0], rows[start][1:]))
+            start = k
+    return out
+
+
+def test_a_station_plan_runs_on_linuxcnc_as_its_gcode_program_with_the_plans_timing():
+    """`stations --gcode` (issue 28): the program runs in LinuxCNC, and its joints are the planned
+    stations' compensated commands while the plan rests there, at the plan's times (run.csv's)."""
+    work = os.path.join(OUT, "gcode")
+    os.makedirs(work, exist_ok=True)
+    run_csv, program = os.path.join(work, "run.csv"), os.path.join(work, "run.ngc")
+    cli("stations", "--count", "13", "--candidates", "300", "--range", "0.1,5", "--out", run_csv, "--gcode", program)
+    rows = read_run_csv(run_csv)
+    planned = rests(rows, 0.5)
+    assert len(planned) == 15, planned  # home, the 13 stations, home
+    home_z = 1000 * model_json()["home_height"]
+    ini = ini_for()
+    trace_every = 0.01
+    run = harness.run(ini, {"steps": [{"home": True}, {"program": program, "trace": trace_every}], "pins": []},
+                      timeout=150, keep_dir=os.path.join(work, "run"))
+    assert run.results and len(run.results) == 2, run.log[-3000:]
+    assert all(r["done"] and not r["errors"] for r in run.results), run.results
+    trace = run.results[1]["trace"]
+    assert trace and trace[-1][0] > rows[-1][0] * 0.9, "the trace does not cover the program"
+    # LinuxCNC's rests: the commanded joints unchanged for 0.3 s or more, on its clock (from AUTO_RUN).
+    observed, first = [], 0
+    for k in range(1, len(trace) + 1):
+        if k == len(trace) or max(abs(a - b) for a, b in zip(trace[k][1:], trace[first][1:])) > 1e-9:
+            if trace[k - 1][0] - trace[first][0] >= 0.3:
+                observed.append((trace[first][0], trace[k - 1][0], trace[first][1:]))
+            first = k
+    assert len(observed) == len(planned), (len(observed), len(planned))
+    # Each rest is the planned station's: the joints are its compensated command.
+    worst_joint = 0.0
+    for (t_plan, _, pose), (_, _, joints) in zip(planned, observed):
+        world = [1000 * pose[0], 1000 * pose[1], home_z + 1000 * pose[2]] + [math.degrees(v) for v in pose[3:]]
+        command = [1000.0 * leg["command_compensated"] for leg in ik(world)["legs"]]
+        worst_joint = max(worst_joint, assert_close(joints, command, JOINT_TOL_MM, "joints at rest, t = %.3f s" % t_plan))
+    # ... at the plan's times: LinuxCNC's arrivals against the plan's, on a clock of its own (an
+    # offset, the program's start, and a rate: each dwell and move ends on a task cycle).
+    xs, ys = [p[0] for p in planned[1:]], [o[0] for o in observed[1:]]
+    n, mx, my = len(xs), sum(xs) / len(xs), sum(ys) / len(ys)
+    rate = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+    offset = my - rate * mx
+    worst = max(abs(y - offset - rate * x) for x, y in zip(xs, ys))
+    print("gcode: %d stations over %.1f s; joints at rest within %.3g mm of the plan's commands; LinuxCNC's arrivals "
+          "= %.4f s + %.5f x the plan's, within %.3f s" % (n - 1, rows[-1][0], worst_joint, offset, rate, worst))
+    assert abs(rate - 1.0) < 0.02 and -0.1 < offset < 1.0 and worst < 0.05, (offset, rate, worst)
