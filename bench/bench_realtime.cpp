@@ -52,6 +52,45 @@ void BM_CompensatedCommandPerCall(benchmark::State& state) {
 }
 BENCHMARK(BM_CompensatedCommandPerCall)->MinTime(2.0);
 
+// The seed with every leg effect (README's leg_effects block: 200 N/um legs under the load, 50 um
+// of play, 11.5 ppm/K on the length and the lead).
+const Model& effects_model() {
+  static const Model m = load_model(std::string(seed_config_yaml()) +
+                                        "\nleg_effects:\n  stiffness: 2.0e8\n  play: 50.0e-6\n  home_direction: 1\n"
+                                        "  length_expansion: 11.5e-6\n  lead_expansion: 11.5e-6\n"
+                                        "  reference_temperature: 20\n",
+                                    "seed with leg effects");
+  return m;
+}
+
+// The command of a real machine (issue 27): the static load's deflection at the pose, each leg's
+// temperature and the play's direction kept from call to call. Same run and poses as
+// BM_CompensatedCommandPerCall; the budget is twice its time.
+void BM_CompensatedCommandWithLegEffectsPerCall(benchmark::State& state) {
+  const Motion& m = motion();
+  const Model& em = effects_model();
+  Latencies lat(1 << 22);
+  Vector6d cmd;
+  LimitReport lim;
+  LegInputs inputs;
+  inputs.temperature = Vector6d::Constant(23.5);
+  PlayState play;
+  start_play(em, em.geometry().home_command, play);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const Pose p = pose_from_placement(m.poses[k]);
+    const std::uint64_t t0 = Latencies::now();
+    const Status s = motor_commands(em, p, Strategy::Compensated, inputs, &play, cmd, lim);
+    const std::uint64_t t1 = Latencies::now();
+    benchmark::DoNotOptimize(s);
+    benchmark::DoNotOptimize(cmd);
+    lat.add(t0, t1);
+    if (++k == m.poses.size()) k = 0;
+  }
+  lat.report(state);
+}
+BENCHMARK(BM_CompensatedCommandWithLegEffectsPerCall)->MinTime(2.0);
+
 void BM_TwistAwareFkWarmPerCall(benchmark::State& state) {
   // From the pose 1 ms earlier on the motion, as a servo loop at 1 kHz does.
   const Motion& m = motion();

@@ -145,18 +145,41 @@ Pose parse_pose_m_deg(const std::string& text, const std::string& option) {
   return p;
 }
 
+namespace {
+
+// A value and its bound with as many decimals as it takes to tell them apart (at least `least`):
+// "1.4000003 m is below the minimum 1.4000000 m", never "1.400000 below 1.400000".
+std::pair<std::string, std::string> apart(double value, double bound, int least) {
+  for (int d = least; d <= 16; ++d) {
+    std::string a = fmt::format("{:.{}f}", value, d), b = fmt::format("{:.{}f}", bound, d);
+    if (a != b) return {a, b};
+  }
+  return {fmt::format("{}", value), fmt::format("{}", bound)};
+}
+
+}  // namespace
+
 std::string describe_limit(const LimitReport& r) {
   if (r.status == Status::Ok) return "ok";
   const std::string leg = r.leg >= 0 ? fmt::format("leg {}: ", r.leg + 1) : std::string();
   switch (r.status) {
     case Status::StrokeBelowMin:
-      return fmt::format("{}length {:.6f} m is below the minimum {:.6f} m (limits.length_min)", leg, r.value, r.bound);
-    case Status::StrokeAboveMax:
-      return fmt::format("{}length {:.6f} m is above the maximum {:.6f} m (limits.length_max)", leg, r.value, r.bound);
+    case Status::StrokeAboveMax: {
+      const bool below = r.status == Status::StrokeBelowMin;
+      const char* which = below ? "minimum" : "maximum";
+      const char* field = below ? "limits.length_min" : "limits.length_max";
+      // Within 10 nm (a boundary found by bisection): at the limit, in digits every CPU prints alike.
+      if (std::abs(r.value - r.bound) < 1e-8)
+        return fmt::format("{}length at the {} {:.6f} m ({})", leg, which, r.bound, field);
+      const auto [v, b] = apart(r.value, r.bound, 6);
+      return fmt::format("{}length {} m is {} the {} {} m ({})", leg, v, below ? "below" : "above", which, b, field);
+    }
     case Status::BendBase:
-    case Status::BendPlatform:
-      return fmt::format("{}{} U-joint bends {:.3f} deg, above the limit {:.3f} deg (limits.bend_max_deg)", leg,
-                         r.status == Status::BendBase ? "base" : "platform", rad2deg(r.value), rad2deg(r.bound));
+    case Status::BendPlatform: {
+      const auto [v, b] = apart(rad2deg(r.value), rad2deg(r.bound), 3);
+      return fmt::format("{}{} U-joint bends {} deg, above the limit {} deg (limits.bend_max_deg)", leg,
+                         r.status == Status::BendBase ? "base" : "platform", v, b);
+    }
     case Status::SingularBase:
     case Status::SingularPlatform:
       return fmt::format(

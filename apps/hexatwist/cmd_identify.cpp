@@ -53,6 +53,8 @@ struct Report {
   const PointLog& log;
   const Identification& id;
   std::string run_description;
+  ClockFit clock;
+  std::size_t outside = 0;  // points of the log outside the run (--time-offset auto)
 
   int line_of(std::size_t observation) const { return log.lines[set.points[observation]]; }
   const ParameterSet& ps() const { return id.parameters; }
@@ -124,15 +126,28 @@ std::vector<Row> parameter_rows(const Report& r) {
   return rows;
 }
 
-// Which axes were fitted, and how well the data determine them, in one phrase.
+// Which axes were fitted, and how well the data determine them, in one phrase. An axis whose
+// standard deviation exceeds 10 deg is undetermined (1e2-1e5 deg is no estimate at all).
 std::string axes_phrase(const Identification& id) {
   if (id.parameters.model() != CalibrationModel::Geometry) return "joints as configured";
   const int fitted = id.parameters.axis_count() / 2;
+  constexpr double kUndetermined = deg2rad(10.0);
   double lo = INFINITY, hi = 0.0;
-  for (const double sd : id.axis_sd)
-    if (std::isfinite(sd)) lo = std::min(lo, sd), hi = std::max(hi, sd);
-  const std::string sds =
-      std::isfinite(lo) ? fmt::format("the data determine them to {:.2g}-{:.2g} deg", rad2deg(lo), rad2deg(hi)) : "";
+  int undetermined = 0, total = 0;
+  for (const double sd : id.axis_sd) {
+    if (std::isnan(sd)) continue;
+    ++total;
+    if (!(sd <= kUndetermined)) {
+      ++undetermined;
+      continue;
+    }
+    lo = std::min(lo, sd), hi = std::max(hi, sd);
+  }
+  std::string sds;
+  if (std::isfinite(lo)) sds = fmt::format("the data determine them to {:.2g}-{:.2g} deg", rad2deg(lo), rad2deg(hi));
+  if (undetermined > 0)
+    sds += fmt::format("{}{} undetermined (sd above 10 deg)", sds.empty() ? "" : "; ",
+                       undetermined == total ? std::string("all") : fmt::format("{} of {}", undetermined, total));
   if (fitted == 0)
     return sds.empty() ? "U-joint axes as configured" : fmt::format("U-joint axes as configured ({}: not fitted)", sds);
   return fmt::format("{} U-joint ax{} fitted{}", fitted, fitted == 1 ? "is" : "es",
@@ -148,6 +163,7 @@ std::string text_report(const Report& r) {
       "commands\n",
       printable(o.log.points), r.log.points_T.size(), id.observations, r.set.settle, id.stations, r.set.targets.size(),
       r.set.targets.size() == 1 ? "" : "s", r.run_description, o.run.strategy);
+  t += clock_line(r.clock, o.log, r.outside);
   t += fmt::format("model: {} ({}), lead effect {}\n", model_name(r.ps().model()), axes_phrase(id),
                    r.ps().lead_effect() == LeadEffect::TwistAndTravel
                        ? "travel (the drives turn the screws by the nominal lead's angles)"
@@ -319,6 +335,11 @@ std::string json_report(const Report& r, const std::string& failure, bool writte
   JsonWriter j;
   j.begin_document(schema::kIdentify).field("command", "identify").field("status", failure.empty() ? "ok" : "failed");
   j.field("identification", to_string(id.status));
+  // The log's clock against the run's: as given (--time-offset SECONDS), or found from the rests.
+  const ClockFit& c = r.clock;
+  j.key("clock").begin_object().field("found", c.matched > 0).field("offset", c.offset).field("scale", c.scale);
+  j.field("offset_sd", c.offset_sd).field("scale_sd", c.scale_sd).field("worst", c.worst);
+  j.field("matched", c.matched).end_object();
   if (!failure.empty()) j.field("reason", failure);
   if (!id.hint.empty()) j.field("hint", id.hint);
   j.field("model", r.nominal.spec().name).field("config", model_source(r.o.run.model)).field("points", r.o.log.points);
@@ -451,18 +472,23 @@ int run_identify(const IdentifyOptions& o) {
   check_option(o.settle < run.test.trajectory.duration(), "--settle", o.settle,
                fmt::format("a time shorter than the run ({:g} s): no point can be still for longer [s]",
                            run.test.trajectory.duration()));
-  const PointLog log = read_point_log(o.log, format);
+  PointLog log = read_point_log(o.log, format);
+  ClockFit clock;
+  std::size_t outside = 0;
+  const TimeAlignment alignment = log_alignment(o.log, run, log, clock, outside);
   // Bad input throws (exit 2, naming the option at fault).
-  const ObservationSet set =
-      observations_at_rest(model, run.commanded, log, {o.log.time_offset, o.log.rate}, strategy_of(o.run), o.settle);
+  const ObservationSet set = observations_at_rest(model, run.commanded, log, alignment, strategy_of(o.run), o.settle);
   Identification id;
   const Status status = identify(model, set.observations, id, library_options(o));
-  const Report report{o, model, set, log, id, run.test.description};
+  const Report report{o, model, set, log, id, run.test.description, clock, outside};
   // A failure still prints the JSON (with the reason, and null where there is no value) when asked.
   const auto fail = [&](const ExitError& e) {
     if (o.json) write_stdout(json_report(report, e.what(), false));
     throw e;
   };
+  // A log that is not of this run is bad input, refused as measure refuses it (exit 2).
+  if (status == Status::InvalidArgument)
+    fail(ExitError(kExitBadInput, fmt::format("{}: {}; nothing was written", printable(o.log.points), id.reason)));
   if (status != Status::Ok)
     fail(ExitError(kExitNotIdentified,
                    fmt::format("{}: {} points at rest at {} station{}: {}: {}{}; nothing was written",

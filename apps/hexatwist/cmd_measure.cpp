@@ -58,7 +58,7 @@ int run_measure(const MeasureOptions& o) {
   if (!std::isnan(o.register_until)) check_option(true, "--register-until", o.register_until, "a time [s]");
   MeasurementOptions mo;
   mo.strategy = strategy_of(o.run);
-  mo.time = {o.log.time_offset, o.log.rate};
+  ClockFit clock;
   mo.window.settle = o.settle;
   std::string window;
   if (o.register_first > 0) {
@@ -75,7 +75,11 @@ int run_measure(const MeasureOptions& o) {
                     "--register-until SECONDS or --register-first N: which points register the tracker frame? (with "
                     "--test, the calibration moves do)");
   }
-  const PointLog log = read_point_log(o.log, format);
+  PointLog log = read_point_log(o.log, format);
+  std::size_t outside = 0;
+  mo.time = log_alignment(o.log, run, log, clock, outside);
+  if (const std::string line = clock_line(clock, o.log, outside); !line.empty())
+    std::fprintf(stderr, "hexatwist measure: %s", line.c_str());
   ReportedMeasurement measured;
   measured.measurement = measure_points(rig.model(), run.commanded, log, mo);  // bad input throws: exit 2
   measured.source = o.log.points;

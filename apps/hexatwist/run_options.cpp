@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 
 namespace hexatwist::cli {
@@ -84,12 +85,77 @@ void add_log_options(CLI::App& app, LogOptions& o) {
   app.add_option("--rate", o.rate, "Samples per second of an indexed log [Hz]")->each([&o](const std::string&) {
     o.rate_given = true;
   });
-  app.add_option("--time-offset", o.time_offset, "The log's time (or index/rate) when the trajectory's time is 0 [s]")
+  app.add_option("--time-offset", o.time_offset,
+                 "The log's time (or index/rate) when the trajectory's time is 0 [s], or auto: found with the log's "
+                 "clock rate from the rests of the run and of the log (a log that starts whenever the tracker was "
+                 "started)")
       ->capture_default_str();
 }
 
+namespace {
+
+// --time-offset as a number, or NaN for auto; ExitError(2) for anything else.
+double offset_of(const LogOptions& o) {
+  if (o.time_offset == "auto") return std::numeric_limits<double>::quiet_NaN();
+  double v = 0.0;
+  const char* b = o.time_offset.data();
+  const char* e = b + o.time_offset.size();
+  const auto [ptr, ec] = std::from_chars(b, e, v);
+  if (ec != std::errc() || ptr != e || !std::isfinite(v))
+    throw ExitError(kExitBadInput,
+                    fmt::format("--time-offset '{}': expected a time [s] or auto", printable(o.time_offset)));
+  return v;
+}
+
+}  // namespace
+
+TimeAlignment log_alignment(const LogOptions& o, const Run& run, PointLog& log, ClockFit& fit, std::size_t& dropped) {
+  fit = ClockFit{};
+  dropped = 0;
+  const double offset = offset_of(o);
+  if (!std::isnan(offset)) {
+    fit.offset = offset;
+    return {offset, o.rate, 1.0};
+  }
+  try {
+    if (fit_log_clock(run.commanded, log, {0.0, o.rate, 1.0}, ClockFitOptions{}, fit) != Status::Ok)
+      throw ExitError(kExitBadInput, fmt::format("--time-offset auto: {}", fit.reason));
+  } catch (const Error& e) {
+    throw ExitError(kExitBadInput, fmt::format("--time-offset auto: {}", e.what()));
+  }
+  const TimeAlignment alignment = fit.alignment(o.rate);
+  // The points outside the run: recorded before it started or after it ended.
+  const std::vector<double> t = trajectory_times(log, alignment);
+  const double front = run.commanded.t.front(), back = run.commanded.t.back();
+  PointLog kept = log;
+  kept.stamps.clear(), kept.points_T.clear(), kept.targets.clear(), kept.lines.clear(), kept.stamp_columns.clear();
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    if (!(t[k] >= front && t[k] <= back)) {
+      ++dropped;
+      continue;
+    }
+    kept.stamps.push_back(log.stamps[k]);
+    kept.points_T.push_back(log.points_T[k]);
+    if (k < log.targets.size()) kept.targets.push_back(log.targets[k]);
+    kept.lines.push_back(log.lines[k]);
+    if (k < log.stamp_columns.size()) kept.stamp_columns.push_back(log.stamp_columns[k]);
+  }
+  log = std::move(kept);
+  return alignment;
+}
+
+std::string clock_line(const ClockFit& fit, const LogOptions& o, std::size_t dropped) {
+  if (fit.matched == 0) return {};
+  return fmt::format(
+      "the log's clock (--time-offset {}): t_log = {:.4f} s ± {:.4f} + {:.7f} ± {:.7f} x t_run, from {} of its {} "
+      "rests matched to the run's {} (from the run's rest {} on), worst misfit {:.4f} s; {} points outside the run "
+      "left out\n",
+      o.time_offset, fit.offset, fit.offset_sd, fit.scale, fit.scale_sd, fit.matched, fit.log_rests, fit.run_rests,
+      fit.first + 1, fit.worst, dropped);
+}
+
 PointLogFormat log_format(const LogOptions& o) {
-  check_option(true, "--time-offset", o.time_offset, "a time [s]");
+  (void)offset_of(o);
   PointLogFormat f;
   std::vector<std::string> names;
   std::size_t begin = 0;

@@ -46,8 +46,8 @@ struct LogOptions {
   std::string units;
   bool index = false;
   double rate = 0.0;
-  bool rate_given = false;  // --rate was given (0 is a value refused, not "none")
-  double time_offset = 0.0;
+  bool rate_given = false;        // --rate was given (0 is a value refused, not "none")
+  std::string time_offset = "0";  // seconds, or "auto": from the rests (log_clock.hpp)
 };
 
 /// Adds --points, --columns, --units, --index, --rate and --time-offset.
@@ -58,5 +58,15 @@ PointLogFormat log_format(const LogOptions& o);
 
 /// Reads and parses the log; ExitError(2) with the parser's one line.
 PointLog read_point_log(const LogOptions& o, const PointLogFormat& format);
+
+/// The log's clock against the run's: --time-offset SECONDS as given, or --time-offset auto found
+/// from the rests (fit_log_clock; ExitError(2) with its reason when they do not match). `fit` gets
+/// the fit (auto) or the given offset with scale 1 and nothing matched. With auto, the points
+/// recorded before the run starts or after it ends are dropped from `log` (`dropped` counts them):
+/// a tracker records whenever it was started.
+TimeAlignment log_alignment(const LogOptions& o, const Run& run, PointLog& log, ClockFit& fit, std::size_t& dropped);
+
+/// The clock's line of a report: "the log's clock: t_log = ... (from N rests ...)", or "" for a given offset.
+std::string clock_line(const ClockFit& fit, const LogOptions& o, std::size_t dropped);
 
 }  // namespace hexatwist::cli

@@ -29,6 +29,7 @@
 #include "hexatwist/simulation/study.hpp"
 
 #include "hexatwist/calibration/identification.hpp"
+#include "hexatwist/calibration/log_clock.hpp"
 #include "hexatwist/calibration/measurement.hpp"
 #include "hexatwist/calibration/observations.hpp"
 #include "hexatwist/calibration/parameter_errors.hpp"

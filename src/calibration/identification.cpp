@@ -73,7 +73,7 @@ Status check_inputs(const Model& nominal, std::span<const Observation> observati
 
 // The start: the nominal platform, the tracker frame by Kabsch of target 0's mean points onto the
 // nominal model's predictions, the other targets placed by least squares from their points.
-Status start_point(const ParameterSet& set, Evaluator& evaluator, const ObservationGroups& groups,
+Status start_point(const ParameterSet& set, Evaluator& evaluator, const ObservationGroups& groups, double max_misfit,
                    Eigen::VectorXd& theta, RigidTransform& X_BT, Registration& registration, std::string& reason) {
   theta = set.nominal_vector();
   Eigen::VectorXd e;
@@ -93,6 +93,11 @@ Status start_point(const ParameterSet& set, Evaluator& evaluator, const Observat
   if (const Status s = register_points(pairs, registration); s != Status::Ok) {
     reason = fmt::format("the start registration of the mean points onto the nominal model failed: {}", describe(s));
     return Status::NotIdentifiable;
+  }
+  // A log of another run (or in other units) is refused as measure_points refuses it.
+  if (std::string why = shape_misfit(pairs, registration, max_misfit); !why.empty()) {
+    reason = std::move(why);
+    return Status::InvalidArgument;
   }
   X_BT = registration.X_BT;
   theta.segment<3>(set.translation_index()) = X_BT.t;
@@ -453,7 +458,9 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
   Eigen::VectorXd start;
   RigidTransform X_start;
   Registration registration;
-  if (const Status s = start_point(set, evaluator, groups, start, X_start, registration, reason); s != Status::Ok)
+  if (const Status s =
+          start_point(set, evaluator, groups, options.max_registration_misfit, start, X_start, registration, reason);
+      s != Status::Ok)
     return fail(s, reason);
   out.nominal = start;
   {

@@ -36,13 +36,8 @@ double rms_spread(const Range& range, Get get) {
 // log is in other units than its header says, or of another run.
 void check_registration_fit(const std::string& src, const std::string& lines_text, const std::vector<PointPair>& pairs,
                             const Registration& reg, const MeasurementOptions& options) {
-  const double spread = rms_spread(pairs, [](const PointPair& p) { return p.p_B; });
-  if (reg.rms_residual <= options.max_registration_misfit * spread) return;
-  throw Error(fmt::format(
-      "{}: {}: the log's points do not have the run's shape: the registration leaves {:.4g} mm rms over points that "
-      "spread {:.4g} mm rms (more than {:g} %): a log in other units than its header says (metres labelled _mm?), "
-      "another run's log, or another time offset",
-      src, lines_text, 1e3 * reg.rms_residual, 1e3 * spread, 100.0 * options.max_registration_misfit));
+  if (const std::string why = shape_misfit(pairs, reg, options.max_registration_misfit); !why.empty())
+    throw Error(fmt::format("{}: {}: {}", src, lines_text, why));
 }
 
 // Evaluated errors the platform cannot have: a point farther off than a leg is long (a typing or

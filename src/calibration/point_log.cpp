@@ -241,9 +241,14 @@ std::vector<double> trajectory_times(const PointLog& log, const TimeAlignment& a
   if (log.indexed && !(std::isfinite(alignment.rate) && alignment.rate > 0.0))
     throw Error(fmt::format("{}: sample rate: expected > 0 Hz for a log of sample indices, got {}", log.source,
                             alignment.rate));
+  if (!(std::isfinite(alignment.scale) && alignment.scale > 0.0))
+    throw Error(
+        fmt::format("{}: clock scale: expected a finite number > 0 (the log's seconds per second of the run), "
+                    "got {}",
+                    log.source, alignment.scale));
   std::vector<double> t(log.stamps.size());
   for (std::size_t k = 0; k < t.size(); ++k)
-    t[k] = (log.indexed ? log.stamps[k] / alignment.rate : log.stamps[k]) - alignment.offset;
+    t[k] = ((log.indexed ? log.stamps[k] / alignment.rate : log.stamps[k]) - alignment.offset) / alignment.scale;
   return t;
 }
 

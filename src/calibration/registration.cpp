@@ -1,5 +1,7 @@
 #include "hexatwist/calibration/registration.hpp"
 
+#include <fmt/format.h>
+
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -117,6 +119,22 @@ Status register_points(std::span<const PointPair> pairs, Registration& out,
   out.rms_residual = std::sqrt(sum2 * inv_n);
   out.sigma = std::sqrt(sum2 / static_cast<double>(3 * n - 6));
   return Status::Ok;
+}
+
+std::string shape_misfit(std::span<const PointPair> pairs, const Registration& registration, double max_misfit) {
+  Vector3d mean = Vector3d::Zero();
+  for (const PointPair& p : pairs) mean += p.p_B;
+  if (pairs.empty()) return {};
+  mean /= static_cast<double>(pairs.size());
+  double sum = 0.0;
+  for (const PointPair& p : pairs) sum += (p.p_B - mean).squaredNorm();
+  const double spread = std::sqrt(sum / static_cast<double>(pairs.size()));
+  if (registration.rms_residual <= max_misfit * spread) return {};
+  return fmt::format(
+      "the log's points do not have the run's shape: the registration leaves {:.4g} mm rms over points that spread "
+      "{:.4g} mm rms (more than {:g} %): a log in other units than its header says (metres labelled _mm?), another "
+      "run's log, or another time offset",
+      1e3 * registration.rms_residual, 1e3 * spread, 100.0 * max_misfit);
 }
 
 }  // namespace hexatwist

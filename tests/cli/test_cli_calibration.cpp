@@ -520,4 +520,60 @@ TEST(CliOptions, SynthErrorsNameTheOptionNotTheRoutine) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+// Issue 28: a tracker log on a clock of its own (started 47.25 s early, 300 ppm fast) identifies
+// as the run's own with --time-offset auto, which reports the clock it found; a log of another run
+// is refused by identify as by measure (the same sentence, exit 2), and by the clock fit too.
+TEST(CliIdentify, TheLogsClockIsFoundFromTheRestsAndALogOfAnotherRunIsRefusedAsMeasureRefusesIt) {
+  const std::filesystem::path dir = temp_dir() / "clock";
+  std::filesystem::create_directories(dir);
+  const std::string log = (dir / "log.csv").string(), shifted = (dir / "shifted.csv").string();
+  ASSERT_EQ(run({"synth", "--stations", "20", "--joint-errors-mm", "0.5", "--lead-error-pct", "2", "--out", log}).code,
+            0);
+  std::vector<std::string> lines = lines_of(read_file(log));
+  for (std::size_t k = 1; k < lines.size(); ++k) {
+    const std::size_t comma = lines[k].find(',');
+    std::ostringstream t;
+    t.precision(17);
+    t << 47.25 + 1.0003 * std::stod(lines[k].substr(0, comma));
+    lines[k] = t.str() + lines[k].substr(comma);
+  }
+  write_file("clock/shifted.csv", joined(lines));
+  const Outcome plain = run({"identify", "--stations", "20", "--points", log, "--json"});
+  const Outcome found = run({"identify", "--stations", "20", "--points", shifted, "--time-offset", "auto", "--json"});
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  ASSERT_EQ(found.code, 0) << found.err;
+  const YAML::Node a = YAML::Load(plain.out), b = YAML::Load(found.out);
+  EXPECT_FALSE(a["clock"]["found"].as<bool>());
+  ASSERT_TRUE(b["clock"]["found"].as<bool>());
+  const double offset = b["clock"]["offset"].as<double>(), offset_sd = b["clock"]["offset_sd"].as<double>();
+  const double scale = b["clock"]["scale"].as<double>(), scale_sd = b["clock"]["scale_sd"].as<double>();
+  EXPECT_NEAR(offset, 47.25, 4 * offset_sd);
+  EXPECT_NEAR(scale, 1.0003, 4 * scale_sd);
+  EXPECT_LT(offset_sd, 0.02);
+  // The same identification: every parameter within half its standard deviation (the points at rest
+  // differ by a sample here and there with the clock found to a few ms: measured 0.17 sd at most).
+  const YAML::Node pa = a["estimate"]["parameters"], pb = b["estimate"]["parameters"];
+  ASSERT_EQ(pa.size(), pb.size());
+  ASSERT_GT(pa.size(), 30u);
+  for (std::size_t k = 0; k < pa.size(); ++k) {
+    const YAML::Node p = pa[k], q = pb[k];
+    ASSERT_EQ(p["name"].as<std::string>(), q["name"].as<std::string>());
+    EXPECT_NEAR(p["estimate"].as<double>(), q["estimate"].as<double>(), 0.5 * p["sd"].as<double>())
+        << p["name"].as<std::string>();
+  }
+  // The text report says what was found.
+  const Outcome text = run({"identify", "--stations", "20", "--points", shifted, "--time-offset", "auto"});
+  EXPECT_NE(text.out.find("the log's clock (--time-offset auto): t_log = 47.2"), std::string::npos) << text.out;
+  // Another run's log: measure and identify refuse it with one sentence.
+  const std::string shape = "the log's points do not have the run's shape";
+  expect_error(run({"identify", "--stations", "20", "--station-seed", "7", "--points", log}), 2, {shape});
+  expect_error(run({"measure", "--stations", "20", "--station-seed", "7", "--points", log, "--register-until", "20"}),
+               2, {shape});
+  expect_error(
+      run({"identify", "--stations", "20", "--station-seed", "7", "--points", shifted, "--time-offset", "auto"}), 2,
+      {"--time-offset auto", "another run"});
+  expect_error(run({"identify", "--stations", "20", "--points", log, "--time-offset", "soon"}), 2,
+               {"--time-offset 'soon'", "auto"});
+}
+
 }  // namespace

@@ -69,6 +69,10 @@ struct IdentificationOptions {
   /// combination's sd is already about a million times the best one's: 40 random stations give
   /// 5e3, 14 give 1e5).
   double max_condition = 1e6;
+  /// A log whose start registration (the nominal model, the tracker frame by Kabsch) leaves an rms
+  /// residual above this share of the model points' spread is not of this run: InvalidArgument,
+  /// worded as measure_points words it (shape_misfit).
+  double max_registration_misfit = kMaxRegistrationMisfit;
   FkOptions fk;  ///< forward kinematics of every station
 };
 

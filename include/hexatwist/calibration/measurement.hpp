@@ -44,7 +44,7 @@ struct MeasurementOptions {
   /// points' rms spread does not have the run's shape (a log in metres labelled _mm, another
   /// run's log): refused. A platform that is millimetres off its drawing leaves well under 5 %
   /// over calibration moves that span decimetres.
-  double max_registration_misfit = 0.2;
+  double max_registration_misfit = kMaxRegistrationMisfit;
   /// A log whose evaluated errors have an rms above both this fraction of the observation point's
   /// commanded motion (rms about its mean over the evaluated points) and `max_error_floor` is of
   /// another motion than the run's (the log of one test measured as another): refused.

@@ -66,12 +66,15 @@ PointLog parse_point_log(std::string_view text, std::string_view source, const P
 
 /// How the log's stamps map to the trajectory's time t (the time of the commanded trajectory).
 struct TimeAlignment {
-  double offset = 0.0;  ///< stamp time at which the trajectory's t = 0: t = stamp - offset [s]
-  double rate = 0.0;    ///< for an indexed log, samples per second: t = index / rate - offset [Hz]
+  double offset = 0.0;  ///< stamp time at which the trajectory's t = 0: t = (stamp - offset) / scale [s]
+  double rate = 0.0;    ///< for an indexed log, samples per second: stamp time = index / rate [Hz]
+  /// The log's seconds per second of the run (1 + the clocks' rate difference; log_clock.hpp finds
+  /// it with the offset); 1 for clocks that agree.
+  double scale = 1.0;
 };
 
 /// The trajectory time of each point [s]. Throws hexatwist::Error if the log is indexed and the
-/// rate is not a finite number > 0, or the offset is not finite.
+/// rate is not a finite number > 0, the offset is not finite, or the scale not finite and > 0.
 std::vector<double> trajectory_times(const PointLog& log, const TimeAlignment& alignment);
 
 }  // namespace hexatwist

@@ -6,6 +6,7 @@
 
 #include <limits>
 #include <span>
+#include <string>
 
 #include "hexatwist/status.hpp"
 #include "hexatwist/types.hpp"
@@ -73,5 +74,17 @@ struct Registration {
 /// `options.max_condition` (nearly collinear).
 [[nodiscard]] Status register_points(std::span<const PointPair> pairs, Registration& out,
                                      const RegistrationOptions& options = {}) noexcept;
+
+/// Largest rms residual of a registration of a log's points onto the model's, as a share of the
+/// model points' rms spread, for the log to be of the run (measure_points and identify decide
+/// with it; MeasurementOptions and IdentificationOptions carry it).
+inline constexpr double kMaxRegistrationMisfit = 0.2;
+
+/// Why a successful registration of a log's points (p_T) onto the model's (p_B) shows the log is
+/// not of the run: its rms residual above `max_misfit` times the model points' rms spread; empty
+/// if it is. One sentence without the log's name (the caller's prefix): a log in other units than
+/// its header says, another run's log, or another time offset. measure_points and identify word
+/// the refusal with it.
+std::string shape_misfit(std::span<const PointPair> pairs, const Registration& registration, double max_misfit);
 
 }  // namespace hexatwist
