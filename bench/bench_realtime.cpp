@@ -32,7 +32,9 @@ namespace {
 using namespace hexatwist;
 using namespace hexatwist::bench;
 
-void BM_CompensatedCommandPerCall(benchmark::State& state) {
+// Times `command(pose, cmd, lim)` call by call over the motion's poses.
+template <class Command>
+void time_each_command(benchmark::State& state, Command&& command) {
   const Motion& m = motion();
   Latencies lat(1 << 22);
   Vector6d cmd;
@@ -41,7 +43,7 @@ void BM_CompensatedCommandPerCall(benchmark::State& state) {
   for (auto _ : state) {
     const Pose p = pose_from_placement(m.poses[k]);
     const std::uint64_t t0 = Latencies::now();
-    const Status s = motor_commands(model(), p, Strategy::Compensated, cmd, lim);
+    const Status s = command(p, cmd, lim);
     const std::uint64_t t1 = Latencies::now();
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(cmd);
@@ -49,6 +51,12 @@ void BM_CompensatedCommandPerCall(benchmark::State& state) {
     if (++k == m.poses.size()) k = 0;
   }
   lat.report(state);
+}
+
+void BM_CompensatedCommandPerCall(benchmark::State& state) {
+  time_each_command(state, [](const Pose& p, Vector6d& cmd, LimitReport& lim) {
+    return motor_commands(model(), p, Strategy::Compensated, cmd, lim);
+  });
 }
 BENCHMARK(BM_CompensatedCommandPerCall)->MinTime(2.0);
 
@@ -67,27 +75,14 @@ const Model& effects_model() {
 // temperature and the play's direction kept from call to call. Same run and poses as
 // BM_CompensatedCommandPerCall; the budget is twice its time.
 void BM_CompensatedCommandWithLegEffectsPerCall(benchmark::State& state) {
-  const Motion& m = motion();
   const Model& em = effects_model();
-  Latencies lat(1 << 22);
-  Vector6d cmd;
-  LimitReport lim;
   LegInputs inputs;
   inputs.temperature = Vector6d::Constant(23.5);
   PlayState play;
   start_play(em, em.geometry().home_command, play);
-  std::size_t k = 0;
-  for (auto _ : state) {
-    const Pose p = pose_from_placement(m.poses[k]);
-    const std::uint64_t t0 = Latencies::now();
-    const Status s = motor_commands(em, p, Strategy::Compensated, inputs, &play, cmd, lim);
-    const std::uint64_t t1 = Latencies::now();
-    benchmark::DoNotOptimize(s);
-    benchmark::DoNotOptimize(cmd);
-    lat.add(t0, t1);
-    if (++k == m.poses.size()) k = 0;
-  }
-  lat.report(state);
+  time_each_command(state, [&](const Pose& p, Vector6d& cmd, LimitReport& lim) {
+    return motor_commands(em, p, Strategy::Compensated, inputs, &play, cmd, lim);
+  });
 }
 BENCHMARK(BM_CompensatedCommandWithLegEffectsPerCall)->MinTime(2.0);
 

@@ -35,11 +35,15 @@ env "${sanitizer_env[@]}" cmake --build build-asan -- -j2
 # - the README's printed digits, which are the Release build's (the same commands run here in their
 #   own tests; this build, without AVX-512 and at -O1, differs in an identification's last digits);
 # - the JSON outputs against their schemas (the same writer in both builds);
+# - a closed standard output walked across every command (the same roll back as a failed write,
+#   which CliOutputs tests here), and the log clock through identify (test_log_clock runs here);
 # - statistics that repeat one computation over many seeds, platforms or grids, whose code paths
 #   the other tests of the same file run here once.
 release_only=(
   'CliReadme[.]'
   'Docs[.]EveryJsonOutputIsValidAgainstItsSchema$'
+  'CliSignals[.]AClosedStandardOutputIsAFailedWriteRolledBack$'
+  'CliIdentify[.]TheLogsClockIsFoundFromTheRestsAndALogOfAnotherRunIsRefusedAsMeasureRefusesIt$'
   'WorkspaceVolume[.]SymmetriesOfTheSeedGiveEqualVolumesWithinTheStatedError$'
   'WorkspaceVolume[.]AgreesWithAnIndependentMonteCarloEstimateToOnePercent$'
   'WorkspaceVolume[.]StatedErrorBoundsTheErrorAgainstAFinerGrid$'

@@ -160,8 +160,9 @@ TEST(CliStations, TheRunIsAlsoWrittenAsALinuxcncProgramAndAsStreamInput) {
   const auto rows = run_rows((temp_dir() / "plan-for-controller.csv").string());
   const std::string poses = read_file(txt);
   const auto lines = static_cast<std::size_t>(std::count(poses.begin(), poses.end(), '\n'));
-  // The CSV is at 100 Hz, the stream input at the control rate (1 kHz): ten lines per row.
-  EXPECT_EQ(lines, 10 * (rows.size() - 1) + 1);
+  // The CSV is at 100 Hz (and its last row, the run's end), the stream input at the control rate
+  // (1 kHz): a line per millisecond up to the CSV's last time.
+  EXPECT_EQ(lines, static_cast<std::size_t>(std::lround(rows.back()[0] * 1000.0)) + 1);
   const Outcome streamed = run({"stream"}, &poses);
   EXPECT_EQ(streamed.code, 0) << streamed.err;
   const auto answers = csv_rows(streamed.out);
@@ -182,7 +183,9 @@ TEST(CliStations, TheRunIsAlsoWrittenAsALinuxcncProgramAndAsStreamInput) {
   const Outcome ik = run({"ik", pose.str(), "--json"});
   ASSERT_EQ(ik.code, 0) << ik.err;
   const YAML::Node legs = YAML::Load(ik.out)["legs"];
-  const auto& answer = answers[10 * row];
+  const auto line = static_cast<std::size_t>(std::lround(rows[row][0] * 1000.0));  // the row's time, in ms
+  ASSERT_LT(line, answers.size());
+  const auto& answer = answers[line];
   for (int i = 0; i < 6; ++i)
     EXPECT_NEAR(std::stod(answer[3 + i]), legs[i]["command_compensated"].as<double>(), 1e-9) << answer[0];
   // The controller's files are outputs like the run: one that is an input or the run is refused.
