@@ -115,9 +115,12 @@ std::vector<Row> parameter_rows(const Report& r) {
     rows.push_back({ps.name(k), "um/kN", 1e9 * id.nominal[k], 1e9 * id.estimate[k], 1e9 * id.sd[k], 4});
   }
   const int effects_end = ps.effect_index() + ps.effects().count();
+  const bool measured = ps.effects().measured;  // heat per kelvin, from the log's temperatures
   for (int k = ps.effect_index(); k < effects_end; ++k)
-    if (ps.name(k) == "lead drift")
-      rows.push_back({ps.name(k), "ppm", 0.0, 1e6 * id.estimate[k], 1e6 * id.sd[k], 2});
+    if (k == ps.lead_drift_index())
+      rows.push_back({ps.name(k), measured ? "ppm/K" : "ppm", 0.0, 1e6 * id.estimate[k], 1e6 * id.sd[k], 2});
+    else if (measured && k >= ps.drift_index() && k < ps.drift_index() + kLegs)
+      rows.push_back({ps.name(k), "um/K", 0.0, 1e6 * id.estimate[k], 1e6 * id.sd[k], 3});
     else if (k != ps.compliance_index())
       rows.push_back({ps.name(k), "mm", 1e3 * id.nominal[k], 1e3 * id.estimate[k], 1e3 * id.sd[k], 4});
   for (int k = ps.target_index(); k < ps.rotation_index(); ++k)
@@ -178,10 +181,11 @@ std::string text_report(const Report& r) {
                    id.twist_sign > 0 ? "as configured" : "flipped (every leg the other hand)", id.cost_ratio);
   t += fmt::format(
       "fit: rms {:.4f} mm before (nominal model, tracker frame by Kabsch), {:.4f} mm after, largest {:.4f} mm (line "
-      "{}); noise {:.4f} mm per axis, the tracker's {:.4f} mm: test {:.2f} sigma (at most 5); condition {:.3g}\n",
+      "{}); noise {:.4f} mm per axis, the tracker's {:.4f} mm: test {:.2f} sigma (at most 5), unexplained {:.4f} mm "
+      "per axis; condition {:.3g}\n",
       1e3 * id.rms_before, 1e3 * id.rms_after, 1e3 * id.max_after,
       r.line_of(static_cast<std::size_t>(id.max_after_index)), 1e3 * id.sigma, 1e3 * id.tracker_noise, id.fit_z,
-      id.condition);
+      1e3 * id.unexplained, id.condition);
   const CrossValidation& cv = id.cross_validation;
   if (cv.folds > 0 && cv.predicted == 0)
     t += fmt::format(
@@ -238,6 +242,14 @@ void json_fit(JsonWriter& j, const Report& r) {
   json_number(j, "tracker_noise", id.tracker_noise, true);
   json_number(j, "scatter", id.scatter, true);
   json_number(j, "noise_ratio", id.sigma / id.tracker_noise, id.fitted);
+  json_number(j, "unexplained", id.unexplained, id.fitted);
+  j.key("diagnosis").begin_array(true);
+  for (const Identification::EffectDiagnosis& d : id.diagnosis) {
+    j.begin_object().field("effect", d.effect);
+    json_number(j, "z", d.z, true);
+    j.end_object();
+  }
+  j.end_array();
   j.key("fit_test").begin_object();
   json_number(j, "statistic", id.fit_statistic, id.fitted);
   j.field("dof", id.fit_dof);
@@ -566,7 +578,9 @@ Command make_identify_command(CLI::App& root) {
   app->add_option("--effects", o->effects,
                   "The legs' effects fitted besides the geometry, comma-separated: load (one compliance under the "
                   "configuration's load), play (each leg's, from approaches from both sides), heat (each leg's drift "
-                  "over the run and a common curvature); none; auto: those the data show (each at 5 sigma)")
+                  "over the run and a common curvature; with the log's temperature column, each leg's expansion per "
+                  "kelvin and the lead's, kept in the corrected configuration); none; auto: those the data show "
+                  "(each at 5 sigma)")
       ->check([](const std::string& v) {
         if (v == "auto") return std::string();
         try {

@@ -30,6 +30,8 @@ struct StationsOptions {
   std::string out;
   std::string gcode;       // the run as a LinuxCNC program
   std::string stream_out;  // the run as `hexatwist stream` input
+  double both_sides_mm = 0.0;
+  int reference_every = 0;
   bool json = false;
 };
 
@@ -58,6 +60,11 @@ StationPlanSpec plan_spec(const Model& model, const StationsOptions& o) {
   spec.run.translation = range[0];
   spec.run.rotation = deg2rad(range[1]);
   spec.run.seed = o.seed;
+  // How the run visits the planned stations (run_options' --both-sides-mm and --reference-every).
+  check_option(o.both_sides_mm >= 0.0 && o.both_sides_mm <= kMaxApproach * 1e3, "--both-sides-mm", o.both_sides_mm,
+               fmt::format("0 to {:g} mm", kMaxApproach * 1e3));
+  spec.run.approach = o.both_sides_mm * 1e-3;
+  spec.run.reference_every = o.reference_every;
   const int fewest = min_planned_stations(model, spec);
   check_option(
       o.count >= fewest && o.count <= kMaxStations, "--count", o.count,
@@ -123,9 +130,12 @@ std::string text_report(const StationsOptions& o, const Model& model, const Stat
   t += quality_row("planned", plan.planned);
   t += quality_row(fmt::format("random (seed {})", o.seed), plan.random);
   t += fmt::format(
-      "wrote {}: home, the {} stations, home; {:g} s at each, straight jerk-limited moves, {:.2f} s at {:g} Hz (read "
-      "by synth and identify with --trajectory)\n",
-      o.out, plan.planned.stations.size(), spec.run.dwell, run.duration(), o.rate);
+      "wrote {}: home, the {} stations{}{}, home; {:g} s at each, straight jerk-limited moves, {:.2f} s at {:g} Hz "
+      "(read by synth and identify with --trajectory)\n",
+      o.out, plan.planned.stations.size(),
+      spec.run.approach > 0.0 ? fmt::format(" each from {:g} mm above and below", 1e3 * spec.run.approach) : "",
+      spec.run.reference_every > 0 ? fmt::format(", home after every {}", spec.run.reference_every) : "",
+      spec.run.dwell, run.duration(), o.rate);
   if (!o.gcode.empty())
     t += fmt::format(
         "wrote {}: the same run as a LinuxCNC program (mm, deg; each move timed as planned, G93) for hexatwistkins\n",
@@ -174,7 +184,9 @@ std::string json_report(const StationsOptions& o, const Model& model, const Stat
   j.key("random");
   quality_json(j, plan.random);
   j.key("run").begin_object().field("out", o.out).field("rate", o.rate).field("duration", run.duration());
-  j.field("dwell", spec.run.dwell).field("gcode", o.gcode).field("stream_out", o.stream_out).end_object();
+  j.field("dwell", spec.run.dwell).field("approach", spec.run.approach);
+  j.field("reference_every", spec.run.reference_every);
+  j.field("gcode", o.gcode).field("stream_out", o.stream_out).end_object();
   return j.end_object().str();
 }
 
@@ -257,6 +269,14 @@ Command make_stations_command(CLI::App& root) {
       ->capture_default_str();
   app->add_option("--rate", o->rate, "Rows of the run per second [Hz]; must divide the control rate")
       ->capture_default_str();
+  app->add_option("--both-sides-mm", o->both_sides_mm,
+                  "The run approaches each station from both sides, from this far above it along z (every leg "
+                  "shortening) and then below (lengthening), for identify's play [mm], 0 to 50; a side outside the "
+                  "limits is left out")
+      ->check(CLI::Range(0.0, kMaxApproach * 1e3));
+  app->add_option("--reference-every", o->reference_every,
+                  "The run visits home again after every N stations, a reference repeated for identify's heat")
+      ->check(CLI::Range(1, 10000));
   app->add_option("--out", o->out, "The run to write (t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad)")->required();
   app->add_option("--gcode", o->gcode,
                   "Also write the run as a LinuxCNC G-code program for hexatwistkins (X Y Z mm, Z absolute; A B C "

@@ -37,6 +37,7 @@ struct SynthOptions {
   std::string play_um;
   std::string temperature_rise_k;
   std::string expansion_ppm_per_k = "11.5,11.5";
+  bool temperature_column = false;
   std::string out;
   std::string run_out;
 };
@@ -221,20 +222,26 @@ SynthesisOptions synthesis_options(const SynthOptions& o, const Rig& rig) {
     so.errors.length_expansion = expansion[0] * 1e-6;
     so.errors.lead_expansion = expansion[1] * 1e-6;
   }
+  so.log_temperature = o.temperature_column;
   return so;
 }
 
 // The log like a tracker's export: millimetres with a unit suffix, 1 nm resolution (noise-free
 // logs stay exact enough), a target column when there are several targets.
+// With the machine's temperature, a temperature_c column (0.001 K resolution).
 std::string log_csv(const SyntheticLog& log, bool targets) {
   fmt::memory_buffer b;
-  fmt::format_to(std::back_inserter(b), "{}", targets ? "t_s,target,x_mm,y_mm,z_mm\n" : "t_s,x_mm,y_mm,z_mm\n");
+  const bool temperature = !log.log.temperatures.empty();
+  fmt::format_to(std::back_inserter(b), "{}{}\n", targets ? "t_s,target,x_mm,y_mm,z_mm" : "t_s,x_mm,y_mm,z_mm",
+                 temperature ? ",temperature_c" : "");
   for (std::size_t k = 0; k < log.log.points_T.size(); ++k) {
     const Vector3d p = 1e3 * log.log.points_T[k];
     fmt::format_to(std::back_inserter(b), "{:.6f},", log.log.stamps[k]);
     if (targets)
       fmt::format_to(std::back_inserter(b), "{},", log.log.target_names[static_cast<std::size_t>(log.log.targets[k])]);
-    fmt::format_to(std::back_inserter(b), "{:.6f},{:.6f},{:.6f}\n", p.x(), p.y(), p.z());
+    fmt::format_to(std::back_inserter(b), "{:.6f},{:.6f},{:.6f}", p.x(), p.y(), p.z());
+    if (temperature) fmt::format_to(std::back_inserter(b), ",{:.3f}", log.log.temperatures[k]);
+    fmt::format_to(std::back_inserter(b), "\n");
   }
   return fmt::to_string(b);
 }
@@ -367,6 +374,9 @@ Command make_synth_command(CLI::App& root) {
                   "With --temperature-rise-k: the real legs' expansion of the length between the joints and of the "
                   "screw's lead [ppm/K] (steel: 11.5)")
       ->capture_default_str();
+  app->add_flag("--temperature-column", o->temperature_column,
+                "The log gets the machine's temperature at each point, the legs' mean [degC], as a temperature_c "
+                "column: identify then fits the legs' expansion per kelvin from it");
   app->add_flag("--flip-sign", o->flip_sign, "The real twist term has the opposite sign (other thread hand)");
   app->add_option("--offsets-mm", o->offsets_mm,
                   "Zero-length offset of each leg's motor-side length [mm]: one number B draws each uniformly in "

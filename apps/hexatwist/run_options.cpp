@@ -26,15 +26,23 @@ Run build_run(const Config& config, const RunOptions& o) {
     StationsSpec spec;
     spec.count = o.stations;
     spec.seed = o.station_seed;
+    check_option(o.both_sides_mm >= 0.0 && o.both_sides_mm <= kMaxApproach * 1e3, "--both-sides-mm", o.both_sides_mm,
+                 fmt::format("0 to {:g} mm", kMaxApproach * 1e3));
+    spec.approach = o.both_sides_mm * 1e-3;
+    spec.reference_every = o.reference_every;
     try {
       run.test.trajectory = stations_trajectory(config.rig.model(), strategy_of(o), spec, dt);
+    } catch (const ParameterError& e) {
+      throw ExitError(kExitBadInput, e.what());
     } catch (const Error& e) {
       throw ExitError(kExitOutOfLimit, fmt::format("--stations: {}", e.what()));
     }
     run.test.name = fmt::format("stations{}", o.stations);
     run.test.label = fmt::format("{} stations", o.stations);
-    run.test.description =
-        fmt::format("{} random stations (seed {}), {:g} s at each", o.stations, o.station_seed, spec.dwell);
+    run.test.description = fmt::format(
+        "{} random stations (seed {}){}{}, {:g} s at each", o.stations, o.station_seed,
+        spec.approach > 0.0 ? fmt::format(", each from {:g} mm above and below", o.both_sides_mm) : "",
+        spec.reference_every > 0 ? fmt::format(", home after every {}", spec.reference_every) : "", spec.dwell);
     run.commanded = timed_poses(run.test.trajectory);
     return run;
   }
@@ -64,6 +72,17 @@ void add_run_options(CLI::App& app, RunOptions& o) {
       "each reachable inside the limits), home; 1 s at each, straight jerk-limited moves");
   app.add_option("--station-seed", o.station_seed, "Seed of the stations (the same seed gives the same run)")
       ->capture_default_str();
+  auto* both = app.add_option("--both-sides-mm", o.both_sides_mm,
+                              "With --stations: each station approached from both sides, from this far above it along "
+                              "z (every leg shortening) and then below (lengthening), for identify's play [mm], "
+                              "0 to 50; a side outside the limits is left out");
+  auto* every = app.add_option("--reference-every", o.reference_every,
+                               "With --stations: home again after every N stations, a reference repeated through the "
+                               "run for identify's heat (where the moves stay inside the limits)");
+  both->needs(stations);
+  every->needs(stations);
+  both->check(CLI::Range(0.0, kMaxApproach * 1e3));
+  every->check(CLI::Range(1, 10000));
   test->excludes(trajectory);
   test->excludes(stations);
   trajectory->excludes(stations);
@@ -85,6 +104,10 @@ void add_log_options(CLI::App& app, LogOptions& o) {
   app.add_option("--rate", o.rate, "Samples per second of an indexed log [Hz]")->each([&o](const std::string&) {
     o.rate_given = true;
   });
+  app.add_option("--temperature-column", o.temperature_column,
+                 "Header name of the machine's temperature column [degC] (a _c suffix allowed); default: a column "
+                 "named temperature or temperature_c, if any. With it, identify's heat fits each leg's expansion per "
+                 "kelvin and the lead's, and the corrected configuration keeps them");
   app.add_option("--time-offset", o.time_offset,
                  "The log's time (or index/rate) when the trajectory's time is 0 [s], or auto: found with the log's "
                  "clock rate from the rests of the run and of the log (a log that starts whenever the tracker was "
@@ -129,6 +152,7 @@ TimeAlignment log_alignment(const LogOptions& o, const Run& run, PointLog& log, 
   const double front = run.commanded.t.front(), back = run.commanded.t.back();
   PointLog kept = log;
   kept.stamps.clear(), kept.points_T.clear(), kept.targets.clear(), kept.lines.clear(), kept.stamp_columns.clear();
+  kept.temperatures.clear();
   for (std::size_t k = 0; k < t.size(); ++k) {
     if (!(t[k] >= front && t[k] <= back)) {
       ++dropped;
@@ -139,6 +163,7 @@ TimeAlignment log_alignment(const LogOptions& o, const Run& run, PointLog& log, 
     if (k < log.targets.size()) kept.targets.push_back(log.targets[k]);
     kept.lines.push_back(log.lines[k]);
     if (k < log.stamp_columns.size()) kept.stamp_columns.push_back(log.stamp_columns[k]);
+    if (k < log.temperatures.size()) kept.temperatures.push_back(log.temperatures[k]);
   }
   log = std::move(kept);
   return alignment;
@@ -190,6 +215,7 @@ PointLogFormat log_format(const LogOptions& o) {
   f.x_column = names[1];
   f.y_column = names[2];
   f.z_column = names[3];
+  f.temperature_column = o.temperature_column;
   if (!o.units.empty()) f.length_unit = o.units == "mm" ? 1e-3 : 1.0;
   f.indexed = o.index;
   if (o.index && !o.rate_given)
@@ -206,7 +232,13 @@ PointLog read_point_log(const LogOptions& o, const PointLogFormat& format) {
   try {
     return parse_point_log(text, o.points, format);
   } catch (const Error& e) {
-    throw ExitError(kExitBadInput, e.what());
+    // A column the options name, not found or with a bad cell: the message names the option too.
+    const std::string what = e.what();
+    const auto names = [&](const std::string& column) {
+      return !column.empty() && what.find(fmt::format("column '{}'", column)) != std::string::npos;
+    };
+    if (names(format.temperature_column)) throw ExitError(kExitBadInput, fmt::format("--temperature-column: {}", what));
+    throw ExitError(kExitBadInput, what);
   }
 }
 

@@ -18,6 +18,8 @@ struct RunOptions {
   std::string trajectory;
   int stations = 0;
   std::uint64_t station_seed = 1;
+  double both_sides_mm = 0.0;  // StationsSpec::approach [mm]
+  int reference_every = 0;     // StationsSpec::reference_every
   std::string strategy = "compensated";
 };
 
@@ -36,7 +38,8 @@ struct Run {
 /// that cannot be placed inside the limits.
 Run build_run(const Config& config, const RunOptions& o);
 
-/// Adds --config, --test, --trajectory, --stations, --station-seed and --strategy.
+/// Adds --config, --test, --trajectory, --stations, --station-seed, --both-sides-mm, --reference-every
+/// and --strategy.
 void add_run_options(CLI::App& app, RunOptions& o);
 
 /// How to read a point log and place it in the run's time (measure and identify).
@@ -46,11 +49,12 @@ struct LogOptions {
   std::string units;
   bool index = false;
   double rate = 0.0;
-  bool rate_given = false;        // --rate was given (0 is a value refused, not "none")
-  std::string time_offset = "0";  // seconds, or "auto": from the rests (log_clock.hpp)
+  bool rate_given = false;         // --rate was given (0 is a value refused, not "none")
+  std::string time_offset = "0";   // seconds, or "auto": from the rests (log_clock.hpp)
+  std::string temperature_column;  // empty: a column named temperature or temperature_c, if any
 };
 
-/// Adds --points, --columns, --units, --index, --rate and --time-offset.
+/// Adds --points, --columns, --units, --index, --rate, --temperature-column and --time-offset.
 void add_log_options(CLI::App& app, LogOptions& o);
 
 /// The log's format from the options; ExitError(2) naming the option at fault.

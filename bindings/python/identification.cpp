@@ -172,6 +172,7 @@ py::dict result(const Identification& id, Status s) {
                                {"scatter", id.scatter},
                                {"fit_statistic", id.fit_statistic},
                                {"fit_z", id.fit_z},
+                               {"unexplained", id.unexplained},
                                {"rms_before", id.rms_before},
                                {"rms_after", id.rms_after},
                                {"max_after", id.max_after},
@@ -180,6 +181,9 @@ py::dict result(const Identification& id, Status s) {
                                {"condition", id.condition}})
     d[key] = v;
   d["fit_dof"] = id.fit_dof;
+  py::dict diagnosis;  // effect -> drop of the fit statistic [sigma], on a refusal
+  for (const Identification::EffectDiagnosis& e : id.diagnosis) diagnosis[py::str(e.effect)] = e.z;
+  d["diagnosis"] = diagnosis;
   d["max_after_index"] = id.max_after_index;
   d["undetermined"] = id.undetermined;
   py::list worst;
@@ -233,7 +237,7 @@ py::dict result(const Identification& id, Status s) {
 py::dict identify_py(const Model& model, const py::object& motor, const py::object& points, const py::object& targets,
                      const std::string& calibration, const std::string& lead_effect, const std::string& axes,
                      const py::object& tracker_noise, int folds, int accuracy_poses, const std::string& effects,
-                     const py::object& times, const py::object& approach) {
+                     const py::object& times, const py::object& approach, const py::object& temperatures) {
   std::size_t nm = 0, np = 0;
   const std::vector<double> m = rows(motor, 6, "motor", nm);
   const std::vector<double> p = rows(points, 3, "points", np);
@@ -247,11 +251,16 @@ py::dict identify_py(const Model& model, const py::object& motor, const py::obje
     raise_input(e.what());
   }
   std::vector<Observation> obs(nm);
-  std::vector<double> t, d;
+  std::vector<double> t, d, c;
   if (!times.is_none()) {
     std::size_t nt = 0;
     t = rows(times, 1, "times", nt);
     if (nt != nm) raise_input("times: expected one per observation");
+  }
+  if (!temperatures.is_none()) {
+    std::size_t nc = 0;
+    c = rows(temperatures, 1, "temperatures", nc);
+    if (nc != nm) raise_input("temperatures: expected one per observation");
   }
   if (!approach.is_none()) {
     std::size_t nd = 0;
@@ -263,6 +272,7 @@ py::dict identify_py(const Model& model, const py::object& motor, const py::obje
     obs[k].p_T = Eigen::Map<const Vector3d>(p.data() + 3 * k);
     obs[k].target = target[k];
     if (!t.empty()) obs[k].time = t[k];
+    if (!c.empty()) obs[k].temperature = c[k];
     if (!d.empty()) obs[k].approach = Eigen::Map<const Vector6d>(d.data() + 6 * k);
   }
   Identification id;
@@ -287,7 +297,7 @@ void expose_identification(py::module_& m) {
         py::arg("targets") = py::none(), py::arg("calibration") = "geometry", py::arg("lead_effect") = "travel",
         py::arg("axes") = "auto", py::arg("tracker_noise") = py::none(), py::arg("folds") = 5,
         py::arg("accuracy_poses") = 1000, py::arg("effects") = "auto", py::arg("times") = py::none(),
-        py::arg("approach") = py::none());
+        py::arg("approach") = py::none(), py::arg("temperatures") = py::none());
   m.def("_corrected_config", &corrected_config_py, py::arg("rig"), py::arg("corrected"), py::arg("header") = "");
 }
 

@@ -41,6 +41,8 @@ class PointLog(Result):
     """The targets' names in order of first appearance."""
     lines: Int32Array
     """(K,) each point's line in the file (1-based)."""
+    temperatures: FloatArray
+    """(K,) the machine's temperature at each point [degC], from a temperature column; (0,) without one."""
     source: str
     """The log's name in messages."""
 
@@ -81,6 +83,9 @@ class Observations(Result):
     """(K,) target indices (0: the observation point)."""
     time: FloatArray
     """(K,) each observation's time in the run [s] (for identify's heat effect)."""
+    temperature: FloatArray
+    """(K,) the machine's temperature at each observation [degC] (NaN without a temperature column;
+    with them, identify's heat fits each leg's expansion per kelvin)."""
     approach: FloatArray
     """(K, 6) each leg's approach to the station: the last monotone run of its command, positive
     lengthening, negative shortening [m] (for identify's play effect)."""
@@ -242,6 +247,11 @@ class Identification(Result):
     fit_statistic: float
     fit_z: float
     """The model-fit test's normal deviate."""
+    unexplained: float
+    """What the model leaves beyond the tracker's noise, per point and coordinate [m]."""
+    diagnosis: dict[str, float]
+    """On a refusal: each effect not fitted ("load", "play", "heat"), its drop of the fit statistic
+    when added [sigma] (NaN where it cannot be fitted)."""
     rms_before: float
     """RMS 3-D residual of the nominal model after Kabsch [m]."""
     rms_after: float
@@ -290,12 +300,14 @@ class Registration(Result):
 
 
 def read_point_log(path_or_text: Union[str, os.PathLike[str]], time_column: str = "t", length_unit: float = 0.0,
-                   indexed: bool = False, target_column: str = "") -> PointLog:
+                   indexed: bool = False, target_column: str = "",
+                   temperature_column: str = "") -> PointLog:
     """A laser tracker's point log (CSV with a header; point_log.hpp). Units come from the column
     suffixes (``x_mm``, ``t_s``) or ``length_unit`` [m per unit]; a ``target`` column (or
-    ``target_column``) names each row's target. Raises ConfigError with the library's
+    ``target_column``) names each row's target; a ``temperature`` or ``temperature_c`` column (or
+    ``temperature_column``) gives the machine's temperature [degC]. Raises ConfigError with the library's
     "source:line:column: ..." message."""
-    d = _core._read_point_log(path_or_text, time_column, length_unit, indexed, target_column)
+    d = _core._read_point_log(path_or_text, time_column, length_unit, indexed, target_column, temperature_column)
     return PointLog(**_fields(d, target_names=tuple(d["target_names"])))
 
 
@@ -306,23 +318,28 @@ def measured_test(rig: RigLike = None, test: Literal["Lz", "Lx", "Rz", "Ry"] = "
 
 def stations_run(rig: RigLike = None, count: int = 40, seed: int = 1,
                  strategy: Strategy = "compensated", translation: float = 0.25,
-                 rotation: float = float(np.radians(15.0)), stations: ArrayLike | None = None) -> StationsRun:
+                 rotation: float = float(np.radians(15.0)), stations: ArrayLike | None = None,
+                 approach: float = 0.0, reference_every: int = 0) -> StationsRun:
     """A calibration run (stations.hpp): home, ``count`` random stations within +-``translation`` [m] and
     +-``rotation`` [rad] inside every limit (the same seed gives the command line's ``--stations N
-    --station-seed S`` run), or the given ``stations`` (N, 6) [m, rad]; 1 s at each, then home."""
-    return StationsRun(**_core._stations_run(rig, count, seed, strategy, translation, rotation, stations))
+    --station-seed S`` run), or the given ``stations`` (N, 6) [m, rad]; 1 s at each, then home. With
+    ``approach`` [m] each station is approached from that far above and below (``--both-sides-mm``),
+    with ``reference_every`` N home is visited again after every N stations (``--reference-every``)."""
+    return StationsRun(**_core._stations_run(rig, count, seed, strategy, translation, rotation, stations, approach,
+                                             reference_every))
 
 
 def observations_at_rest(model: Model, t: ArrayLike, poses: ArrayLike, stamps: ArrayLike, points: ArrayLike,
                          targets: ArrayLike | None = None, time_offset: float = 0.0,
                          strategy: Strategy = "compensated",
-                         settle: float = 0.25) -> Observations:
+                         settle: float = 0.25, temperatures: ArrayLike | None = None) -> Observations:
     """The log points (``stamps`` (K,) [s], ``points`` (K, 3) [m, T], ``targets``) taken while the
     commanded run (``t`` (T,) [s], ``poses`` (T, 6)) had been still for ``settle`` [s], each with the
-    motor-side lengths the model commands there. ``time_offset``: log time at run time 0 [s]."""
+    motor-side lengths the model commands there. ``time_offset``: log time at run time 0 [s];
+    ``temperatures`` (K,) [degC]: the log's temperature column, if any."""
     d = _core._observations_at_rest(model, np.asarray(t, dtype=np.float64), poses,
                                     np.asarray(stamps, dtype=np.float64), points, targets, time_offset, strategy,
-                                    settle)
+                                    settle, None if temperatures is None else np.asarray(temperatures, dtype=np.float64))
     return Observations(**_fields(d, index=np.asarray(d["index"], dtype=np.int_)))
 
 
@@ -416,7 +433,7 @@ def identify(model: Model, motor: ArrayLike, points: ArrayLike, targets: ArrayLi
              calibration: Literal["geometry", "basic"] = "geometry", lead_effect: Literal["travel", "twist"] = "travel",
              axes: Literal["auto", "none", "all"] = "auto", tracker_noise: float | None = None, folds: int = 5,
              accuracy_poses: int = 1000, effects: str = "auto", times: ArrayLike | None = None,
-             approach: ArrayLike | None = None) -> Identification:
+             approach: ArrayLike | None = None, temperatures: ArrayLike | None = None) -> Identification:
     """Calibrates the platform (identification.hpp, theory §13) from observations ``motor`` (K, 6) [m],
     ``points`` (K, 3) [m, T] and their ``targets`` (K,) int (None: all the observation point), with the
     library's decisions: the same status and estimate as ``hexatwist identify`` (whose defaults these are).
@@ -429,11 +446,14 @@ def identify(model: Model, motor: ArrayLike, points: ArrayLike, targets: ArrayLi
     ``hexatwist identify --effects``; heat needs each
     observation's ``times`` (K,) [s], play their ``approach`` (K, 6) [m] (both as
     ``observations_at_rest`` gives them; without times, heat is left out, and without approaches the
-    stations' order decides; pass both to reach the CLI's result). A refusal is
+    stations' order decides; pass both to reach the CLI's result). With ``temperatures`` (K,) [degC]
+    (``observations_at_rest``'s ``temperature``, from the log's temperature column), heat fits each
+    leg's expansion per kelvin and the lead's, which the corrected configuration keeps. A refusal is
     the status (with a reason and a hint), not an exception."""
     column = None if times is None else np.asarray(times, dtype=np.float64).reshape(-1, 1)
+    celsius = None if temperatures is None else np.asarray(temperatures, dtype=np.float64).reshape(-1, 1)
     return _identification(_core._identify(model, motor, points, targets, calibration, lead_effect, axes,
-                                           tracker_noise, folds, accuracy_poses, effects, column, approach))
+                                           tracker_noise, folds, accuracy_poses, effects, column, approach, celsius))
 
 
 def register_points(points_T: ArrayLike, points_B: ArrayLike, max_condition: float = 1e4) -> Registration:

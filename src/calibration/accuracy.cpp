@@ -9,16 +9,44 @@
 #include "calibration/evaluator.hpp"
 #include "calibration/random.hpp"
 #include "hexatwist/calibration/identification.hpp"
+#include "hexatwist/calibration/observations.hpp"
 #include "hexatwist/error.hpp"
+#include "hexatwist/kinematics/leg_effects.hpp"
 #include "kinematics/geometry.hpp"
 
 namespace hexatwist {
 namespace {
 
+// The length shifts per effect parameter at a pose of the corrected platform (6 x
+// set.effects().count(), as EffectRegressors): those the corrected configuration keeps, the
+// load's (the static forces at the pose less at home) and the plays' (the approach straight from
+// home, a run longer than any play); the run's drift is not kept (zero columns).
+Eigen::Matrix<double, 6, Eigen::Dynamic> kept_effects(const Model& nominal, const ParameterSet& set, const FkResult& fk,
+                                                      const Vector6d& command) {
+  const EffectFit& fit = set.effects();
+  Eigen::Matrix<double, 6, Eigen::Dynamic> r = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, fit.count());
+  int k = 0;
+  if (fit.load) {
+    Vector6d force;
+    if (static_leg_forces(nominal, nominal.spec().static_load, fk.legs, force) == Status::Ok)
+      r.col(k) = force - nominal.reference_force();
+    ++k;
+  }
+  if (fit.play) {
+    const Vector6d& home = nominal.geometry().home_direction;
+    for (int i = 0; i < kLegs; ++i) {
+      const double run = command[i] - nominal.home_command()[i];
+      const double sense = std::abs(run) > kSameCommand ? (run > 0.0 ? 1.0 : -1.0) : home[i];
+      r(i, k + i) = -0.5 * (sense - home[i]);
+    }
+  }
+  return r;
+}
+
 // The predicted point error at pose q: sqrt(trace(G C G^T)), G = d A_B / d theta at the commands of
-// q held fixed (the error the parameters' uncertainty leaves). NaN outside a limit; a failed
-// forward kinematics is returned.
-Status error_at(const Model& platform, const ParameterSet& set, const Eigen::VectorXd& theta,
+// q held fixed (the error the parameters' uncertainty leaves, the kept effects' included). NaN
+// outside a limit; a failed forward kinematics is returned.
+Status error_at(const Model& platform, const Model& nominal, const ParameterSet& set, const Eigen::VectorXd& theta,
                 const Eigen::MatrixXd& covariance, const Vector6d& q, double& error,
                 Eigen::Matrix<double, 3, Eigen::Dynamic>* G_out = nullptr, Vector3d* A_out = nullptr) {
   error = std::numeric_limits<double>::quiet_NaN();
@@ -31,7 +59,8 @@ Status error_at(const Model& platform, const ParameterSet& set, const Eigen::Vec
       s != Status::Ok)
     return s;
   Eigen::Matrix<double, 6, Eigen::Dynamic> dx;
-  if (const Status s = detail::pose_sensitivity(platform, set, fk, command, dx); s != Status::Ok) return s;
+  const Eigen::Matrix<double, 6, Eigen::Dynamic> effects = kept_effects(nominal, set, fk, command);
+  if (const Status s = detail::pose_sensitivity(platform, set, fk, command, dx, &effects); s != Status::Ok) return s;
   const Eigen::Matrix<double, 3, Eigen::Dynamic> G = detail::point_sensitivity(set, fk, dx, theta, 0);
   error = std::sqrt(std::max(0.0, (G * covariance * G.transpose()).trace()));
   if (G_out != nullptr) *G_out = G;
@@ -71,10 +100,11 @@ Status predicted_errors(const ParameterSet& set, const Eigen::VectorXd& theta, d
   if (covariance.rows() != set.platform_size() || covariance.cols() != set.platform_size())
     throw Error(fmt::format("predicted errors: the covariance is {}x{}, expected {}x{}", covariance.rows(),
                             covariance.cols(), set.platform_size(), set.platform_size()));
-  const Model platform(set.platform(theta, sign));
+  const Model platform(set.platform(theta, sign)), nominal(set.nominal());
   errors.assign(poses.size(), std::numeric_limits<double>::quiet_NaN());
   for (std::size_t k = 0; k < poses.size(); ++k)
-    if (const Status s = error_at(platform, set, theta, covariance, poses[k], errors[k]); s != Status::Ok) return s;
+    if (const Status s = error_at(platform, nominal, set, theta, covariance, poses[k], errors[k]); s != Status::Ok)
+      return s;
   return Status::Ok;
 }
 
@@ -88,7 +118,7 @@ Status predicted_accuracy(const ParameterSet& set, const Eigen::VectorXd& theta,
   if (!(low.allFinite() && high.allFinite()) || poses < 1) return Status::NotIdentifiable;
   // Poses drawn uniformly in the range until `poses` of them are inside every limit (at most ten
   // draws per pose: a range mostly outside the limits gives fewer).
-  const Model platform(set.platform(theta, sign));
+  const Model platform(set.platform(theta, sign)), nominal(set.nominal());
   detail::Random rng(seed);
   std::vector<double> found;
   std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic>> G;
@@ -99,7 +129,8 @@ Status predicted_accuracy(const ParameterSet& set, const Eigen::VectorXd& theta,
     double e = 0.0;
     Eigen::Matrix<double, 3, Eigen::Dynamic> G_q;
     Vector3d A_q;
-    if (const Status s = error_at(platform, set, theta, covariance, q, e, &G_q, &A_q); s != Status::Ok) return s;
+    if (const Status s = error_at(platform, nominal, set, theta, covariance, q, e, &G_q, &A_q); s != Status::Ok)
+      return s;
     if (std::isnan(e)) continue;
     found.push_back(e);
     G.push_back(G_q);

@@ -196,11 +196,21 @@ EffectRegressors effect_regressors(const ParameterSet& set, std::span<const Obse
     t0 = std::min(t0, o.time);
     t1 = std::max(t1, o.time);
   }
-  for (std::size_t g = 0; g < groups.station.size(); ++g)
+  // Each station's temperature above the run's first (heat from the log's temperatures).
+  std::vector<double> warming(stations, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t g = 0; g < groups.station.size(); ++g) {
     time[static_cast<std::size_t>(groups.station[g])] = observations[groups.first[g]].time;
-  if (fit.heat && !(std::isfinite(t0) && std::isfinite(t1) && t1 > t0 &&
-                    std::all_of(observations.begin(), observations.end(),
-                                [](const Observation& o) { return std::isfinite(o.time); })))
+    warming[static_cast<std::size_t>(groups.station[g])] =
+        observations[groups.first[g]].temperature - fit.reference_temperature;
+  }
+  if (fit.heat && fit.measured &&
+      !(std::isfinite(fit.reference_temperature) &&
+        std::all_of(warming.begin(), warming.end(), [](double w) { return std::isfinite(w); })))
+    return fail("heat: the legs' expansion needs each observation's temperature and the run's first");
+  if (fit.heat && !fit.measured &&
+      !(std::isfinite(t0) && std::isfinite(t1) && t1 > t0 &&
+        std::all_of(observations.begin(), observations.end(),
+                    [](const Observation& o) { return std::isfinite(o.time); })))
     return fail("heat: the legs' drift needs each observation's time, over a run of some duration");
   if (fit.load && !nominal.spec().static_load.present)
     return fail("load: the legs' forces need the configuration's load (its load and mechanism sections)");
@@ -219,7 +229,13 @@ EffectRegressors effect_regressors(const ParameterSet& set, std::span<const Obse
       r.col(k++) = force - nominal.reference_force();
     }
     if (fit.play) k += kLegs;  // play_terms, at each evaluation's plays
-    if (fit.heat) {
+    if (fit.heat && fit.measured) {
+      const double dT = warming[s];  // k_i dT + a_P dT (u_i - h_i)
+      for (int i = 0; i < kLegs; ++i) {
+        r(i, k + i) = dT;
+        r(i, k + kLegs) = dT * (station_motor[s][i] - nominal.home_command()[i]);
+      }
+    } else if (fit.heat) {
       const double f = (time[s] - t0) / (t1 - t0);
       for (int i = 0; i < kLegs; ++i) {
         r(i, k + i) = f;

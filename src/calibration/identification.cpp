@@ -137,7 +137,7 @@ void axis_observability(const Model& nominal, const IdentificationOptions& optio
   AxisSelection all;
   all.fill(true);
   const ParameterSet every(nominal, CalibrationModel::Geometry, options.lead_effect, all, fitted.targets(),
-                           options.leads, options.effects);
+                           options.leads, fitted.effects());
   // The estimate in the larger layout: the same values, the axes at zero.
   Eigen::VectorXd theta = Eigen::VectorXd::Zero(every.size());
   theta.head(fitted.axis_index()) = id.estimate.head(fitted.axis_index());
@@ -187,6 +187,9 @@ Status fit_statistics(const ParameterSet& set, Evaluator& evaluator, std::span<c
   out.fit_statistic = between / var;
   const double d2 = std::isnan(options.tracker_noise) ? static_cast<double>(groups.scatter_dof) : 0.0;
   out.fit_z = detail::f_normal_deviate(out.fit_statistic / out.fit_dof, out.fit_dof, d2);
+  // The systematic part: sum over groups of count |mean error|^2 is the statistic's excess over its
+  // expectation (dof noise variances), per point and coordinate.
+  out.unexplained = std::sqrt(std::max(0.0, between - out.fit_dof * var) / (3.0 * K));
   std::vector<StationResidual> shares;
   for (std::size_t g = 0; g < groups.station.size(); ++g) {
     const Vector3d mean = e.segment<3>(3 * static_cast<Eigen::Index>(g)) / std::sqrt(groups.count[g]);
@@ -325,7 +328,7 @@ Status fit_both_senses(const Model& nominal, ParameterSet& set, std::span<const 
     }
     if (any) {
       ParameterSet with_axes(nominal, CalibrationModel::Geometry, options.lead_effect, chosen, set.targets(),
-                             options.leads, options.effects);
+                             options.leads, set.effects());
       Eigen::VectorXd theta = Eigen::VectorXd::Zero(with_axes.size());
       theta.head(set.axis_index()) = out.estimate.head(set.axis_index());
       theta.tail(with_axes.size() - with_axes.target_index()) = out.estimate.tail(set.size() - set.target_index());
@@ -348,18 +351,47 @@ Status fit_both_senses(const Model& nominal, ParameterSet& set, std::span<const 
 
 namespace {
 
-// Forward selection of the legs' effects (IdentificationOptions::auto_effects, theory §13b).
-Status identify_choosing_effects(const Model& nominal, std::span<const Observation> observations, Identification& out,
-                                 const IdentificationOptions& options) {
+Status identify_fixed(const Model& nominal, std::span<const Observation> observations, Identification& out,
+                      const IdentificationOptions& options, bool diagnose);
+
+constexpr const char* kEffectNames[3] = {"load", "play", "heat"};
+
+// One more effect `e` (0 load, 1 play, 2 heat) on top of `chosen`: the fit, and the drop of the fit
+// statistic from `base_statistic` as a normal deviate (chi-square on the effect's parameters if it
+// is absent); NaN where the solve cannot carry it (undetermined, not converging: one that absorbs
+// another error of the model).
+double effect_drop(const Model& nominal, std::span<const Observation> observations, const IdentificationOptions& trial,
+                   const EffectFit& chosen, int e, double base_statistic, Identification& fit) {
+  EffectFit candidate = chosen;
+  (e == 0 ? candidate.load : e == 1 ? candidate.play : candidate.heat) = true;
+  IdentificationOptions o = trial;
+  o.effects = candidate;
+  (void)identify_fixed(nominal, observations, fit, o, false);
+  const bool usable =
+      fit.status == Status::Ok || fit.status == Status::ModelMismatch || fit.status == Status::SignUndecided;
+  if (!fit.fitted || !usable || !std::isfinite(fit.fit_statistic)) return std::numeric_limits<double>::quiet_NaN();
+  const double dof = candidate.count() - chosen.count();
+  return (base_statistic - fit.fit_statistic - dof) / std::sqrt(2.0 * dof);
+}
+
+// Options for the trial fits of effect_drop: no cross-validation, no accuracy map.
+IdentificationOptions trial_options(const IdentificationOptions& options) {
   IdentificationOptions trial = options;
   trial.auto_effects = false;
   trial.folds = 0;
   trial.accuracy_poses = 0;
+  return trial;
+}
+
+// Forward selection of the legs' effects (IdentificationOptions::auto_effects, theory §13b).
+Status identify_choosing_effects(const Model& nominal, std::span<const Observation> observations, Identification& out,
+                                 const IdentificationOptions& options) {
+  IdentificationOptions trial = trial_options(options);
   trial.effects = EffectFit{};
   Identification base;
   std::string log;
   // On the basic model the joints' errors would go into the effects: none is chosen there.
-  if (options.model == CalibrationModel::Geometry) (void)identify(nominal, observations, base, trial);
+  if (options.model == CalibrationModel::Geometry) (void)identify_fixed(nominal, observations, base, trial, false);
   if (options.model != CalibrationModel::Geometry)
     log = "the basic model keeps the joints as configured, whose errors the effects would absorb";
   else if (base.fitted && std::isfinite(base.fit_statistic)) {
@@ -371,31 +403,19 @@ Status identify_choosing_effects(const Model& nominal, std::span<const Observati
       double best_z = options.effect_sigmas;
       std::string tried;
       for (int e = 0; e < 3; ++e) {
-        EffectFit candidate = chosen;
-        bool& flag = e == 0 ? candidate.load : e == 1 ? candidate.play : candidate.heat;
-        if (flag) continue;
-        flag = true;
-        IdentificationOptions o = trial;
-        o.effects = candidate;
+        if (e == 0 ? chosen.load : e == 1 ? chosen.play : chosen.heat) continue;
         Identification r;
-        (void)identify(nominal, observations, r, o);
-        const char* name = e == 0 ? "load" : e == 1 ? "play" : "heat";
-        // An effect the solve cannot carry (undetermined, not converging: one that absorbs another
-        // error of the model) is left out.
-        const bool usable =
-            r.status == Status::Ok || r.status == Status::ModelMismatch || r.status == Status::SignUndecided;
-        if (!r.fitted || !usable || !std::isfinite(r.fit_statistic)) {
+        const double z = effect_drop(nominal, observations, trial, chosen, e, base.fit_statistic, r);
+        const char* name = kEffectNames[e];
+        if (std::isnan(z)) {
           tried += fmt::format("{}{} cannot be fitted", tried.empty() ? "" : ", ", name);
           continue;
         }
-        // The drop of the fit statistic is chi-square on the effect's parameters if it is absent.
-        const double dof = candidate.count() - chosen.count();
-        const double z = (base.fit_statistic - r.fit_statistic - dof) / std::sqrt(2.0 * dof);
         tried += fmt::format("{}{} {:.1f} sigma", tried.empty() ? "" : ", ", name, z);
         if (z > best_z) {
           found = true;
           best_z = z;
-          best = candidate;
+          best = r.parameters.effects();
           best_fit = std::move(r);
         }
       }
@@ -410,7 +430,7 @@ Status identify_choosing_effects(const Model& nominal, std::span<const Observati
   IdentificationOptions final_options = options;
   final_options.auto_effects = false;
   final_options.effects = trial.effects;
-  const Status s = identify(nominal, observations, out, final_options);
+  const Status s = identify_fixed(nominal, observations, out, final_options, true);
   out.effects_choice =
       fmt::format("auto: {} (each effect's drop of the fit statistic, {:g} sigma needed: {})", trial.effects.names(),
                   options.effect_sigmas, log.empty() ? "the data could not be fitted without effects" : log);
@@ -422,14 +442,80 @@ Status identify_choosing_effects(const Model& nominal, std::span<const Observati
 Status identify(const Model& nominal, std::span<const Observation> observations, Identification& out,
                 const IdentificationOptions& options) {
   if (options.auto_effects) return identify_choosing_effects(nominal, observations, out, options);
+  return identify_fixed(nominal, observations, out, options, true);
+}
+
+namespace {
+
+// What the residuals of a refused fit point to: each effect not fitted, added alone (theory §13b).
+// The hint names those above options.effect_sigmas with the trend each one is, and the option.
+std::string diagnose_effects(const Model& nominal, std::span<const Observation> observations,
+                             const IdentificationOptions& options, Identification& out) {
+  const EffectFit chosen = out.parameters.effects();
+  const IdentificationOptions trial = trial_options(options);
+  std::string pointed, others;
+  EffectFit all = chosen;
+  constexpr const char* kTrend[3] = {"with the legs' forces", "with the approach direction", "with time"};
+  for (int e = 0; e < 3; ++e) {
+    if (e == 0 ? chosen.load : e == 1 ? chosen.play : chosen.heat) continue;
+    Identification fit;
+    const double z = effect_drop(nominal, observations, trial, chosen, e, out.fit_statistic, fit);
+    out.diagnosis.push_back({kEffectNames[e], z});
+    // An effect that lacks what it needs says what (its reason names it: "heat: ...").
+    const bool lacks = !fit.fitted && fit.status == Status::NotIdentifiable && !fit.reason.empty();
+    const std::string said = !std::isnan(z) ? fmt::format("{} {:.1f} sigma", kEffectNames[e], z)
+                             : lacks        ? fmt::format("{}", fit.reason)
+                                            : fmt::format("{} cannot be fitted", kEffectNames[e]);
+    if (z > options.effect_sigmas) {
+      pointed += fmt::format("{}a trend {} ({})", pointed.empty() ? "" : ", ", kTrend[e], said);
+      (e == 0 ? all.load : e == 1 ? all.play : all.heat) = true;
+    } else {
+      others += fmt::format("{}{}", others.empty() ? "" : ", ", said);
+    }
+  }
+  const std::string generic =
+      "another configuration, log, run or strategy than the machine's, a servo still moving (a longer settle "
+      "time), or U-joint axes (fit them all: --axes all)";
+  if (out.diagnosis.empty()) return {};
+  if (pointed.empty())
+    return fmt::format(
+        "the residuals point to none of the legs' effects ({}; {:g} sigma needed): an error the "
+        "model does not have: {}",
+        others, options.effect_sigmas, generic);
+  // Those effects together must explain the data; a larger error (another model, log or run) is
+  // reduced by any of them without being explained.
+  IdentificationOptions with = trial;
+  with.effects = all;
+  Identification fit;
+  (void)identify_fixed(nominal, observations, fit, with, false);
+  if (!(fit.fitted && fit.fit_z <= options.fit_sigmas))
+    return fmt::format(
+        "the legs' effects reduce the residuals ({}{}) but do not explain them (--effects {} leaves "
+        "{:.1f} sigma): an error the model does not have: {}",
+        pointed, others.empty() ? "" : ", " + others, all.names(), fit.fit_z, generic);
+  return fmt::format(
+      "the residuals point to {}{}: fit them (--effects {}, or --effects auto to let the data "
+      "choose)",
+      pointed, others.empty() ? "" : fmt::format("; not to {}", others), all.names());
+}
+
+Status identify_fixed(const Model& nominal, std::span<const Observation> observations, Identification& out,
+                      const IdentificationOptions& options, bool diagnose) {
   out = Identification{};
   const ObservationGroups groups = group_observations(observations);
   out.observations = static_cast<int>(observations.size());
   out.stations = groups.stations;
   out.groups = static_cast<int>(groups.station.size());
+  // Heat from the log's temperatures where every observation has one, about the run's first.
+  EffectFit effects = options.effects;
+  effects.measured = effects.heat && !observations.empty() &&
+                     std::all_of(observations.begin(), observations.end(),
+                                 [](const Observation& o) { return std::isfinite(o.temperature); });
+  effects.reference_temperature =
+      effects.measured ? observations.front().temperature : std::numeric_limits<double>::quiet_NaN();
   // The axes, if any, are added once the rest is fitted (fit_both_senses).
   ParameterSet set(nominal, options.model, options.lead_effect, AxisSelection{}, std::max(groups.targets, 1),
-                   options.leads, options.effects);
+                   options.leads, effects);
   out.parameters = set;
   const auto fail = [&](Status s, std::string reason = {}, std::string hint = {}) {
     if (!reason.empty()) out.reason = std::move(reason);
@@ -499,6 +585,9 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
   // The decisions (theory §13): does the model explain the data as the tracker measures?
   if (!(out.fit_z <= options.fit_sigmas)) {
     const StationResidual& w = out.worst.front();
+    const std::string pointed = diagnose && set.model() == CalibrationModel::Geometry
+                                    ? diagnose_effects(nominal, observations, options, out)
+                                    : std::string();
     return fail(
         Status::ModelMismatch,
         fmt::format("the fit leaves {:.4g} mm per axis where the tracker's noise is {:.4g} mm: a test statistic "
@@ -508,6 +597,8 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
                     options.fit_sigmas, w.station + 1, w.count, 1e3 * w.mean_error),
         set.model() == CalibrationModel::Basic
             ? "the joint geometry is off: identify the joint centres too, the geometry model (--model geometry)"
+        : !pointed.empty()
+            ? pointed
             : "an error the model does not have: legs that warm, deflect under the load or have play (--effects "
               "auto fits those the data show), another configuration, log, run or strategy than the machine's, a "
               "servo still moving (a longer settle time), or U-joint axes (fit them all: --axes all)");
@@ -542,6 +633,8 @@ Status identify(const Model& nominal, std::span<const Observation> observations,
   out.status = Status::Ok;
   return Status::Ok;
 }
+
+}  // namespace
 
 Status identification_residuals(const ParameterSet& set, std::span<const Observation> observations,
                                 const Eigen::VectorXd& theta, double sign, const RigidTransform& X_BT,

@@ -117,6 +117,7 @@ ObservationSet observations_at_rest(const Model& model, const TimedPoses& comman
                               detail::point_location(log, k), times[k], describe(s)));
     o.p_T = log.points_T[k];
     o.time = times[k];
+    if (!log.temperatures.empty()) o.temperature = log.temperatures[k];
     o.target = k < log.targets.size() ? log.targets[k] : 0;
     if (set.points.empty() ||
         (desired[k].to_vector() - desired[set.points.back()].to_vector()).cwiseAbs().maxCoeff() > detail::kSamePose) {

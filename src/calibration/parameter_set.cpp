@@ -84,9 +84,14 @@ ParameterSet::ParameterSet(const Model& nominal, CalibrationModel model, LeadEff
   }
   if (effects_.heat) {
     drift_ = next;
-    curvature_ = drift_ + kLegs;
-    next = curvature_ + kLegs + 1;
+    next += kLegs;
+    if (!effects_.measured) {
+      curvature_ = next;
+      next += kLegs;
+    }
+    lead_drift_ = next++;
   }
+  length_home_ = nominal.length_home();
   if (model_ == CalibrationModel::Geometry) {
     base_ = next;
     platform_ = base_ + 3 * kLegs - 6;
@@ -120,7 +125,7 @@ std::string ParameterSet::group(int i) const {
   if (i < offset_ + kLegs) return "offsets";
   if (i == compliance_) return "load";
   if (play_ >= 0 && i >= play_ && i < play_ + kLegs) return "play";
-  if (drift_ >= 0 && i >= drift_ && i <= curvature_ + kLegs) return "heat";
+  if (drift_ >= 0 && i >= drift_ && i <= lead_drift_) return "heat";
   if (base_ >= 0 && i < platform_) return "base joints";
   if (platform_ >= 0 && i < axis_) return "platform joints";
   if (axis_count_ > 0 && i >= axis_ && i < axis_ + axis_count_) return "axes";
@@ -134,10 +139,11 @@ std::string ParameterSet::name(int i) const {
   if (i < offset_ + kLegs) return fmt::format("offset {}", i - offset_ + 1);
   if (i == compliance_) return "compliance";
   if (play_ >= 0 && i >= play_ && i < play_ + kLegs) return fmt::format("play {}", i - play_ + 1);
-  if (drift_ >= 0 && i >= drift_ && i < curvature_) return fmt::format("drift {}", i - drift_ + 1);
+  if (drift_ >= 0 && i >= drift_ && i < drift_ + kLegs)
+    return fmt::format("{} {}", effects_.measured ? "expansion" : "drift", i - drift_ + 1);
   if (curvature_ >= 0 && i >= curvature_ && i < curvature_ + kLegs)
     return fmt::format("curvature {}", i - curvature_ + 1);
-  if (curvature_ >= 0 && i == curvature_ + kLegs) return "lead drift";
+  if (i == lead_drift_) return effects_.measured ? "lead expansion" : "lead drift";
   if (base_ >= 0 && i < platform_) return fmt::format("base joints g{}", i - base_ + 1);
   if (platform_ >= 0 && i < axis_) return fmt::format("platform joints g{}", i - platform_ + 1);
   if (axis_count_ > 0 && i >= axis_ && i < axis_ + axis_count_) {
@@ -178,6 +184,11 @@ ModelSpec ParameterSet::platform(const Eigen::VectorXd& theta, double sign, bool
       leg.stiffness = with_effects && theta[compliance_] > 1e-11 ? 1.0 / theta[compliance_]
                                                                  : std::numeric_limits<double>::infinity();
     if (play_ >= 0) leg.play = with_effects ? std::max(theta[play_ + i], 0.0) : 0.0;
+    if (effects_.measured && drift_ >= 0) {
+      // The expansions from the log's temperatures, about the run's first (EffectFit::measured).
+      leg.length_expansion = with_effects ? theta[drift_ + i] / length_home_[i] : 0.0;
+      leg.lead_expansion = with_effects ? theta[lead_drift_] : 0.0;
+    }
     leg.lead = theta[lead_count_ == 1 ? 0 : i];
     if (sign < 0.0) leg.thread = leg.thread == ThreadSense::Right ? ThreadSense::Left : ThreadSense::Right;
     leg.length_offset = theta[offset_ + i];
@@ -188,6 +199,7 @@ ModelSpec ParameterSet::platform(const Eigen::VectorXd& theta, double sign, bool
                          ? nominal_drive_lead_[i]
                          : std::numeric_limits<double>::quiet_NaN();
   }
+  if (effects_.measured && drift_ >= 0 && with_effects) spec.reference_temperature = effects_.reference_temperature;
   if (model_ == CalibrationModel::Geometry) {
     const Eigen::VectorXd db = base_basis_ * theta.segment(base_, 3 * kLegs - 6);
     const Eigen::VectorXd dp = platform_basis_ * theta.segment(platform_, 3 * kLegs - 6);

@@ -24,6 +24,7 @@ struct Suffix {
 };
 constexpr Suffix kTimeSuffixes[] = {{"_s", 1.0}, {"_ms", 1e-3}};
 constexpr Suffix kLengthSuffixes[] = {{"_m", 1.0}, {"_mm", 1e-3}};
+constexpr Suffix kTemperatureSuffixes[] = {{"_c", 1.0}};  // degrees Celsius
 
 bool same_ignoring_case(std::string_view a, std::string_view b) {
   return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
@@ -88,10 +89,12 @@ struct LogColumns {
   Column time;
   std::array<Column, 3> xyz;
   std::optional<Column> target;
+  std::optional<Column> temperature;
 
   // A cell's column as messages name it: as the format does for those read, else the header's.
   std::string_view name(std::size_t c, const std::vector<detail::CsvCell>& header) const {
     if (target && c == target->index) return target->name;
+    if (temperature && c == temperature->index) return temperature->name;
     if (c == time.index) return time.name;
     for (const Column& a : xyz)
       if (c == a.index) return a.name;
@@ -130,6 +133,15 @@ LogColumns find_columns(const detail::CsvReader& r, const detail::CsvLine& head,
   } else {
     for (std::size_t c = 0; c < header.size(); ++c)
       if (same_ignoring_case(header[c].text, "target")) cols.target = Column{"target", c, 1.0, header[c].text};
+  }
+  // The machine's temperature, if any [degC]: named by the format, or a header cell `temperature`
+  // or `temperature_c`.
+  if (!format.temperature_column.empty()) {
+    cols.temperature = find_column(r, head, header, format.temperature_column, kTemperatureSuffixes, suffix);
+  } else {
+    for (std::size_t c = 0; c < header.size(); ++c)
+      if (same_ignoring_case(header[c].text, "temperature") || same_ignoring_case(header[c].text, "temperature_c"))
+        cols.temperature = Column{"temperature", c, 1.0, header[c].text};
   }
   return cols;
 }
@@ -220,6 +232,15 @@ PointLog parse_point_log(std::string_view text, std::string_view source, const P
                                           stamp, log.stamps[previous], log.lines[previous], per_target)
                             : fmt::format("time {} s is not after {} s on line {}; times must be strictly increasing{}",
                                           stamp, log.stamps[previous], log.lines[previous], per_target));
+    if (cols.temperature) {
+      const detail::CsvCell& cell = cells[cols.temperature->index];
+      const double celsius = r.number(line, cell, cols.temperature->name, 1.0);
+      if (!(celsius >= kMinLogTemperature && celsius <= kMaxLogTemperature))
+        r.fail(line.number, line.text, cell.offset, cols.temperature->name,
+               fmt::format("{} degC is not a machine's temperature; expected {} to {} degC", celsius,
+                           kMinLogTemperature, kMaxLogTemperature));
+      log.temperatures.push_back(celsius);
+    }
     last_of_target[static_cast<std::size_t>(t)] = log.stamps.size();
     log.targets.push_back(t);
     log.stamps.push_back(stamp);

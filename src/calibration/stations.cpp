@@ -74,17 +74,51 @@ std::vector<Vector6d> random_stations(const Model& model, Strategy strategy, con
   return stations;
 }
 
-Trajectory station_run(const Model& model, Strategy strategy, std::span<const Vector6d> stations,
-                       const StationsSpec& spec, double dt) {
+std::vector<Vector6d> station_waypoints(const Model& model, Strategy strategy, std::span<const Vector6d> stations,
+                                        const StationsSpec& spec) {
+  if (!(spec.approach >= 0.0 && spec.approach <= kMaxApproach))
+    throw ParameterError(fmt::format("stations: approach: expected 0 to {:g} m, got {:g}", kMaxApproach, spec.approach),
+                         "approach");
+  if (spec.reference_every < 0)
+    throw ParameterError(fmt::format("stations: reference every: expected 0 (none) or a number of stations, got {}",
+                                     spec.reference_every),
+                         "reference_every");
   std::vector<Vector6d> waypoints{Vector6d::Zero()};
-  for (std::size_t i = 0; i <= stations.size(); ++i) {
-    const Vector6d next = i < stations.size() ? stations[i] : Vector6d::Zero();
+  const auto visit = [&](const Vector6d& next, std::size_t i) {
     if (!reachable_from(model, strategy, waypoints.back(), next))
       throw Error(i < stations.size()
                       ? fmt::format("station {}: it, or the straight move to it, leaves a limit", i + 1)
                       : std::string("stations: the straight move home from the last station leaves a limit"));
     waypoints.push_back(next);
+  };
+  for (std::size_t i = 0; i < stations.size(); ++i) {
+    const Vector6d& station = stations[i];
+    bool visited = false;
+    for (const double side : {1.0, -1.0}) {
+      if (!(spec.approach > 0.0)) break;
+      Vector6d start = station;
+      start[2] += side * spec.approach;
+      if (reachable_from(model, strategy, waypoints.back(), start) && reachable_from(model, strategy, start, station)) {
+        waypoints.push_back(start);
+        waypoints.push_back(station);
+        visited = true;
+      }
+    }
+    if (!visited) visit(station, i);
+    // Home as a reference, where the moves to it and on to the next station stay inside the limits.
+    const Vector6d home = Vector6d::Zero();
+    if (spec.reference_every > 0 && (i + 1) % static_cast<std::size_t>(spec.reference_every) == 0 &&
+        i + 1 < stations.size() && reachable_from(model, strategy, waypoints.back(), home) &&
+        reachable_from(model, strategy, home, stations[i + 1]))
+      waypoints.push_back(home);
   }
+  visit(Vector6d::Zero(), stations.size());
+  return waypoints;
+}
+
+Trajectory station_run(const Model& model, Strategy strategy, std::span<const Vector6d> stations,
+                       const StationsSpec& spec, double dt) {
+  const std::vector<Vector6d> waypoints = station_waypoints(model, strategy, stations, spec);
   return waypoint_trajectory(waypoints, spec.limits, spec.dwell, dt);
 }
 

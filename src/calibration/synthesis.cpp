@@ -108,6 +108,7 @@ Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisO
       out.ticks.push_back(k);
       out.log.stamps.push_back(sample.time);
       out.log.points_T.push_back(p_T);
+      if (options.log_temperature) out.log.temperatures.push_back(inputs.temperature.mean());
       out.log.targets.push_back(static_cast<int>(t));
       out.log.lines.push_back(static_cast<int>(out.log.lines.size()) + 2);
       out.log.stamp_columns.push_back(1);

@@ -136,7 +136,10 @@ YAML::Node leg_effects_node(const ModelSpec& platform) {
                                     std::pair{"length_expansion", &LegSpec::length_expansion},
                                     std::pair{"lead_expansion", &LegSpec::lead_expansion}})
     if (any(member)) block[key] = per_leg(platform, member);
-  if (platform.reference_temperature != ModelSpec{}.reference_temperature)
+  // The temperature the geometry holds at: wherever it differs from the default, and always with
+  // an expansion (the coefficients mean nothing without it).
+  if (platform.reference_temperature != ModelSpec{}.reference_temperature || any(&LegSpec::length_expansion) ||
+      any(&LegSpec::lead_expansion))
     block["reference_temperature"] = number(platform.reference_temperature);
   return block;
 }

@@ -2,6 +2,7 @@
 
 #include "kinematics/compensation_internal.hpp"
 #include "kinematics/lanes.hpp"
+#include "kinematics/leg_effects_internal.hpp"
 #include "kinematics/twist_internal.hpp"
 
 namespace hexatwist {
@@ -22,18 +23,6 @@ void length_error(const Model& model, const Vector6d& dtheta, Vector6d& error) n
 }
 
 namespace {
-
-// The travel under the legs' effects for the twist-compensated travel u0 (leg_effects.hpp): the
-// direction of each leg decided on the travel without its play term, then the play's term with it.
-// `no_play` receives that travel (what the play state moves on to).
-void effects_travel(const Model& model, const Vector6d& u0, const Vector6d& twist_term, const Vector6d& force,
-                    const Vector6d& temperature, const PlayState* play, Vector6d& travel, Vector6d& no_play,
-                    Vector6d& direction, LegEffects* effects) noexcept {
-  const Vector6d& home = model.geometry().home_direction;
-  travel_under_effects(model, u0, twist_term, force, temperature, home, no_play, nullptr);
-  direction = play_direction(model, play != nullptr ? *play : PlayState{}, no_play);
-  travel_under_effects(model, u0, twist_term, force, temperature, direction, travel, effects);
-}
 
 // Inverse kinematics, the limits, the twist and Eq. (10)-(12) as the nuts' travels: Ok when the
 // pose is inside every limit (out.conventional and out.compensated then hold travels still to be
@@ -81,14 +70,19 @@ namespace {
 // to the full path. The two decide alike except within rounding of a bound. The condition limit
 // is proven after the loop (limits.hpp: once every leg passed) for the motor-side Jacobian from
 // the geometric one, formed from the same registers, and a bound on the twist's share of it
-// (docs/theory.md §8): the twist's own Jacobian costs as much as the proof.
-bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, Vector6d& command) noexcept {
+// (docs/theory.md §8): the twist's own Jacobian costs as much as the proof. With `load`, the
+// legs' static forces under it (leg_effects_internal.hpp) go to `force` and their status to
+// `force_status`, when every test passed; `twist_term` (may be null) gets k dtheta.
+bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, Vector6d& command,
+                       const StaticLoadSpec* load = nullptr, Vector6d* force = nullptr, Status* force_status = nullptr,
+                       Vector6d* twist_term = nullptr) noexcept {
   using namespace detail;
   const LegLanes& g = model.geometry().lanes;
   const Matrix3d R = detail::rotation_from_rpy(pose.rpy);
   const bool twist_model = model.has_twist();
   lane_m ok = all_set();
-  Vector6d out;
+  Vector6d out, twist_out = Vector6d::Zero();
+  LegLoads loads;
   ColumnPackets J;
   lane_v twist_share = {};
   const lane_v inv_condition_length = splat<lane_v>(1.0 / model.condition_length());
@@ -108,8 +102,11 @@ bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, V
       ok &= twist_regular(model, t.x, y, legs.length2 * legs.length2, k);
       twist_share += twist_share_bound(model, t.x, y, dot_a, dot_d, legs.length, legs.length2, inv_length, k);
       if (compensated) {
+        const lane_v rigid = command_k;
         command_k -= load_lanes(g.twist_gain, k) * twist_angle(model, t.x, y, true, k);  // Eq. (12)
         ok &= within_stroke(model, command_k);
+        // k dtheta as the difference, which leaves Eq. (12)'s multiply-add (batch.cpp's) alone.
+        if (twist_term != nullptr) store6(twist_out.data(), rigid - command_k, k);
       }
     }
     store6(out.data(), command_k, k);
@@ -118,6 +115,7 @@ bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, V
     const lanes3 s = inv_length * legs.leg;
     const lanes3 arm_x_s = inv_condition_length * cross(legs.arm, s);
     J.set(k, {s.x, s.y, s.z, arm_x_s.x, arm_x_s.y, arm_x_s.z});
+    if (load != nullptr) add_leg_loads(*load, s, legs.arm, inv_length, k, loads);
   }
   if (!all_lanes(ok)) return false;
   // The platform singularity last, once every leg passed (limits.hpp): a cheap proof that the
@@ -127,9 +125,12 @@ bool commands_in_lanes(const Model& model, const Pose& pose, bool compensated, V
   // of about 1, in a column sum of six (theory §8).
   PaddedRows rows;
   J.rows(rows);
+  // The forces before the proof, which does not need them: the two chains overlap.
+  if (load != nullptr) *force_status = finish_leg_forces(model, *load, R, loads, rows, *force);
   const double perturbation = sum_lanes(twist_share) * (1.0 + 1e-6) + 1e-13;
   if (!condition_below(rows, model.condition_reference(), model.condition_max_accepted(), perturbation)) return false;
   command = out;
+  if (twist_term != nullptr) *twist_term = twist_out;
   return true;
 }
 
@@ -159,8 +160,9 @@ Status compute_commands(const Model& model, const Pose& pose, const LegInputs& i
   if (const Status s = resolve_inputs(model, out.legs, inputs, force, temperature); s != Status::Ok)
     return fail(out.limit, s);
   Vector6d travel;
-  effects_travel(model, out.compensated, out.length_error, force, temperature, play, travel, no_play, direction,
-                 &out.effects);
+  detail::command_travel(model, out.compensated, out.length_error, force, temperature, play, travel, no_play,
+                         direction);
+  effect_lengths(model, travel, out.length_error, force, temperature, direction, out.effects);
   out.compensated = travel;
   return drive_commands(model, out);
 }
@@ -170,25 +172,29 @@ Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, c
   if (strategy != Strategy::Compensated || !model.has_leg_effects())
     return motor_commands(model, pose, strategy, command, report);
   if (!pose.is_finite()) return fail(report, Status::NonFiniteInput);
-  // The twist-compensated travel u0 in registers (every limit checked), else through a LegState
-  // (which names the leg and limit); the legs' state for their forces either way.
-  LegState legs;
-  Vector6d u0, twist_term;
-  if (const Status s = inverse_kinematics(model, placement_from_pose(pose), legs); s != Status::Ok)
-    return fail(report, s);
-  const Vector6d& offset = model.geometry().length_offset;
-  if (commands_in_lanes(model, pose, model.has_twist(), u0)) {
-    twist_term = legs.length - offset - u0;
-  } else {
+  // The twist-compensated travel u0 in registers (every limit checked), with the static forces
+  // where they are needed; else through a LegState, which names the leg and limit.
+  const bool static_forces = detail::needs_static_forces(model, inputs);
+  const StaticLoadSpec& load = model.spec().static_load;
+  Vector6d u0, twist_term = Vector6d::Zero(), static_force = Vector6d::Zero();
+  Status static_status = Status::Ok;
+  if (!commands_in_lanes(model, pose, model.has_twist(), u0, static_forces ? &load : nullptr, &static_force,
+                         &static_status, &twist_term)) {
+    LegState legs;
+    if (const Status s = inverse_kinematics(model, placement_from_pose(pose), legs); s != Status::Ok)
+      return fail(report, s);
     if (const Status s = check_limits(model, legs, report); s != Status::Ok) return s;
     Vector6d dtheta;
     if (const Status s = twist(model, legs, dtheta); s != Status::Ok) return fail(report, s);
     length_error(model, dtheta, twist_term);
-    u0 = legs.length - offset - twist_term;
+    u0 = legs.length - model.geometry().length_offset - twist_term;
+    if (static_forces) static_status = static_leg_forces(model, load, legs, static_force);
   }
   Vector6d force, temperature, travel, no_play, direction;
-  if (const Status s = resolve_inputs(model, legs, inputs, force, temperature); s != Status::Ok) return fail(report, s);
-  effects_travel(model, u0, twist_term, force, temperature, play, travel, no_play, direction, nullptr);
+  if (const Status s = detail::resolve_inputs(model, inputs, static_status, static_force, force, temperature);
+      s != Status::Ok)
+    return fail(report, s);
+  detail::command_travel(model, u0, twist_term, force, temperature, play, travel, no_play, direction);
   if (const Status s = check_stroke(model, travel, report); s != Status::Ok) return s;
   report = LimitReport{};
   command = model.motor_from_travel(travel);

@@ -128,6 +128,50 @@ inline bool eliminate(const Columns& J, Inverse6& out) noexcept {
 
 }  // namespace gj
 
+/// Solves M x = b by the same elimination with b as a seventh column and no X: 21 column updates
+/// where the inverse takes 36. Returns min |pivot| / max |pivot| (0, x unspecified, when M is
+/// singular or not finite), as gauss_jordan.
+inline double gj_solve_system(const Columns& M, const Vector6d& b, Vector6d& x) noexcept {
+  Columns a;
+  lane_v rhs[kPackets], row[kPackets];
+  alignas(64) double padded_b[kPackets * kWidth] = {};
+  for (int i = 0; i < 6; ++i) padded_b[i] = b[i];
+  std::memcpy(rhs, padded_b, sizeof rhs);
+  for (int k = 0; k < kPackets; ++k) {
+    row[k] = gj::lane_index(k);
+    const lane_v real = blend(row[k] < 6.0, splat<lane_v>(1.0), splat<lane_v>(0.0));
+    for (int c = 0; c < 6; ++c) a.c[c][k] = M.c[c][k] * real;
+  }
+  unsigned available = 0x3f;
+  int pivot_row[6];
+  double pivot_min = INFINITY, pivot_max = 0.0;
+#pragma GCC unroll 6
+  for (int k = 0; k < 6; ++k) {
+    double pivot;
+    const int p = gj::select_pivot(a.c[k], available, pivot);
+    if (p < 0) return 0.0;
+    available &= ~(1u << p);
+    pivot_row[k] = p;
+    pivot_min = std::min(pivot_min, std::abs(pivot));
+    pivot_max = std::max(pivot_max, std::abs(pivot));
+    const double inv = 1.0 / pivot;
+    // Row p /= pivot, every other row i -= a(i, k) * (new row p), as gj::eliminate.
+    lane_v m[kPackets];
+    for (int q = 0; q < kPackets; ++q)
+      m[q] = blend(row[q] == static_cast<double>(p), splat<lane_v>(1.0 - inv), a.c[k][q] * inv);
+    for (int c = k + 1; c < 6; ++c) {
+      const lane_v v = gj::broadcast_row(a.c[c], p);
+      for (int q = 0; q < kPackets; ++q) a.c[c][q] -= m[q] * v;
+    }
+    const lane_v v = gj::broadcast_row(rhs, p);
+    for (int q = 0; q < kPackets; ++q) rhs[q] -= m[q] * v;
+  }
+  // Column k of the reduced matrix is e_{pivot_row[k]}: x_k is that row of the right side.
+  std::memcpy(padded_b, rhs, sizeof rhs);
+  for (int k = 0; k < 6; ++k) x[k] = padded_b[pivot_row[k]];
+  return pivot_min / pivot_max;
+}
+
 /// Inverts J (columns; not modified). Returns out.pivot_ratio, min |pivot| / max |pivot|; when it
 /// is 0 (singular or not finite) the rest of `out` is unspecified. The pivots are those of LU with
 /// partial pivoting (lu6_factor), so the ratio means the same as lu6_factor's. (Taking the pivot

@@ -1,37 +1,59 @@
 #include "hexatwist/kinematics/leg_effects.hpp"
 
-#include <Eigen/LU>
 #include <cmath>
 
-namespace hexatwist {
+#include "kinematics/leg_effects_internal.hpp"
 
+namespace hexatwist {
 Status static_leg_forces(const Model& model, const StaticLoadSpec& load, const LegState& legs,
                          Vector6d& force) noexcept {
-  if (!load.present) return Status::InvalidArgument;
   // The generalised force of gravity for the platform twist [dt; dw] about the pivot (theory
-  // §4b): the load's weight at its centre of mass, and each leg's housing and rod, whose centres
-  // move with the leg's axis: f_i = m_r g + (m_h c_h - m_r c_r) / l_i (g - (s_i . g) s_i) at the
-  // platform joint.
-  const Vector3d g(0.0, 0.0, -load.gravity);
-  const Vector3d weight = load.mass * g;
-  const Vector3d com_B = legs.R_BP * (load.center_of_mass_P - model.spec().pivot_P);
-  Vector3d G_force = weight, G_moment = com_B.cross(weight);
-  Matrix6d Jt;  // columns: the length Jacobian's rows [s_i; a_i x s_i]
-  for (int i = 0; i < kLegs; ++i) {
-    const Vector3d s = legs.s_B.row(i).transpose();
-    const Vector3d a = legs.arm_B.row(i).transpose();
-    const Vector3d f = load.rod_mass * g + (load.leg_moment / legs.length[i]) * (g - s.dot(g) * s);
-    G_force += f;
-    G_moment += a.cross(f);
-    Jt.col(i) << s, a.cross(s);
+  // §4b), and J^T F = G (leg_effects_internal.hpp).
+  const double w = 1.0 / model.condition_length();
+  detail::LegLoads loads;
+  detail::ColumnPackets A;
+  for (int k = 0; k < detail::kPackets; ++k) {
+    const detail::lanes3 s = detail::load6(legs.s_B, k), arm = detail::load6(legs.arm_B, k);
+    const detail::lanes3 arm_x_s = detail::splat<detail::lane_v>(w) * detail::cross(arm, s);
+    A.set(k, {s.x, s.y, s.z, arm_x_s.x, arm_x_s.y, arm_x_s.z});
+    detail::add_leg_loads(load, s, arm, 1.0 / detail::load6(legs.length.data(), k), k, loads);
   }
-  Vector6d G;
-  G << G_force, G_moment;
-  // J^T F = G: the legs' tensions pull the platform towards the base and balance gravity.
-  const Eigen::PartialPivLU<Matrix6d> lu(Jt);
-  if (!(std::abs(lu.determinant()) > 0.0)) return Status::SingularJacobian;
-  force = lu.solve(G);
-  return force.allFinite() ? Status::Ok : Status::NonFiniteInput;
+  detail::PaddedRows rows;
+  A.rows(rows);
+  return detail::finish_leg_forces(model, load, legs.R_BP, loads, rows, force);
+}
+
+bool detail::needs_static_forces(const Model& model, const LegInputs& inputs) noexcept {
+  return model.has_stiffness() && inputs.force.array().isNaN().any();
+}
+
+Status detail::resolve_inputs(const Model& model, const LegInputs& inputs, Status static_status,
+                              const Vector6d& static_force, Vector6d& force, Vector6d& temperature) noexcept {
+  for (int i = 0; i < kLegs; ++i)
+    if (std::isinf(inputs.force[i]) || std::isinf(inputs.temperature[i])) return Status::NonFiniteInput;
+  temperature = inputs.temperature;
+  for (int i = 0; i < kLegs; ++i)
+    if (std::isnan(temperature[i])) temperature[i] = model.reference_temperature();
+  force = inputs.force;
+  if (!model.has_stiffness()) {
+    force = force.unaryExpr([](double f) { return std::isnan(f) ? 0.0 : f; });
+    return Status::Ok;
+  }
+  if (needs_static_forces(model, inputs)) {
+    if (static_status != Status::Ok) return static_status;
+    for (int i = 0; i < kLegs; ++i)
+      if (std::isnan(force[i])) force[i] = static_force[i];
+  }
+  return Status::Ok;
+}
+
+Status resolve_inputs(const Model& model, const LegState& legs, const LegInputs& inputs, Vector6d& force,
+                      Vector6d& temperature) noexcept {
+  Vector6d static_force = Vector6d::Zero();
+  const Status static_status = detail::needs_static_forces(model, inputs)
+                                   ? static_leg_forces(model, model.spec().static_load, legs, static_force)
+                                   : Status::Ok;
+  return detail::resolve_inputs(model, inputs, static_status, static_force, force, temperature);
 }
 
 void start_play(const Model& model, const Vector6d& travel, PlayState& play) noexcept {
@@ -70,27 +92,6 @@ Vector6d follow_nuts(const Model& model, const Vector6d& motor, NutGap& nuts) no
   return direction;
 }
 
-Status resolve_inputs(const Model& model, const LegState& legs, const LegInputs& inputs, Vector6d& force,
-                      Vector6d& temperature) noexcept {
-  for (int i = 0; i < kLegs; ++i)
-    if (std::isinf(inputs.force[i]) || std::isinf(inputs.temperature[i])) return Status::NonFiniteInput;
-  temperature = inputs.temperature;
-  for (int i = 0; i < kLegs; ++i)
-    if (std::isnan(temperature[i])) temperature[i] = model.reference_temperature();
-  force = inputs.force;
-  if (!model.has_stiffness()) {
-    force = force.unaryExpr([](double f) { return std::isnan(f) ? 0.0 : f; });
-    return Status::Ok;
-  }
-  if (force.array().isNaN().any()) {
-    Vector6d load;
-    if (const Status s = static_leg_forces(model, model.spec().static_load, legs, load); s != Status::Ok) return s;
-    for (int i = 0; i < kLegs; ++i)
-      if (std::isnan(force[i])) force[i] = load[i];
-  }
-  return Status::Ok;
-}
-
 namespace {
 
 // The parts of E that do not depend on the travel: the load, the length's expansion and the play.
@@ -104,23 +105,43 @@ void fixed_parts(const Model& model, const Vector6d& force, const Vector6d& temp
   e.play = -g.half_play.cwiseProduct(direction - g.home_direction);
 }
 
+// u + E(u) = u0 with E linear in w = u - h + k dtheta (leg_effects.hpp): with the home direction
+// (no play term), w = (u0 - h + k dtheta - E_fixed) / (1 + a_P dT) and u = u0 - E; the play's
+// term p then moves u by -p / (1 + a_P dT). `scale` gets 1 + a_P dT.
+void travel_without_play(const Model& model, const Vector6d& u0, const Vector6d& twist_term, const Vector6d& force,
+                         const Vector6d& temperature, Vector6d& travel, Vector6d& scale) noexcept {
+  const LegGeometry& g = model.geometry();
+  const Vector6d dT = temperature.array() - model.reference_temperature();
+  const Vector6d fixed = g.compliance.cwiseProduct(force - model.reference_force()) + dT.cwiseProduct(g.thermal_length);
+  const Vector6d aP_dT = g.lead_expansion.cwiseProduct(dT);
+  scale = Vector6d::Ones() + aP_dT;
+  const Vector6d w = (u0 - g.home_command + twist_term - fixed).cwiseQuotient(scale);
+  travel = u0 - fixed - aP_dT.cwiseProduct(w);
+}
+
+Vector6d play_term(const Model& model, const Vector6d& direction) noexcept {
+  const LegGeometry& g = model.geometry();
+  return -g.half_play.cwiseProduct(direction - g.home_direction);
+}
+
 }  // namespace
 
 void travel_under_effects(const Model& model, const Vector6d& u0, const Vector6d& twist_term, const Vector6d& force,
                           const Vector6d& temperature, const Vector6d& direction, Vector6d& travel,
                           LegEffects* effects) noexcept {
-  const LegGeometry& g = model.geometry();
-  LegEffects e;
-  fixed_parts(model, force, temperature, direction, e);
-  const Vector6d dT = temperature.array() - model.reference_temperature();
-  // u + E(u) = u0 with E linear in w = u - h + k dtheta: w = (u0 - h + k dtheta - E_fixed) / (1 + a_P dT).
-  const Vector6d fixed = e.load + dT.cwiseProduct(g.thermal_length) + e.play;
-  const Vector6d aP_dT = g.lead_expansion.cwiseProduct(dT);
-  const Vector6d w = (u0 - g.home_command + twist_term - fixed).cwiseQuotient(Vector6d::Ones() + aP_dT);
-  e.thermal = dT.cwiseProduct(g.thermal_length) + aP_dT.cwiseProduct(w);
-  e.total = e.load + e.thermal + e.play;
-  travel = u0 - e.total;
-  if (effects != nullptr) *effects = e;
+  Vector6d no_play, scale;
+  travel_without_play(model, u0, twist_term, force, temperature, no_play, scale);
+  travel = no_play - play_term(model, direction).cwiseQuotient(scale);
+  if (effects != nullptr) effect_lengths(model, travel, twist_term, force, temperature, direction, *effects);
+}
+
+void detail::command_travel(const Model& model, const Vector6d& u0, const Vector6d& twist_term, const Vector6d& force,
+                            const Vector6d& temperature, const PlayState* play, Vector6d& travel, Vector6d& no_play,
+                            Vector6d& direction) noexcept {
+  Vector6d scale;
+  travel_without_play(model, u0, twist_term, force, temperature, no_play, scale);
+  direction = play_direction(model, play != nullptr ? *play : PlayState{}, no_play);
+  travel = no_play - play_term(model, direction).cwiseQuotient(scale);
 }
 
 void effect_lengths(const Model& model, const Vector6d& travel, const Vector6d& twist_term, const Vector6d& force,

@@ -4,6 +4,8 @@
 // it still, with Gaussian noise.
 #pragma once
 
+#include <algorithm>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -113,6 +115,104 @@ inline std::vector<Observation> observe(const Model& nominal, const Truth& truth
       }
   }
   return out;
+}
+
+// The truth in the order of `set` (tracker rotation: zero; compare X_BT apart).
+inline Eigen::VectorXd truth_vector(const ParameterSet& set, const Truth& truth) {
+  Eigen::VectorXd theta = Eigen::VectorXd::Zero(set.size());
+  const ModelSpec& nominal = set.nominal();
+  for (int j = 0; j < set.lead_count(); ++j) theta[j] = truth.spec.legs[static_cast<std::size_t>(j)].lead;
+  for (int i = 0; i < kLegs; ++i)
+    theta[set.offset_index() + i] = truth.spec.legs[static_cast<std::size_t>(i)].length_offset;
+  if (set.model() == CalibrationModel::Geometry) {
+    Eigen::VectorXd db(3 * kLegs), dp(3 * kLegs);
+    for (int i = 0; i < kLegs; ++i) {
+      db.segment<3>(3 * i) =
+          truth.spec.legs[static_cast<std::size_t>(i)].base_B - nominal.legs[static_cast<std::size_t>(i)].base_B;
+      dp.segment<3>(3 * i) = truth.spec.legs[static_cast<std::size_t>(i)].platform_P -
+                             nominal.legs[static_cast<std::size_t>(i)].platform_P;
+    }
+    theta.segment(set.base_index(), 3 * kLegs - 6) = set.base_basis().transpose() * db;
+    theta.segment(set.platform_index(), 3 * kLegs - 6) = set.platform_basis().transpose() * dp;
+    for (int a = 0, k = set.axis_index(); a < 2 * kLegs; ++a) {
+      if (!set.axes()[static_cast<std::size_t>(a)]) continue;
+      const LegSpec& n = nominal.legs[static_cast<std::size_t>(a % kLegs)];
+      const LegSpec& r = truth.spec.legs[static_cast<std::size_t>(a % kLegs)];
+      const Vector3d axis0 = (a < kLegs ? n.axis_base_B : n.axis_platform_P).normalized();
+      Vector3d axis = a < kLegs ? r.axis_base_B : r.axis_platform_P;
+      axis /= axis.dot(axis0);  // axis0 + u1 e1 + u2 e2
+      theta[k] = axis.dot(set.axis_directions(a)[0]);
+      theta[k + 1] = axis.dot(set.axis_directions(a)[1]);
+      k += 2;
+    }
+  }
+  for (std::size_t t = 0; t < truth.targets.size(); ++t)
+    theta.segment<3>(set.target_index() + 3 * static_cast<int>(t)) = truth.targets[t];
+  theta.segment<3>(set.translation_index()) = truth.X_BT.t;
+  return theta;
+}
+
+// Estimate minus truth, the tracker rotation as dw with R_est = exp(dw) R_true.
+inline Eigen::VectorXd parameter_error(const Identification& id, const Truth& truth) {
+  Eigen::VectorXd d = id.estimate - truth_vector(id.parameters, truth);
+  const Eigen::AngleAxisd r(Matrix3d(id.X_BT.R * truth.X_BT.R.transpose()));
+  d.segment<3>(id.parameters.rotation_index()) = r.angle() * r.axis();
+  return d;
+}
+
+// How well a corrected model commands the real platform on poses not used: its commands at
+// `count` random poses within +-translation, +-rotation, run on the real platform, against where
+// the corrected model puts its A; in the gauge frames and after a rigid re-alignment (sorted), and
+// the largest miss of the nominal model's commands.
+struct HeldOut {
+  std::vector<double> gauge, aligned;
+  double nominal_miss = 0.0;
+  double gauge_median() const { return gauge[gauge.size() / 2]; }
+  double aligned_median() const { return aligned[aligned.size() / 2]; }
+};
+
+inline HeldOut held_out(const Model& nominal, const Identification& id, const Truth& truth, double translation,
+                        double rotation, int count, std::mt19937_64& rng) {
+  const Model corrected(id.corrected), real(truth.spec);
+  std::vector<Vector3d> target, actual;
+  HeldOut out;
+  while (static_cast<int>(target.size()) < count) {
+    const Pose p = random_pose(rng, translation, rotation);
+    Vector6d command, command_nominal;
+    LimitReport limit;
+    if (motor_commands(corrected, p, Strategy::Compensated, command, limit) != Status::Ok) continue;
+    if (motor_commands(nominal, p, Strategy::Compensated, command_nominal, limit) != Status::Ok) continue;
+    FkResult fk, fk_nominal;
+    EXPECT_EQ(forward_kinematics(real, command, LengthKind::Motor, placement_from_pose(p), fk), Status::Ok);
+    EXPECT_EQ(forward_kinematics(real, command_nominal, LengthKind::Motor, placement_from_pose(p), fk_nominal),
+              Status::Ok);
+    target.push_back(platform_point_B(corrected, placement_from_pose(p), id.corrected.observation_P));
+    actual.push_back(platform_point_B(real, fk.placement, truth.spec.observation_P));
+    out.nominal_miss =
+        std::max(out.nominal_miss, (platform_point_B(real, fk_nominal.placement, truth.spec.observation_P) -
+                                    platform_point_B(nominal, placement_from_pose(p), nominal.spec().observation_P))
+                                       .norm());
+  }
+  std::vector<PointPair> pairs;
+  for (std::size_t k = 0; k < target.size(); ++k) {
+    out.gauge.push_back((actual[k] - target[k]).norm());
+    pairs.push_back({target[k], actual[k]});
+  }
+  Registration reg;
+  EXPECT_EQ(register_points(pairs, reg), Status::Ok);
+  for (std::size_t k = 0; k < target.size(); ++k)
+    out.aligned.push_back((apply(reg.X_BT, target[k]) - actual[k]).norm());
+  std::sort(out.gauge.begin(), out.gauge.end());
+  std::sort(out.aligned.begin(), out.aligned.end());
+  return out;
+}
+
+inline void print_held_out(const char* what, const HeldOut& h, const Identification& id) {
+  std::printf(
+      "  %s: gauge frames median %.1f um (predicted %.1f), worst %.1f um; aligned median %.2f um (predicted %.2f), "
+      "worst %.2f um; nominal model misses by up to %.2f mm\n",
+      what, 1e6 * h.gauge_median(), 1e6 * id.accuracy.median, 1e6 * h.gauge.back(), 1e6 * h.aligned_median(),
+      1e6 * id.accuracy.aligned_median, 1e6 * h.aligned.back(), 1e3 * h.nominal_miss);
 }
 
 }  // namespace hexatwist::test

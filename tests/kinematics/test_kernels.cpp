@@ -5,6 +5,7 @@
 #include "kinematics/fast_math.hpp"
 #include "kinematics/gauss_jordan.hpp"
 #include "kinematics/lanes.hpp"
+#include "kinematics/leg_effects_internal.hpp"
 #include "kinematics/linear_solve.hpp"
 #include "kinematics/twist_internal.hpp"
 #include "support.hpp"
@@ -129,17 +130,22 @@ Matrix6d inverse_of(const Inverse6& inv) {
   return J_inv;
 }
 
+// A random system A x = b, entries uniform in [-1, 1].
+void random_system(std::mt19937_64& rng, Matrix6d& A, Vector6d& b) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 36; ++i) A.data()[i] = u(rng);
+  for (int i = 0; i < 6; ++i) b[i] = u(rng);
+}
+
 TEST(GaussJordan, MatchesEigenOnRandomMatrices) {
   // Inverse, solve, determinant sign, pivot ratio (LU's, the same pivots) and the 1-norm condition
   // number, against Eigen's full-pivoting LU and lu6_factor.
   std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
   double worst_backward = 0.0, worst_inverse = 0.0, worst_condition = 0.0;
   for (int n = 0; n < 20000; ++n) {
     Matrix6d A;
     Vector6d b;
-    for (int i = 0; i < 36; ++i) A.data()[i] = u(rng);
-    for (int i = 0; i < 6; ++i) b[i] = u(rng);
+    random_system(rng, A, b);
     Inverse6 inv;
     const double ratio = gauss_jordan(columns_of(A), inv);
     ASSERT_GT(ratio, 0.0);
@@ -191,6 +197,86 @@ TEST(GaussJordan, ReportsSingularNonFiniteAndPermutedMatrices) {
   gj_solve(inv, c, x);
   EXPECT_LT((P * x - c).norm(), 2e-14);
   EXPECT_NEAR(gj_condition(columns_of(P), inv), 6.0 / 1.0, 1e-15);
+}
+
+TEST(GaussJordan, SolvesASystemWithoutTheInverse) {
+  // gj_solve_system against the inverse's solve (the same pivots): the same backward error, the
+  // same pivot ratio, and 0 for singular or non-finite matrices.
+  std::mt19937_64 rng(4);
+  double worst = 0.0;
+  for (int n = 0; n < 20000; ++n) {
+    Matrix6d A;
+    Vector6d b;
+    random_system(rng, A, b);
+    Inverse6 inv;
+    const double ratio = gauss_jordan(columns_of(A), inv);
+    Vector6d x, y;
+    ASSERT_EQ(gj_solve_system(columns_of(A), b, x), ratio);
+    gj_solve(inv, b, y);
+    worst = std::max(worst, (A * x - b).norm() / (A.norm() * x.norm() + b.norm()));
+    EXPECT_LT((x - y).norm(), 1e-12 * (1.0 + y.norm()) / ratio) << A;
+  }
+  std::printf("  backward error %.2g\n", worst);
+  EXPECT_LT(worst, 2e-14);  // measured 1.4e-15
+  Matrix6d S = Matrix6d::Identity();
+  S(3, 3) = 0.0;
+  Vector6d x;
+  EXPECT_EQ(gj_solve_system(columns_of(S), Vector6d::Ones(), x), 0.0);
+  S(3, 3) = NAN;
+  EXPECT_EQ(gj_solve_system(columns_of(S), Vector6d::Ones(), x), 0.0);
+}
+
+// The padded rows of A (row-major, two zeros of padding), as the limits' kernel forms them.
+void padded_rows_of(const Matrix6d& A, PaddedRows& rows) {
+  alignas(64) double r[6][8] = {};
+  for (int i = 0; i < 6; ++i)
+    for (int c = 0; c < 6; ++c) r[i][c] = A(i, c);
+  std::memcpy(rows, r, sizeof r);
+}
+
+TEST(LegForces, BlocksAndTheEliminationSolveTheSameSystem) {
+  // finish_leg_forces solves A^T F = G' by 3x3 blocks, or by the pivoted elimination where a block
+  // is nearly singular. With A = I it returns G' itself; for any A, F satisfies A^T F = G' to
+  // rounding, on either branch; a singular A is SingularJacobian.
+  const Config config = load_config(seed_config_yaml(), "seed");
+  const Model& model = config.rig.model();
+  const StaticLoadSpec& load = model.spec().static_load;
+  ASSERT_TRUE(load.present);
+  const LegLoads none;
+  const Matrix3d R = Eigen::AngleAxisd(0.3, Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  PaddedRows rows;
+  padded_rows_of(Matrix6d::Identity(), rows);
+  Vector6d G;
+  ASSERT_EQ(finish_leg_forces(model, load, R, none, rows, G), Status::Ok);
+  EXPECT_NE(G[2], 0.0);
+  std::mt19937_64 rng(6);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  double worst_blocks = 0.0, worst_pivoted = 0.0;
+  for (int n = 0; n < 2000; ++n) {
+    Matrix6d A;
+    for (int i = 0; i < 36; ++i) A.data()[i] = u(rng);
+    // Every other draw: legs 0, 2 and 4 with coplanar axes (the first block singular), the
+    // matrix still regular: the elimination's branch.
+    const bool coplanar = n % 2 == 1;
+    for (int i = 0; i < 6; i += 2)
+      if (coplanar) A(i, 2) = 0.0;
+    padded_rows_of(A, rows);
+    Vector6d F;
+    ASSERT_EQ(finish_leg_forces(model, load, R, none, rows, F), Status::Ok);
+    const double residual = (A.transpose() * F - G).norm() / (A.norm() * F.norm() + G.norm());
+    (coplanar ? worst_pivoted : worst_blocks) = std::max(coplanar ? worst_pivoted : worst_blocks, residual);
+    const Vector6d exact = A.transpose().fullPivLu().solve(G);
+    const double cond = A.norm() * A.inverse().norm();
+    EXPECT_LT((F - exact).norm(), 1e-13 * cond * exact.norm()) << A;
+  }
+  std::printf("  backward error by blocks %.2g, by elimination %.2g\n", worst_blocks, worst_pivoted);
+  EXPECT_LT(worst_blocks, 1e-14);   // measured 9.2e-16
+  EXPECT_LT(worst_pivoted, 2e-15);  // measured 2.2e-16
+  Matrix6d singular = Matrix6d::Identity();
+  singular.row(4) = singular.row(1);
+  padded_rows_of(singular, rows);
+  Vector6d F;
+  EXPECT_EQ(finish_leg_forces(model, load, R, none, rows, F), Status::SingularJacobian);
 }
 
 TEST(GaussJordan, ColumnPacketsTransposeLikeTheMatrix) {

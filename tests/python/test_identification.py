@@ -119,6 +119,38 @@ def test_a_time_offset_outside_the_run_is_refused_by_both_naming_the_parameter(l
         hexatwist.observations_at_rest(model, stations.t, stations.poses, log.stamps, log.points, settle=-1.0)
 
 
+def test_a_temperature_column_gives_the_same_expansions_in_python_and_the_cli(tmp_path):
+    # The log's temperature column (synth --temperature-column): heat fits each leg's expansion per
+    # kelvin, the CLI and Python alike bit for bit, and both corrected configurations keep them.
+    run("synth", "--stations", "30", "--station-seed", "4", "--joint-errors-mm", "0.5", "--seed", "6",
+        "--temperature-rise-k", "2", "--temperature-column", "--out", "w.csv", cwd=tmp_path)
+    cli = json.loads(run("identify", "--points", "w.csv", "--stations", "30", "--station-seed", "4", "--json",
+                         "--no-figures", "--effects", "heat", "--out", "c.yaml", cwd=tmp_path).stdout)
+    model = hexatwist.default_model()
+    log = hexatwist.read_point_log(str(tmp_path / "w.csv"))
+    assert log.temperatures.shape == log.stamps.shape and log.temperatures[0] == 20.0 and log.temperatures[-1] > 21.9
+    stations = hexatwist.stations_run(count=30, seed=4)
+    obs = hexatwist.observations_at_rest(model, stations.t, stations.poses, log.stamps, log.points,
+                                         temperatures=log.temperatures)
+    py = hexatwist.identify(model, obs.motor, obs.points, effects="heat", times=obs.time, approach=obs.approach,
+                            temperatures=obs.temperature)
+    assert cli["status"] == "ok" and py.status == "ok", py.reason
+    names = [p["name"] for p in cli["estimate"]["parameters"]]
+    assert "expansion 1" in names and "lead expansion" in names and "drift 1" not in names
+    assert list(py.parameter_names[:len(names)]) == names
+    np.testing.assert_array_equal([p["estimate"] for p in cli["estimate"]["parameters"]], py.estimate[:len(names)])
+    lead = names.index("lead expansion")
+    assert abs(py.estimate[lead] - 11.5e-6) < 3.0 * py.sd[lead]
+    text = (tmp_path / "c.yaml").read_text()
+    assert "length_expansion:" in text and "lead_expansion:" in text and "reference_temperature: 20" in text
+    # A temperature outside a machine's range is refused naming the file, line and column.
+    bad = (tmp_path / "w.csv").read_text().splitlines()
+    bad[5] = bad[5].rsplit(",", 1)[0] + ",400.000"
+    (tmp_path / "bad.csv").write_text("\n".join(bad) + "\n")
+    with pytest.raises(hexatwist.ConfigError, match=r"bad.csv:6:.*400 degC is not a machine's temperature"):
+        hexatwist.read_point_log(str(tmp_path / "bad.csv"))
+
+
 def test_the_legs_effects_are_chosen_and_fitted_alike_by_python_and_the_cli(tmp_path):
     # A machine whose legs warm 1 K, deflect at 200 N/um and have 50 um of play (theory §13b): the CLI's
     # --effects auto and Python's effects="auto", with the times and approaches observations_at_rest
@@ -140,6 +172,8 @@ def test_the_legs_effects_are_chosen_and_fitted_alike_by_python_and_the_cli(tmp_
     assert cli["effects_choice"] == py.effects_choice
     np.testing.assert_array_equal([p["estimate"] for p in cli["estimate"]["parameters"]], py.estimate)
     plain = hexatwist.identify(model, obs.motor, obs.points)
-    assert plain.status == "model_mismatch" and "--effects auto" in plain.hint
+    # Without the times, heat cannot be fitted: the refusal says what it needs.
+    assert plain.status == "model_mismatch" and "heat: the legs' drift needs each observation's time" in plain.hint
+    assert set(plain.diagnosis) == {"load", "heat"} and np.isnan(plain.diagnosis["heat"]), plain.diagnosis
     with pytest.raises(ValueError, match="warp"):
         hexatwist.identify(model, obs.motor, obs.points, effects="heat,warp")

@@ -164,6 +164,18 @@ struct Identification {
   double fit_statistic = std::numeric_limits<double>::quiet_NaN();
   int fit_dof = 0;
   double fit_z = std::numeric_limits<double>::quiet_NaN();
+  /// What the model leaves beyond the tracker's noise, per point and coordinate [m]: the fit
+  /// statistic's excess over its expectation, sqrt(max(0, sum_g count_g |mean residual_g|^2 - dof
+  /// tracker_noise^2) / (3 points)) (0 when the fit is within the noise).
+  double unexplained = std::numeric_limits<double>::quiet_NaN();
+  /// On ModelMismatch with the geometry model: each effect not fitted, tried alone on top of those
+  /// fitted, with its drop of the fit statistic in sigma (NaN where it cannot be fitted); those
+  /// above options.effect_sigmas are what the residuals point to (the hint names them).
+  struct EffectDiagnosis {
+    std::string effect;  ///< "load", "play" or "heat"
+    double z = std::numeric_limits<double>::quiet_NaN();
+  };
+  std::vector<EffectDiagnosis> diagnosis;
   std::vector<StationResidual> worst;  ///< the stations with the largest shares of T, largest first (up to 5)
   double rms_before =
       std::numeric_limits<double>::quiet_NaN();  ///< rms 3-D residual of the nominal model after Kabsch [m]

@@ -24,6 +24,9 @@ struct Observation {
   /// When it was taken [s] (the trajectory's time): the time of the legs' drift (EffectFit::heat);
   /// NaN = unknown.
   double time = std::numeric_limits<double>::quiet_NaN();
+  /// The machine's temperature when it was taken [degC] (the log's temperature column): heat then
+  /// fits the legs' expansion per kelvin (EffectFit::measured); NaN = unknown.
+  double temperature = std::numeric_limits<double>::quiet_NaN();
   /// Each leg's approach to the station (EffectFit::play): the length of the last monotone run of
   /// its commanded motor-side length before the station, positive lengthening, negative shortening
   /// [m]; a play longer than the run leaves the nut partway across its gap. 0 = unknown (then the

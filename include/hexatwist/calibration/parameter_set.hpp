@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -51,9 +52,18 @@ struct EffectFit {
   /// screws warming as the motors and the hall do, at any rate that levels off or speeds up; the
   /// offsets and the lead are the legs' at the run's start.
   bool heat = false;
+  /// Heat from the log's temperatures (every observation has one; identify decides): each leg's
+  /// growth per kelvin k_i [m/K] and the screws' lead expansion a_P [1/K], k_i dT + a_P dT (u_i -
+  /// h_i), dT the temperature above the run's first, `reference_temperature` [degC] (no
+  /// curvature: the expansion is linear). The corrected configuration records them
+  /// (length_expansion = k_i / length at home, lead_expansion, reference_temperature).
+  bool measured = false;
+  double reference_temperature = std::numeric_limits<double>::quiet_NaN();
   bool any() const noexcept { return load || play || heat; }
   /// Number of parameters: 1 + 6 + 13 at most.
-  int count() const noexcept { return (load ? 1 : 0) + (play ? kLegs : 0) + (heat ? 2 * kLegs + 1 : 0); }
+  int count() const noexcept {
+    return (load ? 1 : 0) + (play ? kLegs : 0) + (heat ? (measured ? kLegs + 1 : 2 * kLegs + 1) : 0);
+  }
   /// "load,play,heat" (those fitted), "none" without any.
   std::string names() const;
 };
@@ -87,14 +97,16 @@ class ParameterSet {
   int lead_count() const noexcept { return lead_count_; }
   int offset_index() const noexcept { return offset_; }
   /// The legs' effects fitted and their parameters' indices (-1 where not fitted): the compliance,
-  /// the first of the six plays, the first of the six drifts, the first of their six curvatures
-  /// (the lead drift follows them).
+  /// the first of the six plays, the first of the six drifts (expansions per kelvin where
+  /// measured), the first of their six curvatures (none where measured), the lead drift (lead
+  /// expansion where measured).
   const EffectFit& effects() const noexcept { return effects_; }
   int effect_index() const noexcept { return offset_ + kLegs; }  ///< the first effect's parameter
   int compliance_index() const noexcept { return compliance_; }
   int play_index() const noexcept { return play_; }
   int drift_index() const noexcept { return drift_; }
   int curvature_index() const noexcept { return curvature_; }
+  int lead_drift_index() const noexcept { return lead_drift_; }
   /// First gauge coordinate of the base / platform joints; -1 in the Basic model.
   int base_index() const noexcept { return base_; }
   int platform_index() const noexcept { return platform_; }
@@ -151,7 +163,8 @@ class ParameterSet {
   LeadEffect lead_effect_ = LeadEffect::TwistAndTravel;
   AxisSelection axes_{};
   EffectFit effects_{};
-  int compliance_ = -1, play_ = -1, drift_ = -1, curvature_ = -1;
+  int compliance_ = -1, play_ = -1, drift_ = -1, curvature_ = -1, lead_drift_ = -1;
+  Vector6d length_home_ = Vector6d::Zero();  ///< the nominal legs' lengths at home [m]
   int lead_count_ = 1, offset_ = 1, base_ = -1, platform_ = -1, axis_ = -1, axis_count_ = 0, target_ = 7, targets_ = 1,
       rotation_ = 10, size_ = 16;
   Eigen::MatrixXd base_basis_, platform_basis_;

@@ -27,6 +27,9 @@ struct PointLogFormat {
   /// a number per row, case kept); empty = no such column unless the header has one named
   /// `target` (case ignored): then every row is the one target, the observation point.
   std::string target_column;
+  /// Header name of the machine's temperature column [degC] (a `_c` suffix allowed); empty = none
+  /// unless the header has one named `temperature` or `temperature_c` (case ignored).
+  std::string temperature_column;
   /// Length unit of x, y, z for header names without a suffix [m per unit]: 1e-3 for mm, 1 for
   /// m; 0 = not given (then every coordinate column needs a suffix: "units missing" otherwise).
   /// A suffix that disagrees with a given unit is an error.
@@ -41,6 +44,7 @@ struct PointLog {
   std::vector<Vector3d> points_T;         ///< the target as measured [m, T]
   std::vector<int> targets;               ///< which target each point is of: an index into `target_names`
   std::vector<std::string> target_names;  ///< in order of first appearance; target 0 is the observation point
+  std::vector<double> temperatures;       ///< the machine's temperature at each point [degC]; empty = no column
   std::vector<int> lines;                 ///< source line of each point (1-based)
   std::vector<int> stamp_columns;         ///< 1-based character column of each point's time cell
   std::string source;                     ///< the log's name in messages (a file name)
@@ -51,6 +55,9 @@ struct PointLog {
 inline constexpr std::size_t kMinLogPoints = 3;
 /// Most targets a log may carry.
 inline constexpr std::size_t kMaxTargets = 16;
+/// The range of a log's temperatures a machine works in [degC]; outside, a sensor or unit error.
+inline constexpr double kMinLogTemperature = -40.0;
+inline constexpr double kMaxLogTemperature = 150.0;
 
 /// Parses a point log: CSV with a header row, cells separated by commas without quoting, blank
 /// and '#' lines skipped, CRLF and a UTF-8 byte-order mark accepted, other columns ignored but

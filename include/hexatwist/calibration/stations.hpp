@@ -41,7 +41,20 @@ struct StationsSpec {
   MotionLimits limits{0.2, 0.5, 2.5};  ///< the moves, on the distance in pose coordinates [m or rad /s, /s^2, /s^3]
   double dwell = 1.0;                  ///< rest at each station [s]
   std::uint64_t seed = 1;              ///< the same seed gives the same stations everywhere
+  /// Each station approached from both sides (identify's play): twice in a row, first from this
+  /// far above it along z (every leg shortening to it: ds/dz = s_z > 0), then from as far below
+  /// (every leg lengthening), the start poses rests too [m]; 0 = once, from the pose before. A side
+  /// whose start pose, or a move to or from it, leaves a limit is left out (the station is
+  /// then approached from one side or from the pose before). At most kMaxApproach.
+  double approach = 0.0;
+  /// Home again after every this many stations, a reference visited through the run (identify's
+  /// heat: its repeats show the legs' drift apart from the geometry), where the moves to it and on
+  /// to the next station stay inside the limits; 0 = only at the ends.
+  int reference_every = 0;
 };
+
+/// The longest approach a stations run takes [m]: further, a leg's travel would be a station's.
+inline constexpr double kMaxApproach = 0.05;
 
 /// Most stations a run may have.
 inline constexpr int kMaxStations = 10000;
@@ -57,9 +70,16 @@ std::vector<Vector6d> random_stations(const Model& model, Strategy strategy, con
 /// every limit of `model` for the commands of `strategy` [m, rad].
 bool reachable_from(const Model& model, Strategy strategy, const Vector6d& from, const Vector6d& to);
 
-/// Home, then the stations in order, then home: straight moves in pose coordinates (jerk-limited,
-/// as waypoint_trajectory, with `spec.limits`), `spec.dwell` at each. Sampled every `dt` [s] from
-/// t0 = 0. Throws hexatwist::Error if a move leaves a limit (reachable_from), and as waypoint_trajectory.
+/// The poses a run visits, in order: home, the stations (each from both sides with spec.approach,
+/// home again every spec.reference_every), home [m, rad]. Throws hexatwist::Error naming the
+/// station if a move to it leaves a limit (reachable_from), or for an approach outside [0,
+/// kMaxApproach] or a negative reference_every.
+std::vector<Vector6d> station_waypoints(const Model& model, Strategy strategy, std::span<const Vector6d> stations,
+                                        const StationsSpec& spec);
+
+/// station_waypoints' poses with straight moves in pose coordinates between them (jerk-limited, as
+/// waypoint_trajectory, with `spec.limits`), `spec.dwell` at each. Sampled every `dt` [s] from t0 =
+/// 0. Throws as station_waypoints and waypoint_trajectory.
 Trajectory station_run(const Model& model, Strategy strategy, std::span<const Vector6d> stations,
                        const StationsSpec& spec, double dt);
 

@@ -31,6 +31,9 @@ struct SynthesisOptions {
   /// screw's warm-up, whose time constant is of the run's length). It matters where the real
   /// legs expand (ParameterErrors' expansions).
   Vector6d temperature_rise = Vector6d::Zero();
+  /// The log gets the machine's temperature at each point (PointLog::temperatures), the legs' mean
+  /// [degC], as a sensor on the machine read with each point would give it.
+  bool log_temperature = false;
 };
 
 /// A synthetic log and its truth.
