@@ -207,6 +207,15 @@ EffectRegressors effect_regressors(const ParameterSet& set, std::span<const Obse
       !(std::isfinite(fit.reference_temperature) &&
         std::all_of(warming.begin(), warming.end(), [](double w) { return std::isfinite(w); })))
     return fail("heat: the legs' expansion needs each observation's temperature and the run's first");
+  if (fit.heat && fit.measured) {
+    const auto [low, high] = std::minmax_element(warming.begin(), warming.end());
+    if (!(*high - *low >= kMinTemperatureSpread))
+      return fail(
+          fmt::format("heat: the log's temperatures vary by {:.3g} K over the run; the legs' expansion per "
+                      "kelvin needs at least {:g} K (a machine that does not warm needs no heat: leave it "
+                      "out, --effects without heat)",
+                      *high - *low, kMinTemperatureSpread));
+  }
   if (fit.heat && !fit.measured &&
       !(std::isfinite(t0) && std::isfinite(t1) && t1 > t0 &&
         std::all_of(observations.begin(), observations.end(),

@@ -46,6 +46,9 @@ struct EffectRegressors {
   std::vector<Vector6d> constant;                                    ///< per station [m]
 };
 
+/// The least spread of a log's temperatures over the run that heat's expansions are fitted from [K].
+inline constexpr double kMinTemperatureSpread = 0.1;
+
 /// Each leg's play term at a station with approach `approach` [m] (signed run) for the plays `play`
 /// [m]: E = -(b/2)(d - d_home) with the nut's direction d = sign(run) where b <= |run|, and
 /// sign(run)(2|run|/b - 1) where the run ends inside the gap (the nut dragged from the far side):

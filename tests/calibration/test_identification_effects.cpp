@@ -427,6 +427,11 @@ TEST(IdentificationEffects, WhatAnEffectNeedsIsAskedFor) {
   Identification id;
   EXPECT_EQ(identify(nominal, obs, id, options), Status::NotIdentifiable);
   EXPECT_EQ(id.reason.rfind("heat:", 0), 0u) << id.reason;
+  // Temperatures that do not change over the run: no expansion can be fitted from them.
+  for (Observation& o : obs) o.temperature = 21.5;
+  EXPECT_EQ(identify(nominal, obs, id, options), Status::NotIdentifiable);
+  EXPECT_NE(id.reason.find("heat: the log's temperatures vary by 0 K"), std::string::npos) << id.reason;
+  for (Observation& o : obs) o.temperature = std::numeric_limits<double>::quiet_NaN();
   // Load without the configuration's load.
   ModelSpec bare = nominal.spec();
   bare.static_load = StaticLoadSpec{};
