@@ -57,7 +57,7 @@ void write_stdout(std::string_view text) {
 Model load_model_from(const ModelOptions& opts) {
   try {
     if (opts.config.empty()) return default_model();
-    return load_model(read_text_file(opts.config, "--config", "config file", kMaxConfigBytes), opts.config);
+    return load_model(read_text_file(opts.config, opts.option, "config file", kMaxConfigBytes), opts.config);
   } catch (const Error& e) {
     throw ExitError(kExitBadInput, e.what());
   }
@@ -66,7 +66,7 @@ Model load_model_from(const ModelOptions& opts) {
 Config load_config_from(const ModelOptions& opts) {
   try {
     if (opts.config.empty()) return default_config();
-    return load_config(read_text_file(opts.config, "--config", "config file", kMaxConfigBytes), opts.config);
+    return load_config(read_text_file(opts.config, opts.option, "config file", kMaxConfigBytes), opts.config);
   } catch (const Error& e) {
     throw ExitError(kExitBadInput, e.what());
   }
@@ -85,16 +85,50 @@ Vector6d per_leg_option(const std::string& text, const char* option, const std::
   return out;
 }
 
+namespace {
+
+// ExitError(2) for a temperature option `option` given on a model whose legs do not expand.
+void require_expansion(const Model& model, const char* option, const std::string& text, const char* what) {
+  if (model.has_thermal()) return;
+  throw ExitError(kExitBadInput, fmt::format("{} {}: the configuration's legs do not expand (leg_effects: "
+                                             "length_expansion, lead_expansion), so {} changes nothing",
+                                             option, printable(text), what));
+}
+
+}  // namespace
+
 Vector6d temperature_option(const std::string& text, const Model& model) {
   if (text.empty()) return Vector6d::Constant(std::numeric_limits<double>::quiet_NaN());
-  if (!model.has_thermal())
-    throw ExitError(kExitBadInput, fmt::format("--temperature-c {}: the configuration's legs do not expand "
-                                               "(leg_effects: length_expansion, lead_expansion), so a temperature "
-                                               "changes nothing",
-                                               printable(text)));
+  require_expansion(model, "--temperature-c", text, "a temperature");
   return per_leg_option(text, "--temperature-c",
                         fmt::format("a temperature from {:g} to {:g} degC, or six", kMinTemperature, kMaxTemperature),
                         kMinTemperature, kMaxTemperature, 1.0);
+}
+
+void range_option(const std::string& text, StationsSpec& run) {
+  constexpr const char* kRangeWhat =
+      "X_M,ROT_DEG: the stations within ±X_M [m] of home in x, y, z and ±ROT_DEG [deg] in roll, pitch, yaw";
+  const std::vector<double> range = parse_numbers(text, 2, "--range", kRangeWhat);
+  check_option(range[0] >= 0.0 && range[0] <= 10.0, "--range", range[0], "a translation range of 0 to 10 m");
+  check_option(range[1] >= 0.0 && range[1] <= 90.0, "--range", range[1], "a rotation range of 0 to 90 deg");
+  if (range[0] == 0.0 && range[1] == 0.0)
+    throw ExitError(kExitBadInput,
+                    "--range 0,0: expected a range > 0 in translation or rotation: the stations would "
+                    "all be at home");
+  run.translation = range[0];
+  run.rotation = deg2rad(range[1]);
+}
+
+Vector6d temperature_rise_option(const std::string& text, const Model* model) {
+  if (text.empty()) return Vector6d::Zero();
+  const Vector6d rise = per_leg_option(text, "--temperature-rise-k",
+                                       fmt::format("a temperature rise from {:g} to {:g} K over the run, or six",
+                                                   -kMaxTemperatureRise, kMaxTemperatureRise),
+                                       -kMaxTemperatureRise, kMaxTemperatureRise, 1.0);
+  if (model != nullptr)
+    if (const std::string_view why = check_temperature_rise(*model, rise); !why.empty())
+      throw ExitError(kExitBadInput, fmt::format("--temperature-rise-k {}: {}", printable(text), why));
+  return rise;
 }
 
 std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option,

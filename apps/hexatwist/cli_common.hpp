@@ -40,7 +40,8 @@ std::string printable(std::string_view text);
 
 /// Options every command that needs a platform shares.
 struct ModelOptions {
-  std::string config;  ///< YAML file; empty = embedded seed platform
+  std::string config;               ///< YAML file; empty = embedded seed platform
+  const char* option = "--config";  ///< how messages name the argument
 };
 
 /// Adds --config to a subcommand.
@@ -80,6 +81,15 @@ Vector6d per_leg_option(const std::string& text, const char* option, const std::
 /// not expand (it would change nothing).
 Vector6d temperature_option(const std::string& text, const Model& model);
 
+/// `--range X_M,ROT_DEG` into `run`'s translation [m] and rotation [rad]: 0 to 10 m and 0 to 90 deg,
+/// not both 0 (ExitError(2) naming the option).
+void range_option(const std::string& text, StationsSpec& run);
+
+/// The legs' warm-up over a run of `--temperature-rise-k` [K] (one or six, each within
+/// +-kMaxTemperatureRise; empty: none), for synth's real platform and the study's leg effects.
+/// ExitError(2) for a value out of range, or any for a `model` (may be null) whose legs do not expand.
+Vector6d temperature_rise_option(const std::string& text, const Model* model);
+
 /// Help text of `--temperature-c`.
 inline constexpr const char* kTemperatureHelp =
     "Each leg's temperature [degC], one or six, for a configuration with leg_effects (their thermal "
@@ -109,6 +119,7 @@ struct Command {
 };
 Command make_ik_command(CLI::App& root);
 Command make_fk_command(CLI::App& root);
+Command make_compare_command(CLI::App& root);
 Command make_config_command(CLI::App& root);
 Command make_study_command(CLI::App& root);
 Command make_simulate_command(CLI::App& root);

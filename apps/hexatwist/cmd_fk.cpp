@@ -15,6 +15,7 @@ struct FkOptionsCli {
   ModelOptions model;
   std::string lengths;
   std::string guess = "0,0,0,0,0,0";
+  std::string temperature_c;
   bool motor = false;
   bool json = false;
   int max_iterations = FkOptions{}.max_iterations;
@@ -35,7 +36,15 @@ int run_fk(const FkOptionsCli& o) {
   FkOptions fo;
   fo.max_iterations = o.max_iterations;
   auto result = std::make_unique<FkResult>();
-  const Status status = forward_kinematics(model, lengths, kind, placement_from_pose(guess), *result, fo);
+  LegInputs inputs;
+  inputs.temperature = temperature_option(o.temperature_c, model);
+  if (!o.temperature_c.empty() && !o.motor)
+    throw ExitError(kExitBadInput,
+                    "--temperature-c: give it with --motor (the drives' lengths, which the legs' "
+                    "expansion changes); geometric lengths are the joints' distances already");
+  const Status status =
+      o.motor ? forward_kinematics(model, lengths, inputs, nullptr, placement_from_pose(guess), *result, fo)
+              : forward_kinematics(model, lengths, kind, placement_from_pose(guess), *result, fo);
   LimitReport limit;
   Status final_status = status;
   if (status == Status::Ok) final_status = check_limits(model, result->legs, limit);
@@ -96,6 +105,7 @@ Command make_fk_command(CLI::App& root) {
   app->add_option("--max-iterations", opts->max_iterations, "Newton iterations before giving up")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
+  app->add_option("--temperature-c", opts->temperature_c, kTemperatureHelp);
   add_model_options(*app, opts->model);
   app->add_flag("--json", opts->json, "Machine-readable output (SI units: m, rad)");
   return {app, [opts] { return run_fk(*opts); }};

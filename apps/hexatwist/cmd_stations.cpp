@@ -48,17 +48,7 @@ std::string stream_input(const Trajectory& run) {
 // The library's spec from the options, each checked with its own name (exit 2).
 StationPlanSpec plan_spec(const Model& model, const StationsOptions& o) {
   StationPlanSpec spec;
-  constexpr const char* kRangeWhat =
-      "X_M,ROT_DEG: the stations within ±X_M [m] of home in x, y, z and ±ROT_DEG [deg] in roll, pitch, yaw";
-  const std::vector<double> range = parse_numbers(o.range, 2, "--range", kRangeWhat);
-  check_option(range[0] >= 0.0 && range[0] <= 10.0, "--range", range[0], "a translation range of 0 to 10 m");
-  check_option(range[1] >= 0.0 && range[1] <= 90.0, "--range", range[1], "a rotation range of 0 to 90 deg");
-  if (range[0] == 0.0 && range[1] == 0.0)
-    throw ExitError(kExitBadInput,
-                    "--range 0,0: expected a range > 0 in translation or rotation: the stations would "
-                    "all be at home");
-  spec.run.translation = range[0];
-  spec.run.rotation = deg2rad(range[1]);
+  range_option(o.range, spec.run);
   spec.run.seed = o.seed;
   // How the run visits the planned stations (run_options' --both-sides-mm and --reference-every).
   check_option(o.both_sides_mm >= 0.0 && o.both_sides_mm <= kMaxApproach * 1e3, "--both-sides-mm", o.both_sides_mm,

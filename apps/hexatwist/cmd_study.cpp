@@ -18,6 +18,7 @@ struct StudyOptions {
   std::string out = "study-out";
   std::string tests = "Lz,Lx,Rz,Ry";
   std::string trajectory;  // simulate only
+  std::string temperature_rise_k;
   bool no_figures = false;
   bool no_csv = false;
 };
@@ -34,7 +35,8 @@ struct StudyFiles {
 
 int finish(const Rig& rig, const StudyOptions& o, const std::string& command, std::vector<ReportedTest>& tests,
            OutputFiles& files, std::chrono::steady_clock::time_point start) {
-  const ReportOptions ro{o.out, command, model_source(o.model), !o.no_figures, !o.no_csv};
+  ReportOptions ro{o.out, command, model_source(o.model), !o.no_figures, !o.no_csv};
+  ro.temperature_rise = temperature_rise_option(o.temperature_rise_k, &rig.model());
   simulate_and_report(rig, ro, tests, files, start);
   return kExitOk;
 }
@@ -81,6 +83,10 @@ void add_common(CLI::App& app, StudyOptions& o) {
       ->capture_default_str();
   app.add_flag("--no-figures", o.no_figures, "Skip the PNG/SVG figures (gnuplot)");
   app.add_flag("--no-csv", o.no_csv, "Skip the per-tick CSVs (about 9 MB per test and strategy at 1 kHz)");
+  app.add_option("--temperature-rise-k", o.temperature_rise_k,
+                 "For a configuration whose legs expand (leg_effects): the legs warm by this over each test [K], one "
+                 "or six, along synth's warm-up, in the table of what each leg effect costs (perfect servos); "
+                 "default 0");
 }
 
 }  // namespace

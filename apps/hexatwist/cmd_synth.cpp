@@ -40,12 +40,13 @@ struct SynthOptions {
   bool temperature_column = false;
   std::string out;
   std::string run_out;
+  std::string real;
 };
 
 std::string truth_json(const Config& config, const SynthOptions& o, const Run& run, const SynthesisOptions& so,
                        const SyntheticLog& log) {
   const Model& model = config.rig.model();
-  const Model real = real_model(model, so.errors);
+  const Model real = real_platform(model, so);
   JsonWriter j;
   j.begin_document(schema::kTruth)
       .field("command", "synth")
@@ -126,6 +127,22 @@ std::string mm_list(const Vec& v) {
   std::string s;
   for (Eigen::Index i = 0; i < v.size(); ++i) s += fmt::format("{}{:.4f}", i == 0 ? "" : ", ", 1e3 * v[i]);
   return s;
+}
+
+// The real platform as a configuration: --config's text (or the seed's) with the real platform in
+// the legs form, its legs' effects included: for synth --real (a validation run) and compare.
+std::string real_platform_yaml(const SynthOptions& o, const Model& model, const SynthesisOptions& so,
+                               const std::string& out) {
+  const std::string source_text = o.run.model.config.empty()
+                                      ? std::string(seed_config_yaml())
+                                      : read_text_file(o.run.model.config, "--config", "config file");
+  ModelSpec real = real_platform(model, so).spec();
+  real.name = fmt::format("the real platform of {} (hexatwist synth --seed {})", out, o.seed);
+  const std::string header = fmt::format(
+      "The real platform hexatwist synth measured for {}: give it to synth --real to drive the same platform with\n"
+      "another configuration's commands (a validation run), or to compare.",
+      out);
+  return platform_config_yaml(source_text, model_source(o.run.model), real, header, true);
 }
 
 // The synthesis options from the command's, every value checked (one line naming the option).
@@ -217,12 +234,12 @@ SynthesisOptions synthesis_options(const SynthOptions& o, const Rig& rig) {
     check_option(v >= kMinExpansion * 1e6 && v <= kMaxExpansion * 1e6, "--expansion-ppm-per-k", v,
                  fmt::format("expansions from {:g} to {:g} ppm/K", kMinExpansion * 1e6, kMaxExpansion * 1e6));
   if (!o.temperature_rise_k.empty()) {
-    so.temperature_rise = per_leg_option(o.temperature_rise_k, "--temperature-rise-k",
-                                         "a temperature rise from -50 to 50 K over the run, or six", -50.0, 50.0, 1.0);
+    so.temperature_rise = temperature_rise_option(o.temperature_rise_k, nullptr);
     so.errors.length_expansion = expansion[0] * 1e-6;
     so.errors.lead_expansion = expansion[1] * 1e-6;
   }
   so.log_temperature = o.temperature_column;
+  if (!o.real.empty()) so.real = load_model_from(ModelOptions{o.real, "--real"}).spec();
   return so;
 }
 
@@ -248,23 +265,26 @@ std::string log_csv(const SyntheticLog& log, bool targets) {
 
 // What synth tells the user: the run, the real platform's errors, the tracker, the files.
 std::string summary_text(const SynthOptions& o, const Rig& rig, const Run& run, const SynthesisOptions& so,
-                         const SyntheticLog& log, const std::string& out, const std::string& truth) {
+                         const SyntheticLog& log, const std::string& out, const std::string& truth,
+                         const std::string& real_yaml) {
   const bool targets = !so.extra_targets_P.empty();
   const Vector3d& origin = log.X_BT.t;
   std::string text = fmt::format("hexatwist synth on {}: {}\n", model_source(o.run.model), rig.model().spec().name);
   text += fmt::format("run: {}, {} commands, {:.2f} s: {} points at {:g} Hz\n", run.test.description, o.run.strategy,
                       run.test.trajectory.duration(), log.log.points_T.size(), so.rate);
   const bool one_lead = (so.errors.lead_error.array() == so.errors.lead_error[0]).all();
-  text += fmt::format(
-      "real platform: lead {} ({} mm), twist sign {}, zero offsets [{}] mm, point offset [{}] mm\n",
-      one_lead ? fmt::format("{:+g}%", 100.0 * so.errors.lead_error[0]) : "errors [" + o.lead_error_pct + "] %",
-      one_lead
-          ? fmt::format("{:g}", 1e3 * rig.model().leg(0).lead * (1.0 + so.errors.lead_error[0]))
-          : mm_list(
-                Vector6d(so.errors.lead_error.array() + 1.0).cwiseProduct(Vector6d::Constant(rig.model().leg(0).lead))),
-      so.errors.flip_twist_sign ? "flipped" : "as modelled", mm_list(so.errors.zero_offset),
-      mm_list(so.errors.observation_offset_P));
-  if (o.joint_errors_mm > 0.0 || o.axis_errors_deg > 0.0)
+  if (!o.real.empty())
+    text += fmt::format("real platform: {} (its joints, leads, offsets, point and legs' effects)\n", printable(o.real));
+  else
+    text += fmt::format(
+        "real platform: lead {} ({} mm), twist sign {}, zero offsets [{}] mm, point offset [{}] mm\n",
+        one_lead ? fmt::format("{:+g}%", 100.0 * so.errors.lead_error[0]) : "errors [" + o.lead_error_pct + "] %",
+        one_lead ? fmt::format("{:g}", 1e3 * rig.model().leg(0).lead * (1.0 + so.errors.lead_error[0]))
+                 : mm_list(Vector6d(so.errors.lead_error.array() + 1.0)
+                               .cwiseProduct(Vector6d::Constant(rig.model().leg(0).lead))),
+        so.errors.flip_twist_sign ? "flipped" : "as modelled", mm_list(so.errors.zero_offset),
+        mm_list(so.errors.observation_offset_P));
+  if (o.real.empty() && (o.joint_errors_mm > 0.0 || o.axis_errors_deg > 0.0))
     text += fmt::format(
         "joints: centres off by up to {:.4f} mm (within ±{:g} mm per coordinate, no rigid part), axes turned by up to "
         "{:.3f} deg\n",
@@ -277,8 +297,8 @@ std::string summary_text(const SynthOptions& o, const Rig& rig, const Run& run, 
   if (targets) text += fmt::format("targets: A and {} more, measured at every sample\n", so.extra_targets_P.size());
   text += fmt::format("tracker: origin ({:.3f}, {:.3f}, {:.3f}) m in the base frame, noise {:g} um per axis, seed {}\n",
                       origin.x(), origin.y(), origin.z(), o.noise_um, o.seed);
-  text += o.run_out.empty() ? fmt::format("wrote {} and {}", out, truth)
-                            : fmt::format("wrote {}, {} and the run {}", out, truth, o.run_out);
+  text += o.run_out.empty() ? fmt::format("wrote {}, {} and {}", out, truth, real_yaml)
+                            : fmt::format("wrote {}, {}, {} and the run {}", out, truth, real_yaml, o.run_out);
   if (std::isfinite(run.calibration_end))
     text += fmt::format("; measure registers on the calibration moves, t <= {:.3f} s", run.calibration_end);
   return text + "\n";
@@ -291,11 +311,14 @@ int run_synth(const SynthOptions& o) {
   const std::string out = o.out.empty() ? fmt::format("tracker_{}.csv", run.test.name) : o.out;
   const std::filesystem::path csv(out);
   const std::string truth = (csv.parent_path() / (csv.stem().string() + ".truth.json")).string();
+  const std::string real_yaml = (csv.parent_path() / (csv.stem().string() + ".real.yaml")).string();
   OutputFiles files("synth");
   files.input("--config", o.run.model.config);
   files.input("--trajectory", o.run.trajectory);
+  files.input("--real", o.real);
   files.output("--out", out);
   files.output("the truth beside --out", truth);
+  files.output("the real platform beside --out", real_yaml);
   files.output("--run-out", o.run_out);
   const SynthesisOptions so = synthesis_options(o, rig);
   SimulationIssue issue;
@@ -320,13 +343,14 @@ int run_synth(const SynthOptions& o) {
 
   files.add(out, log_csv(log, !so.extra_targets_P.empty()));
   files.add(truth, truth_json(config, o, run, so, log));
+  files.add(real_yaml, real_platform_yaml(o, rig.model(), so, out));
   if (!o.run_out.empty())
     files.add(o.run_out,
               format_trajectory_csv(run.test.trajectory,
                                     static_cast<std::size_t>(std::llround(rig.simulation().control_rate / so.rate))));
   files.commit();
 
-  files.finish(summary_text(o, rig, run, so, log, out, truth));
+  files.finish(summary_text(o, rig, run, so, log, out, truth, real_yaml));
   return kExitOk;
 }
 
@@ -339,9 +363,10 @@ Command make_synth_command(CLI::App& root) {
       "A tracker-like point log made from the closed-loop simulation: the real platform differs from the model by "
       "known errors (joint centres and axes, leads, twist sign, zero offsets, observation point), the points of one "
       "or more targets are in a random tracker frame with Gaussian noise. Writes FILE.csv (t_s,x_mm,y_mm,z_mm; a "
-      "target column with --targets-mm) and FILE.truth.json (SI: the tracker frame X_BT, the errors, the real "
-      "platform, the noise) beside it, all files or none; outputs naming the same file are refused (exit 2). Input "
-      "for measure and identify.");
+      "target column with --targets-mm), FILE.truth.json (SI: the tracker frame X_BT, the errors, the real "
+      "platform, the noise) and FILE.real.yaml (the real platform as a configuration: for --real and compare) "
+      "beside it, all files or none; outputs naming the same file are refused (exit 2). Input for measure and "
+      "identify.");
   add_run_options(*app, o->run);
   app->add_option("--noise-um", o->noise_um, "Tracker noise, standard deviation per axis [um], >= 0")
       ->capture_default_str();
@@ -389,6 +414,14 @@ Command make_synth_command(CLI::App& root) {
   app->add_option("--run-out", o->run_out,
                   "Also write the commanded run as a trajectory CSV (t_s,x_m,y_m,z_m,roll_rad,pitch_rad,yaw_rad, at "
                   "the tracker rate): to drive a real platform through it (e.g. a --stations run), or as --trajectory");
+  CLI::Option* real = app->add_option(
+      "--real", o->real,
+      "The real platform itself, a configuration (e.g. the FILE.real.yaml of an earlier synth): the log is measured "
+      "on it while --config's commands drive it (a validation run of a corrected configuration); excludes the "
+      "options of the real platform's errors");
+  for (const char* name : {"--lead-error-pct", "--joint-errors-mm", "--axis-errors-deg", "--stiffness-n-per-um",
+                           "--play-um", "--expansion-ppm-per-k", "--flip-sign", "--offsets-mm", "--point-offset-mm"})
+    real->excludes(app->get_option(name));
   return {app, [o] { return run_synth(*o); }};
 }
 

@@ -44,11 +44,12 @@ Command make_design_command(CLI::App& root);
 Command make_tolerance_command(CLI::App& root);
 
 std::vector<Command> add_commands(CLI::App& app) {
-  std::vector<Command> commands{
-      make_study_command(app),   make_simulate_command(app),  make_dynamics_command(app), make_synth_command(app),
-      make_measure_command(app), make_identify_command(app),  make_stations_command(app), make_workspace_command(app),
-      make_design_command(app),  make_tolerance_command(app), make_stream_command(app),   make_ik_command(app),
-      make_fk_command(app),      make_config_command(app),    make_linuxcnc_command(app), make_mjcf_command(app)};
+  std::vector<Command> commands{make_study_command(app),     make_simulate_command(app),  make_dynamics_command(app),
+                                make_synth_command(app),     make_measure_command(app),   make_identify_command(app),
+                                make_stations_command(app),  make_workspace_command(app), make_design_command(app),
+                                make_tolerance_command(app), make_stream_command(app),    make_ik_command(app),
+                                make_fk_command(app),        make_config_command(app),    make_linuxcnc_command(app),
+                                make_mjcf_command(app),      make_compare_command(app)};
   for (const Command& c : commands)
     for (CLI::Option* opt : c.app->get_options())
       if (opt->get_type_name() == "UINT")

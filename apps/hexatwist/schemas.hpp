@@ -9,6 +9,7 @@ namespace hexatwist::cli::schema {
 
 inline constexpr const char* kIk = "hexatwist.ik/1";                // ik --json
 inline constexpr const char* kFk = "hexatwist.fk/1";                // fk --json
+inline constexpr const char* kCompare = "hexatwist.compare/1";      // compare --json
 inline constexpr const char* kConfig = "hexatwist.config/1";        // config --json
 inline constexpr const char* kIdentify = "hexatwist.identify/2";    // identify --json (2: lead, thread per leg)
 inline constexpr const char* kStations = "hexatwist.stations/1";    // stations --json

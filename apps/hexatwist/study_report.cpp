@@ -134,6 +134,16 @@ void measured_json(JsonWriter& j, const ReportedMeasurement& r) {
   j.end_object();
 }
 
+// An effect's three costs in the tables' order, with their JSON names.
+std::array<std::pair<const char*, const ErrorStats*>, 3> effect_columns(const EffectCost& e) {
+  return {{{"conventional", &e.conventional},
+           {"twist_compensated", &e.twist_compensated},
+           {"compensated", &e.compensated}}};
+}
+
+// How the tables name an effect's row.
+std::string effect_label(const EffectCost& e) { return e.effect == "all" ? std::string("all of them") : e.effect; }
+
 std::string summary_json(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests,
                          const std::vector<std::string>& files) {
   JsonWriter j;
@@ -157,6 +167,17 @@ std::string summary_json(const Rig& rig, const ReportOptions& o, const std::vect
     if (t.measured) {
       j.key("measured");
       measured_json(j, *t.measured);
+    }
+    if (!t.effects.empty()) {
+      j.key("leg_effects").begin_array(true);
+      for (const EffectCost& e : t.effects) {
+        j.begin_object().field("effect", e.effect);
+        for (const auto& [name, stats] : effect_columns(e)) {
+          j.key(name).begin_object().field("max", stats->max).field("rms", stats->rms).end_object();
+        }
+        j.end_object();
+      }
+      j.end_array();
     }
     j.end_object();
   }
@@ -190,6 +211,36 @@ constexpr ErrorRow kErrorRows[] = {
 std::string mm(double m) {
   const double v = 1e3 * m;
   return v != 0.0 && std::abs(v) < 5e-5 ? fmt::format("{:.1e}", v) : fmt::format("{:.4f}", v);
+}
+
+// summary.md's table of the legs' effects; empty without them.
+std::string effects_md(const std::vector<ReportedTest>& tests, const Vector6d& temperature_rise) {
+  if (tests.empty() || tests.front().effects.empty()) return {};
+  std::string s =
+      "\n**The legs' effects** (the configuration's `leg_effects`; theory §4b): the error of point A in mm with "
+      "perfect servos (the motors exactly at their targets), each effect alone on otherwise rigid legs. "
+      "**conventional**: commands that ignore the twist and the effect; **twist compensated**: Eq. (12) alone, "
+      "the effect left; **compensated**: both (the legs' temperatures known to the commands).";
+  if (temperature_rise.any())
+    s += fmt::format(" Heat: the legs warm by {:g} to {:g} K over each test (along synth's warm-up).",
+                     temperature_rise.minCoeff(), temperature_rise.maxCoeff());
+  s += "\n\n";
+  s += "| effect | commands |";
+  for (const ReportedTest& t : tests) s += fmt::format(" {} max | {} RMS |", t.name, t.name);
+  s += "\n|---|---|";
+  for (std::size_t i = 0; i < tests.size(); ++i) s += "---:|---:|";
+  s += "\n";
+  for (std::size_t r = 0; r < tests.front().effects.size(); ++r)
+    for (std::size_t c = 0; c < 3; ++c) {
+      const char* column_names[] = {"conventional", "twist compensated", "compensated"};
+      s += fmt::format("| {} | {} |", effect_label(tests.front().effects[r]), column_names[c]);
+      for (const ReportedTest& t : tests) {
+        const ErrorStats& st = *effect_columns(t.effects[r])[c].second;
+        s += fmt::format(" {} | {} |", mm(st.max), mm(st.rms));
+      }
+      s += "\n";
+    }
+  return s;
 }
 
 std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector<ReportedTest>& tests,
@@ -243,6 +294,7 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
           m.points.size() - m.window, t.name);
     }
   }
+  s += effects_md(tests, o.temperature_rise);
   if (const std::string notes = report_notes(rig, tests); !notes.empty()) s += "\n" + notes;
   s += "\nTests:\n\n";
   for (const ReportedTest& t : tests)
@@ -290,7 +342,7 @@ std::string where(const ReportedTest& t, const SimulationIssue& issue) {
 
 }  // namespace
 
-void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests) {
+void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const Vector6d& temperature_rise) {
   for (const ReportedTest& t : tests) {
     SimulationIssue issue;
     if (const Status s = check_trajectory(rig, t.trajectory, issue); s != Status::Ok)
@@ -315,12 +367,19 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests) {
     before += 3 * t.trajectory.poses.size();
   }
   bar.finish();
+  for (ReportedTest& t : tests) {
+    SimulationIssue issue;
+    if (const Status s = effect_costs(rig.model(), t.trajectory, temperature_rise, t.effects, issue); s != Status::Ok)
+      throw ExitError(kExitOutOfLimit,
+                      fmt::format("{}: the legs' effects: {}; no report was written", where(t, issue),
+                                  is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+  }
 }
 
 void simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<ReportedTest>& tests, OutputFiles& files,
                          std::chrono::steady_clock::time_point start,
                          const std::function<std::string(std::vector<ReportedTest>&)>& after_simulation) {
-  simulate_tests(rig, tests);
+  simulate_tests(rig, tests, o.temperature_rise);
   const double simulated = [&] {
     double d = 0.0;
     for (const ReportedTest& t : tests) d += 3.0 * t.trajectory.duration();
@@ -357,6 +416,17 @@ std::string summary_table(const std::vector<ReportedTest>& tests) {
     for (const ReportedTest& t : tests)
       s += fmt::format(" {:>10}", measured(t) ? mm(t.measured->measurement.error.max) : std::string());
     s += "\n";
+  }
+  // The legs' effects (the same rows on every test: they depend on the configuration), perfect servos.
+  if (tests.empty() || tests.front().effects.empty()) return s;
+  s += "legs' effects, perfect servos:\n";
+  for (std::size_t r = 0; r < tests.front().effects.size(); ++r) {
+    const char* column_names[] = {"conventional", "twist comp.", "compensated"};
+    for (std::size_t c = 0; c < 3; ++c) {
+      s += fmt::format("{:<13} {:<14}", c == 0 ? effect_label(tests.front().effects[r]) : "", column_names[c]);
+      for (const ReportedTest& t : tests) s += fmt::format(" {:>10}", mm(effect_columns(t.effects[r])[c].second->max));
+      s += "\n";
+    }
   }
   return s;
 }

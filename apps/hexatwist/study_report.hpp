@@ -32,6 +32,7 @@ struct ReportedTest {
   Trajectory trajectory;
   TestRun run;
   std::optional<ReportedMeasurement> measured;  ///< with `measure`: the experiment
+  std::vector<EffectCost> effects;  ///< what the legs' effects cost on it (a configuration with leg_effects)
 };
 
 /// A study test to report: its name, label, description ("rotation about z, +-30 deg") and swept
@@ -45,17 +46,19 @@ ReportedTest reported_trajectory_file(const std::string& path, double dt, TimedP
 
 /// Where and how to write.
 struct ReportOptions {
-  std::string out_dir;        ///< created if missing
-  std::string command;        ///< "study", "simulate" or "measure", for the summary
-  std::string config_source;  ///< where the configuration came from
-  bool figures = true;        ///< draw PNG + SVG figures with gnuplot
-  bool csv = true;            ///< write the per-tick CSVs
+  std::string out_dir;                           ///< created if missing
+  std::string command;                           ///< "study", "simulate" or "measure", for the summary
+  std::string config_source;                     ///< where the configuration came from
+  bool figures = true;                           ///< draw PNG + SVG figures with gnuplot
+  bool csv = true;                               ///< write the per-tick CSVs
+  Vector6d temperature_rise = Vector6d::Zero();  ///< the legs' warm-up over each test, for the effects' costs [K]
 };
 
 /// Checks every test's trajectory against the limits first (ExitError(3) naming the test, time and
 /// limit, and nothing runs, if one fails), then runs each test's three simulations (run_test), with a
-/// progress bar on stderr when it is a terminal.
-void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests);
+/// progress bar on stderr when it is a terminal; then, on a configuration whose legs have effects,
+/// what each costs on each test (effect_costs with `temperature_rise` [K]).
+void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const Vector6d& temperature_rise);
 
 /// What study, simulate and measure do once their tests are set up and `files` knows their inputs
 /// and folder: simulate_tests, then `after_simulation` (may be empty; returns lines to print before

@@ -133,16 +133,34 @@ py::dict strategy_summary(const Rig& rig, const StrategyRun& r) {
   return d;
 }
 
-py::dict study_py(const py::object& config_src, const py::object& test, const py::object& poses) {
+// An effect's costs as summary.json has them.
+py::dict effect_dict(const EffectCost& e) {
+  py::dict d;
+  d["effect"] = e.effect;
+  d["conventional"] = stats(e.conventional);
+  d["twist_compensated"] = stats(e.twist_compensated);
+  d["compensated"] = stats(e.compensated);
+  return d;
+}
+
+py::dict study_py(const py::object& config_src, const py::object& test, const py::object& poses,
+                  const py::object& temperature_rise) {
   const auto rig = rig_of(config_src);  // built once: a Rig argument is not parsed again
   const Config& config = *rig->config;
   const Trajectory tr = trajectory_of(config, test, poses);
+  const Vector6d rise = py::isinstance<py::float_>(temperature_rise) || py::isinstance<py::int_>(temperature_rise)
+                            ? Vector6d::Constant(temperature_rise.cast<double>())
+                            : vector6(temperature_rise, "temperature_rise");
+  if (const std::string_view why = check_temperature_rise(config.rig.model(), rise); !why.empty())
+    raise_input("temperature_rise: " + std::string(why));
   TestRun run;
+  std::vector<EffectCost> effects;
   SimulationIssue issue;
   Status s;
   {
     py::gil_scoped_release release;
     s = run_test(config.rig, tr, run, issue);
+    if (s == Status::Ok) s = effect_costs(config.rig.model(), tr, rise, effects, issue);
   }
   py::dict d;
   py::dict summary = issue_dict(s, issue);
@@ -153,6 +171,9 @@ py::dict study_py(const py::object& config_src, const py::object& test, const py
     // A run stopped by a limit has no errors to report: None, not the zeros of no ticks.
     summary[name] = s == Status::Ok ? py::object(strategy_summary(config.rig, *r)) : py::none();
   }
+  py::list leg_effects;
+  for (const EffectCost& e : effects) leg_effects.append(effect_dict(e));
+  summary["leg_effects"] = leg_effects;
   d["tracking_only"] =
       py::array_t<double>(static_cast<py::ssize_t>(run.tracking_only.size()), run.tracking_only.data());
   d["summary"] = summary;
@@ -165,7 +186,8 @@ void expose_simulation(py::module_& m) {
   m.attr("MAX_TRAJECTORY_SAMPLES") = kMaxTrajectorySamples;
   m.def("_simulate", &simulate_py, py::arg("rig") = py::none(), py::arg("test") = py::none(),
         py::arg("poses") = py::none(), py::arg("strategy") = "compensated", py::arg("twist_in_plant") = true);
-  m.def("_study", &study_py, py::arg("rig") = py::none(), py::arg("test") = py::none(), py::arg("poses") = py::none());
+  m.def("_study", &study_py, py::arg("rig") = py::none(), py::arg("test") = py::none(), py::arg("poses") = py::none(),
+        py::arg("temperature_rise") = 0.0);
   m.def(
       "control_period", [](const py::object& c) { return rig_of(c)->config->rig.control_period(); },
       py::arg("rig") = py::none(), "The configuration's control period [s] (poses of simulate are this far apart).");

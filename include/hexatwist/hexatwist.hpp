@@ -24,6 +24,7 @@
 #include "hexatwist/dynamics/motor_sizing.hpp"
 #include "hexatwist/dynamics/rig.hpp"
 
+#include "hexatwist/simulation/effect_cost.hpp"
 #include "hexatwist/simulation/servo.hpp"
 #include "hexatwist/simulation/simulation.hpp"
 #include "hexatwist/simulation/study.hpp"
@@ -39,6 +40,7 @@
 #include "hexatwist/calibration/station_plan.hpp"
 #include "hexatwist/calibration/stations.hpp"
 #include "hexatwist/calibration/synthesis.hpp"
+#include "hexatwist/calibration/validation.hpp"
 
 #include "hexatwist/design/axis_design.hpp"
 #include "hexatwist/design/required_workspace.hpp"

@@ -6,7 +6,8 @@
  * World: X Y Z in the machine's length unit, Z the absolute height of the platform frame above the
  * base frame (home: Z = home_height); A B C in degrees, roll, pitch, yaw with R = Rz(C) Ry(B) Rx(A).
  * Joints 0..5: the absolute motor-side lengths of legs 1..6 in the machine's length unit (what the
- * motor encoders measure). See integrations/linuxcnc/README.md.
+ * motor encoders measure). Legs that expand (the configuration's leg_effects) get an input pin each,
+ * hexatwistkins.leg.N.temperature [degC]. See integrations/linuxcnc/README.md.
  *
  * This unit is C because LinuxCNC's headers are; the kinematics are the library's. Nothing here
  * allocates after rtapi_app_main: the calls made from the servo thread are the C API's real-time
@@ -39,6 +40,7 @@ struct leg_pins {
   hal_float_t* twist;        /* rod rotation relative to the housing since home [deg] */
   hal_float_t* length_error; /* real minus motor-side length caused by the twist [machine unit] */
   hal_float_t* length;       /* joint-to-joint length [machine unit] */
+  hal_float_t* temperature;  /* IN: the leg's temperature [degC] (only for legs that expand) */
 };
 
 struct pins {
@@ -64,6 +66,22 @@ static hexatwist_strategy command_strategy = HEXATWIST_COMPENSATED;
 static double unit_per_m = 1000.0;   /* machine length units per metre */
 static double home_height = 0.0;     /* [m] */
 static hexatwist_fk_tracker tracker; /* the last forward solution and its assembly mode */
+static int expands = 0;              /* the legs expand: the temperature pins exist */
+
+/* The legs' conditions from the pins: the forces the static load's, the temperatures the pins'
+ * (the reference without expansion). A pin that is not a number is refused (a failed sensor is not
+ * the reference temperature): returns 0 then. The library refuses one outside -60..200 degC. */
+static int leg_inputs(hexatwist_leg_inputs* inputs) {
+  int i;
+  *inputs = hexatwist_leg_inputs_default();
+  if (!expands) return 1;
+  for (i = 0; i < HEXATWIST_LEGS; ++i) {
+    const double t = *pins->leg[i].temperature;
+    if (t != t) return 0;
+    inputs->temperature[i] = t;
+  }
+  return 1;
+}
 
 /* World pose [machine unit, deg] to a hexatwist pose relative to home [m, rad]. */
 static void to_pose(const EmcPose* world, double pose[6]) {
@@ -89,13 +107,19 @@ int kinematicsInverse(const EmcPose* world, double* joints, const KINEMATICS_INV
                       KINEMATICS_FORWARD_FLAGS* fflags) {
   double pose[6];
   hexatwist_command_report report;
+  hexatwist_leg_inputs inputs;
   const double* command;
   hexatwist_status status;
   int i;
   (void)iflags;
   if (fflags) *fflags = 0;
   to_pose(world, pose);
-  status = hexatwist_compute_commands(model, pose, &report);
+  if (!leg_inputs(&inputs)) {
+    *pins->ik_status = HEXATWIST_NON_FINITE_INPUT;
+    ++*pins->ik_refused;
+    return -1;
+  }
+  status = hexatwist_compute_commands_under(model, pose, &inputs, NULL, &report);
   *pins->ik_status = status;
   *pins->condition = report.condition;
   *pins->limit_status = report.nearest.status;
@@ -127,13 +151,20 @@ int kinematicsForward(const double* joints, EmcPose* world, const KINEMATICS_FOR
   double lengths[HEXATWIST_LEGS], guess[6];
   hexatwist_fk_result result;
   hexatwist_fk_tracker fallback;
+  hexatwist_leg_inputs inputs;
   hexatwist_status status;
   int i;
   (void)fflags;
   if (iflags) *iflags = 0;
   for (i = 0; i < HEXATWIST_LEGS; ++i) lengths[i] = joints[i] / unit_per_m;
-  status = hexatwist_forward_kinematics_tracked(model, lengths, HEXATWIST_MOTOR, &tracker, NULL, &result);
-  if (status != HEXATWIST_OK && status != HEXATWIST_NON_FINITE_INPUT) {
+  if (!leg_inputs(&inputs)) {
+    *pins->fk_status = HEXATWIST_NON_FINITE_INPUT;
+    *pins->fk_fail = 1;
+    ++*pins->fk_failures;
+    return -1;
+  }
+  status = hexatwist_forward_kinematics_tracked_under(model, lengths, &inputs, NULL, &tracker, NULL, &result);
+  if (status != HEXATWIST_OK && status != HEXATWIST_NON_FINITE_INPUT && status != HEXATWIST_INVALID_ARGUMENT) {
     /* Fallback starts, each accepted only on the tracker's assembly mode. */
     static const double home_pose[6] = {0, 0, 0, 0, 0, 0};
     const double* starts[2];
@@ -143,7 +174,7 @@ int kinematicsForward(const double* joints, EmcPose* world, const KINEMATICS_FOR
     for (i = 0; i < 2 && status != HEXATWIST_OK; ++i) {
       if (hexatwist_fk_tracker_set(model, &fallback, starts[i], HEXATWIST_MOTOR) != HEXATWIST_OK) continue;
       if (tracker.valid && fallback.det_sign != tracker.det_sign) continue; /* a start on another mode */
-      status = hexatwist_forward_kinematics_tracked(model, lengths, HEXATWIST_MOTOR, &fallback, NULL, &result);
+      status = hexatwist_forward_kinematics_tracked_under(model, lengths, &inputs, NULL, &fallback, NULL, &result);
       if (status == HEXATWIST_OK) {
         tracker = fallback;
         ++*pins->fk_recoveries;
@@ -182,7 +213,10 @@ EXPORT_SYMBOL(kinematicsForward);
 EXPORT_SYMBOL(kinematicsInverse);
 EXPORT_SYMBOL(kinematicsHome);
 
-static int export_pins(void) {
+/* The temperature pins exist only for legs that expand (a `net` to one of a configuration without
+ * expansion fails the HAL file, rather than a sensor changing nothing); they start at the reference
+ * temperature, so that an unconnected pin leaves the commands those without expansion. */
+static int export_pins(double reference_temperature) {
   int i, r = 0;
   pins = hal_malloc(sizeof *pins);
   if (!pins) return -1;
@@ -190,6 +224,11 @@ static int export_pins(void) {
     r |= hal_pin_float_newf(HAL_OUT, &pins->leg[i].twist, comp_id, NAME ".leg.%d.twist", i + 1);
     r |= hal_pin_float_newf(HAL_OUT, &pins->leg[i].length_error, comp_id, NAME ".leg.%d.length-error", i + 1);
     r |= hal_pin_float_newf(HAL_OUT, &pins->leg[i].length, comp_id, NAME ".leg.%d.length", i + 1);
+    pins->leg[i].temperature = NULL;
+    if (expands) {
+      r |= hal_pin_float_newf(HAL_IN, &pins->leg[i].temperature, comp_id, NAME ".leg.%d.temperature", i + 1);
+      if (r == 0) *pins->leg[i].temperature = reference_temperature;
+    }
   }
   r |= hal_pin_s32_newf(HAL_OUT, &pins->ik_status, comp_id, NAME ".ik-status");
   r |= hal_pin_u32_newf(HAL_OUT, &pins->ik_refused, comp_id, NAME ".ik-refused");
@@ -231,6 +270,7 @@ static int read_parameters(void) {
 
 int rtapi_app_main(void) {
   char error[512];
+  double reference_temperature = 0.0;
   comp_id = hal_init(NAME);
   if (comp_id < 0) return comp_id;
   if (read_parameters() != 0) {
@@ -258,14 +298,16 @@ int rtapi_app_main(void) {
   }
   home_height = hexatwist_model_home_height(model);
   hexatwist_fk_tracker_reset(&tracker);
-  if (export_pins() != 0) {
+  expands = hexatwist_model_expands(model, &reference_temperature);
+  if (export_pins(reference_temperature) != 0) {
     rtapi_print_msg(RTAPI_MSG_ERR, NAME ": cannot export the HAL pins\n");
     hexatwist_model_free(model);
     model = NULL;
     hal_exit(comp_id);
     return -ENOMEM;
   }
-  rtapi_print_msg(RTAPI_MSG_INFO, NAME ": %s, %s commands, %s\n", hexatwist_model_name(model), strategy, units);
+  rtapi_print_msg(RTAPI_MSG_INFO, NAME ": %s, %s commands, %s%s\n", hexatwist_model_name(model), strategy, units,
+                  expands ? ", leg temperatures from hexatwistkins.leg.N.temperature" : "");
   hal_ready(comp_id);
   return 0;
 }

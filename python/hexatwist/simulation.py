@@ -17,7 +17,7 @@ from .kinematics import Strategy
 
 __all__ = [
     "MAX_TRAJECTORY_SAMPLES", "simulate", "study", "study_trajectory", "TimeSeries", "Simulation",
-    "SimulationSummary", "Study", "StudySummary", "StrategySummary", "ErrorStats",
+    "SimulationSummary", "Study", "StudySummary", "StrategySummary", "ErrorStats", "EffectCost",
 ]
 
 TestName = Literal["Lz", "Lx", "Rz", "Ry"]
@@ -111,6 +111,21 @@ class StrategySummary(Result):
 
 
 @dataclass(frozen=True)
+class EffectCost(Result):
+    """What one of the legs' effects costs at point A over the test, perfect servos (effect_cost.hpp;
+    summary.json's ``leg_effects``)."""
+
+    effect: str
+    """"load", "play", "heat" (each alone on otherwise rigid legs) or "all"."""
+    conventional: ErrorStats
+    """Commands that ignore the twist and the effect [m]."""
+    twist_compensated: ErrorStats
+    """Eq. (12) alone: the twist compensated, the effect not [m]."""
+    compensated: ErrorStats
+    """Both compensated [m]."""
+
+
+@dataclass(frozen=True)
 class StudySummary(Result):
     """The verdict of one study test."""
 
@@ -128,6 +143,8 @@ class StudySummary(Result):
     """None unless the status is ok."""
     compensated: StrategySummary | None
     """None unless the status is ok."""
+    leg_effects: tuple[EffectCost, ...]
+    """One per effect the configuration's legs have (empty for rigid legs, or unless the status is ok)."""
 
 
 @dataclass(frozen=True)
@@ -161,12 +178,18 @@ def simulate(rig: RigLike = None, test: TestName | None = None, poses: ArrayLike
     return Simulation(**d, summary=summary)
 
 
-def study(rig: RigLike = None, test: TestName | None = None, poses: ArrayLike | None = None) -> Study:
+def study(rig: RigLike = None, test: TestName | None = None, poses: ArrayLike | None = None,
+          temperature_rise: float | ArrayLike = 0.0) -> Study:
     """One test of the paper's study (§4, Table 1): the twist-free, conventional and compensated runs of
     ``test`` (Lz, Lx, Rz, Ry; Rz when neither is given) or of ``poses`` (T, 6) [m, rad], not both; the
-    summary's metrics are what ``hexatwist study`` reports in summary.json, number for number."""
-    d = _core._study(rig, test, poses)
+    summary's metrics are what ``hexatwist study`` reports in summary.json, number for number. For a
+    configuration with ``leg_effects``, ``summary.leg_effects`` says what each costs, the legs warming
+    by ``temperature_rise`` [K] (one or six) over the test (``hexatwist study --temperature-rise-k``)."""
+    d = _core._study(rig, test, poses, temperature_rise)
     s = dict(d["summary"])
+    s["leg_effects"] = tuple(EffectCost(effect=e["effect"], **{k: ErrorStats(**e[k]) for k in
+                                                               ("conventional", "twist_compensated", "compensated")})
+                             for e in s["leg_effects"])
     for name in ("conventional", "compensated"):
         if s[name] is not None:
             s[name] = StrategySummary(**_fields(s[name], **{k: ErrorStats(**s[name][k])

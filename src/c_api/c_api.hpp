@@ -6,6 +6,7 @@
 #include <string>
 
 #include "hexatwist/c/hexatwist.h"
+#include "hexatwist/kinematics/leg_effects.hpp"
 #include "hexatwist/kinematics/limits.hpp"
 #include "hexatwist/kinematics/model.hpp"
 #include "hexatwist/kinematics/pose.hpp"
@@ -50,6 +51,27 @@ inline void from_limit(const LimitReport& r, hexatwist_limit* out) noexcept {
   out->leg = r.leg + 1;
   out->value = r.value;
   out->bound = r.bound;
+}
+
+/// The library's leg inputs from the C struct (NULL: the defaults, NaN everywhere).
+inline LegInputs to_leg_inputs(const hexatwist_leg_inputs* inputs) noexcept {
+  LegInputs in;
+  if (inputs != nullptr) {
+    in.force = to_vector(inputs->force);
+    in.temperature = to_vector(inputs->temperature);
+  }
+  return in;
+}
+
+/// The library's play state from the C struct (NULL: not started, each leg from home).
+inline PlayState to_play_state(const hexatwist_play_state* play) noexcept {
+  PlayState state;
+  if (play != nullptr) {
+    state.started = play->started != 0;
+    state.direction = to_vector(play->direction);
+    state.last = to_vector(play->last);
+  }
+  return state;
 }
 
 /// Copies `message` into the caller's buffer, truncated and NUL-terminated (nothing if no buffer).

@@ -5,6 +5,8 @@
 #include "hexatwist/kinematics/twist.hpp"
 
 using namespace hexatwist;
+using hexatwist::c_api::to_leg_inputs;
+using hexatwist::c_api::to_play_state;
 
 extern "C" {
 
@@ -46,17 +48,8 @@ hexatwist_status hexatwist_motor_commands_under(const hexatwist_model* model, co
   if (model == nullptr || pose == nullptr || command == nullptr ||
       (strategy != HEXATWIST_CONVENTIONAL && strategy != HEXATWIST_COMPENSATED))
     return HEXATWIST_INVALID_ARGUMENT;
-  LegInputs in;
-  if (inputs != nullptr) {
-    in.force = c_api::to_vector(inputs->force);
-    in.temperature = c_api::to_vector(inputs->temperature);
-  }
-  PlayState state;
-  if (play != nullptr) {
-    state.started = play->started != 0;
-    state.direction = c_api::to_vector(play->direction);
-    state.last = c_api::to_vector(play->last);
-  }
+  const LegInputs in = to_leg_inputs(inputs);
+  PlayState state = to_play_state(play);
   Vector6d cmd;
   LimitReport report;
   const Status s = motor_commands(model->model, c_api::to_pose(pose),
@@ -76,9 +69,17 @@ hexatwist_status hexatwist_motor_commands_under(const hexatwist_model* model, co
 
 hexatwist_status hexatwist_compute_commands(const hexatwist_model* model, const double pose[6],
                                             hexatwist_command_report* report) {
+  return hexatwist_compute_commands_under(model, pose, nullptr, nullptr, report);
+}
+
+hexatwist_status hexatwist_compute_commands_under(const hexatwist_model* model, const double pose[6],
+                                                  const hexatwist_leg_inputs* inputs, const hexatwist_play_state* play,
+                                                  hexatwist_command_report* report) {
   if (model == nullptr || pose == nullptr || report == nullptr) return HEXATWIST_INVALID_ARGUMENT;
   CommandReport r;
-  const Status s = compute_commands(model->model, c_api::to_pose(pose), r);
+  const PlayState state = to_play_state(play);
+  const Status s = compute_commands(model->model, c_api::to_pose(pose), to_leg_inputs(inputs),
+                                    play != nullptr ? &state : nullptr, r);
   c_api::from_vector(r.legs.length, report->length);
   c_api::from_vector(r.twist, report->twist);
   c_api::from_vector(r.length_error, report->length_error);

@@ -83,6 +83,23 @@ hexatwist_status hexatwist_forward_kinematics_tracked(const hexatwist_model* mod
   return c_api::to_c(s);
 }
 
+hexatwist_status hexatwist_forward_kinematics_tracked_under(
+    const hexatwist_model* model, const double motor[HEXATWIST_LEGS], const hexatwist_leg_inputs* inputs,
+    const hexatwist_play_state* play, hexatwist_fk_tracker* tracker, const hexatwist_fk_options* options,
+    hexatwist_fk_result* result) {
+  if (model == nullptr || motor == nullptr || tracker == nullptr || result == nullptr)
+    return HEXATWIST_INVALID_ARGUMENT;
+  FkTracker t = to_tracker(*tracker);
+  FkResult r;
+  const bool started = play != nullptr && play->started != 0;
+  const Vector6d direction = started ? c_api::to_vector(play->direction) : Vector6d::Zero();
+  const Status s = forward_kinematics_tracked(model->model, c_api::to_vector(motor), c_api::to_leg_inputs(inputs),
+                                              started ? &direction : nullptr, t, r, to_options(options));
+  from_result(r, result);
+  if (s == Status::Ok) from_tracker(t, *tracker);
+  return c_api::to_c(s);
+}
+
 void hexatwist_fk_tracker_reset(hexatwist_fk_tracker* tracker) {
   if (tracker != nullptr) *tracker = hexatwist_fk_tracker{};
 }

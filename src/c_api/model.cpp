@@ -84,6 +84,12 @@ int hexatwist_model_play(const hexatwist_model* model, double play[HEXATWIST_LEG
   return model->model.has_play() ? 1 : 0;
 }
 
+int hexatwist_model_expands(const hexatwist_model* model, double* reference_temperature) {
+  if (model == nullptr) return 0;
+  if (reference_temperature != nullptr) *reference_temperature = model->model.reference_temperature();
+  return model->model.has_thermal() ? 1 : 0;
+}
+
 void hexatwist_model_stroke(const hexatwist_model* model, double* length_min, double* length_max) {
   if (model == nullptr) return;
   if (length_min != nullptr) *length_min = model->model.spec().limits.length_min;

@@ -7,8 +7,13 @@
 #include "calibration/random.hpp"
 #include "hexatwist/error.hpp"
 #include "hexatwist/kinematics/leg_effects.hpp"
+#include "hexatwist/simulation/effect_cost.hpp"
 
 namespace hexatwist {
+
+Model real_platform(const Model& nominal, const SynthesisOptions& options) {
+  return options.real ? Model(*options.real) : real_model(nominal, options.errors);
+}
 using detail::Random;
 
 RigidTransform random_tracker_frame(std::uint64_t seed) {
@@ -47,7 +52,7 @@ Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisO
   // At most 10^9 control periods per sample, so that the divisor converts exactly.
   if (!(ratio <= 1e9))
     throw Error(fmt::format("rate: {} Hz is below the control rate {} Hz / 1e9", options.rate, control_rate));
-  const Model real = real_model(rig.model(), options.errors);
+  const Model real = real_platform(rig.model(), options);
   if (options.extra_targets_P.size() + 1 > kMaxTargets)
     throw Error(fmt::format("targets: {} targets, at most {}", options.extra_targets_P.size() + 1, kMaxTargets));
   for (const Vector3d& t : options.extra_targets_P)
@@ -78,16 +83,23 @@ Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisO
   Vector6d direction = real.geometry().home_direction;
   const double duration = out.simulation.empty() ? 0.0 : out.simulation.back().time;
   std::size_t played = 0;  // the ticks the dead band has followed
+  // The legs' temperatures at a time of the run [degC].
+  const auto temperature_at = [&](double t) -> Vector6d {
+    return Vector6d::Constant(real.reference_temperature()) + options.temperature_rise * warm_up_share(t, duration);
+  };
   for (std::size_t k = 0; k < out.simulation.size(); k += every) {
     const SimulationSample& sample = out.simulation[k];
-    for (; played <= k; ++played) direction = follow_nuts(real, out.simulation[played].command, nuts);
+    for (; played <= k; ++played) {
+      const SimulationSample& tick = out.simulation[played];
+      direction = real.has_thermal() && real.has_play()
+                      ? follow_nuts(real, tick.command, temperature_at(tick.time), nuts)
+                      : follow_nuts(real, tick.command, nuts);
+    }
     // The drives' motor-side lengths on the real platform: its leads, joints, offsets and the
     // drives' reference and scale (real_model) give the pose the platform takes, under its legs'
     // effects (the direction d = -2 g / b gives the play's term g - g_home).
     LegInputs inputs;
-    const double shape = duration > 0.0 ? (1.0 - std::exp(-sample.time / duration)) / (1.0 - std::exp(-1.0)) : 0.0;
-    for (int i = 0; i < kLegs; ++i)
-      inputs.temperature[i] = real.reference_temperature() + options.temperature_rise[i] * shape;
+    inputs.temperature = temperature_at(sample.time);
     const Status fk_status = real.has_leg_effects()
                                  ? forward_kinematics(real, sample.motor, inputs, &direction, guess, fk)
                                  : forward_kinematics(real, sample.motor, LengthKind::Motor, guess, fk);

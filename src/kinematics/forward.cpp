@@ -315,10 +315,11 @@ Status fk_tracker_set(const Model& model, const Placement& x, LengthKind kind, F
   return Status::Ok;
 }
 
-Status forward_kinematics_tracked(const Model& model, const Vector6d& lengths, LengthKind kind, FkTracker& tracker,
-                                  FkResult& out, const FkOptions& options) noexcept {
-  const Placement guess = tracker.valid ? tracker.last : Placement{};
-  if (const Status s = forward_kinematics(model, lengths, kind, guess, out, options); s != Status::Ok) return s;
+namespace {
+
+/// The tracker's acceptance of a solve's result `s` (forward_kinematics_tracked).
+Status accept_tracked(const Model& model, Status s, FkTracker& tracker, const FkResult& out) noexcept {
+  if (s != Status::Ok) return s;
   // The guess's mode is the tracker's unless the caller's tracker came from another kind of lengths.
   if (tracker.valid && out.det_sign != tracker.det_sign) return Status::AssemblyModeChanged;
   // Past the condition limit the lengths of a pose beyond a singularity can have a solution on
@@ -326,6 +327,22 @@ Status forward_kinematics_tracked(const Model& model, const Vector6d& lengths, L
   if (!(out.condition <= model.condition_max_accepted())) return Status::PlatformSingularity;
   tracker = FkTracker{out.placement, out.det_sign, true};
   return Status::Ok;
+}
+
+}  // namespace
+
+Status forward_kinematics_tracked(const Model& model, const Vector6d& lengths, LengthKind kind, FkTracker& tracker,
+                                  FkResult& out, const FkOptions& options) noexcept {
+  const Placement guess = tracker.valid ? tracker.last : Placement{};
+  return accept_tracked(model, forward_kinematics(model, lengths, kind, guess, out, options), tracker, out);
+}
+
+Status forward_kinematics_tracked(const Model& model, const Vector6d& motor, const LegInputs& inputs,
+                                  const Vector6d* direction, FkTracker& tracker, FkResult& out,
+                                  const FkOptions& options, LegEffects* effects) noexcept {
+  const Placement guess = tracker.valid ? tracker.last : Placement{};
+  return accept_tracked(model, forward_kinematics(model, motor, inputs, direction, guess, out, options, effects),
+                        tracker, out);
 }
 
 }  // namespace hexatwist

@@ -27,10 +27,34 @@ bool detail::needs_static_forces(const Model& model, const LegInputs& inputs) no
   return model.has_stiffness() && inputs.force.array().isNaN().any();
 }
 
+namespace {
+
+/// The status for inputs check_leg_inputs refuses; Ok for the others.
+Status input_status(const LegInputs& inputs) noexcept {
+  Status s = Status::Ok;
+  for (int i = 0; i < kLegs; ++i) {
+    const double t = inputs.temperature[i];
+    if (std::isinf(inputs.force[i]) || std::isinf(t)) return Status::NonFiniteInput;
+    if (!(std::isnan(t) || (t >= kMinTemperature && t <= kMaxTemperature))) s = Status::InvalidArgument;
+  }
+  return s;
+}
+
+}  // namespace
+
+std::string_view check_leg_inputs(const LegInputs& inputs) noexcept {
+  for (int i = 0; i < kLegs; ++i) {
+    const double t = inputs.temperature[i];
+    if (!(std::isnan(t) || (t >= kMinTemperature && t <= kMaxTemperature)))
+      return "inputs.temperature must be from -60 to 200 degC, or NaN for the reference temperature";
+    if (std::isinf(inputs.force[i])) return "inputs.force must be finite [N], or NaN for the static force";
+  }
+  return {};
+}
+
 Status detail::resolve_inputs(const Model& model, const LegInputs& inputs, Status static_status,
                               const Vector6d& static_force, Vector6d& force, Vector6d& temperature) noexcept {
-  for (int i = 0; i < kLegs; ++i)
-    if (std::isinf(inputs.force[i]) || std::isinf(inputs.temperature[i])) return Status::NonFiniteInput;
+  if (const Status s = input_status(inputs); s != Status::Ok) return s;
   temperature = inputs.temperature;
   for (int i = 0; i < kLegs; ++i)
     if (std::isnan(temperature[i])) temperature[i] = model.reference_temperature();
@@ -77,6 +101,10 @@ void advance_play(PlayState& play, const Vector6d& travel, const Vector6d& direc
 }
 
 Vector6d follow_nuts(const Model& model, const Vector6d& motor, NutGap& nuts) noexcept {
+  return follow_nuts(model, motor, Vector6d::Constant(model.reference_temperature()), nuts);
+}
+
+Vector6d follow_nuts(const Model& model, const Vector6d& motor, const Vector6d& temperature, NutGap& nuts) noexcept {
   const Vector6d& half = model.geometry().half_play;
   const Vector6d& home = model.geometry().home_direction;
   if (!nuts.started) {
@@ -84,7 +112,10 @@ Vector6d follow_nuts(const Model& model, const Vector6d& motor, NutGap& nuts) no
     nuts.gap = -half.cwiseProduct(home);
     nuts.last = motor;
   }
-  nuts.gap = (nuts.gap - (motor - nuts.last)).cwiseMax(-half).cwiseMin(half);
+  // The thread moves by the motor-side change times the warm lead's scale 1 + a_P dT.
+  const Vector6d scale = Vector6d::Ones() + model.geometry().lead_expansion.cwiseProduct(
+                                                temperature - Vector6d::Constant(model.reference_temperature()));
+  nuts.gap = (nuts.gap - (motor - nuts.last).cwiseProduct(scale)).cwiseMax(-half).cwiseMin(half);
   nuts.last = motor;
   Vector6d direction = home;
   for (int i = 0; i < kLegs; ++i)

@@ -97,12 +97,7 @@ std::string_view check_stream_settings(const StreamSettings& s) noexcept {
   if (s.on_reject == RejectPolicy::Skip && s.rate_limited())
     return "on_reject: skip leaves the drive without a command for each rejected input, so it stops within one "
            "period, outside the rate limits; use hold, which keeps moving within the limits";
-  for (int i = 0; i < kLegs; ++i) {
-    const double t = s.inputs.temperature[i];
-    if (!(std::isnan(t) || (t >= kMinTemperature && t <= kMaxTemperature)))
-      return "inputs.temperature must be from -60 to 200 degC, or NaN for the reference temperature";
-    if (std::isinf(s.inputs.force[i])) return "inputs.force must be finite [N], or NaN for the static force";
-  }
+  if (const std::string_view why = check_leg_inputs(s.inputs); !why.empty()) return why;
   return check_fk_options(s.fk);
 }
 

@@ -7,22 +7,13 @@
 #include "hexatwist/dynamics/mechanism.hpp"
 #include "hexatwist/kinematics/leg_effects.hpp"
 #include "hexatwist/simulation/servo.hpp"
+#include "simulation_internal.hpp"
 
 namespace hexatwist {
 namespace {
 
 // How often progress is reported [ticks].
 constexpr std::size_t kProgressEvery = 500;
-
-Status fail(SimulationIssue& issue, Status status, std::size_t index, const Trajectory& trajectory,
-            const LimitReport& limit = {}) {
-  issue.status = status;
-  issue.index = index;
-  issue.time = trajectory.time(index);
-  issue.limit = limit;
-  if (issue.limit.status == Status::Ok) issue.limit.status = status;
-  return status;
-}
 
 // The leg lengths forward kinematics of the plant takes for the nuts' travel `travel` (the motor
 // angles through the real lead, theory §4): the drives' motor-side lengths when the plant twists
@@ -70,19 +61,19 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   start_play(model, model.home_command(), play);
   for (std::size_t k = 0; k < n; ++k) {
     if (const Status s = compute_commands(model, trajectory.poses[k], report); s != Status::Ok)
-      return fail(issue, s, k, trajectory, report.limit);
+      return detail::fail_at(issue, s, k, trajectory, report.limit);
     command[k] = compensated ? report.compensated : report.conventional;
     if (compensated && model.has_play()) {
       LimitReport limit;
       if (const Status s =
               motor_commands(model, trajectory.poses[k], Strategy::Compensated, LegInputs{}, &play, command[k], limit);
           s != Status::Ok)
-        return fail(issue, s, k, trajectory, limit);
+        return detail::fail_at(issue, s, k, trajectory, limit);
     }
     if (!check_holding) continue;
     // Every motor must at least be able to hold the mechanism standing still at every pose.
     if (const Status s = holding_torque(rig, trajectory.poses[k], still); s != Status::Ok)
-      return fail(issue, s, k, trajectory);
+      return detail::fail_at(issue, s, k, trajectory);
     for (int i = 0; i < kLegs; ++i) {
       const double hold = std::abs(still[i]);
       if (hold > accepted_max(torque_limit)) {  // on the limit is inside it (limits.hpp)
@@ -91,7 +82,7 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
         limit.leg = i;
         limit.value = hold;
         limit.bound = torque_limit;
-        return fail(issue, Status::TorqueAboveMax, k, trajectory, limit);
+        return detail::fail_at(issue, Status::TorqueAboveMax, k, trajectory, limit);
       }
     }
   }
@@ -120,7 +111,7 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
         limit.leg = i;
         limit.value = std::abs(r.speed[i]);
         limit.bound = rig.servo().max_speed;
-        return fail(issue, Status::MotorSpeedAboveMax, k, trajectory, limit);
+        return detail::fail_at(issue, Status::MotorSpeedAboveMax, k, trajectory, limit);
       }
   }
   if (plan == nullptr) return Status::Ok;
@@ -134,7 +125,7 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   for (std::size_t k = 0; k < n; ++k) {
     if (const Status s = plant_fk(model, plant_lengths(model, travel[k], twist_in_plant), kind, guess, nuts, fk);
         s != Status::Ok)
-      return fail(issue, s, k, trajectory);
+      return detail::fail_at(issue, s, k, trajectory);
     guess = fk.placement;
     const Placement desired = placement_from_pose(trajectory.poses[k]);
     plan->error_twist_only[k] =
@@ -174,8 +165,8 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
   const std::size_t n = trajectory.poses.size();
   if (n == 0) return Status::Ok;
   if (std::abs(trajectory.dt - rig.control_period()) > 1e-9 * rig.control_period() && n > 1)
-    return fail(issue, Status::NonFiniteInput, 0, trajectory);
-  if (n > kMaxTrajectorySamples) return fail(issue, Status::InvalidArgument, 0, trajectory);
+    return detail::fail_at(issue, Status::NonFiniteInput, 0, trajectory);
+  if (n > kMaxTrajectorySamples) return detail::fail_at(issue, Status::InvalidArgument, 0, trajectory);
   // make_plan checks every sample of the commands this run sends (limits, stroke, motor speed,
   // holding torque) before the loop starts; check_trajectory adds the other strategy's commands.
   Plan plan;
@@ -198,14 +189,14 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
   if (const Status s = plant_fk(model, plant_lengths(model, motor, options.twist_in_plant), kind,
                                 placement_from_pose(trajectory.poses[0]), nuts, fk);
       s != Status::Ok)
-    return fail(issue, s, 0, trajectory);
+    return detail::fail_at(issue, s, 0, trajectory);
   // The mechanism's load on the motors (docs/theory.md §9, §14), at the start and then once per
   // control period, held over it.
   detail::DriveLoad load;
   Vector6d motor_acceleration = plan.reference[0].acceleration;
   if (const Status s = detail::drive_load(rig, fk.legs, drives.speed, motor_acceleration, options.twist_in_plant, load);
       s != Status::Ok)
-    return fail(issue, s, 0, trajectory);
+    return detail::fail_at(issue, s, 0, trajectory);
   // Holding torque: the motor balances the load (and the viscous friction at its speed).
   const Vector6d holding = rig.servo().viscous_friction * drives.speed - load.load + load.thread_loss;
   Vector6d measured;
@@ -245,7 +236,7 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
       if (const Status s =
               detail::drive_load(rig, fk.legs, drives.speed, motor_acceleration, options.twist_in_plant, load);
           s != Status::Ok)
-        return fail(issue, s, k, trajectory);
+        return detail::fail_at(issue, s, k, trajectory);
     const Vector6d speed_before = drives.speed;
     integrate_drives(rig, load.inverse_inertia, load.load - load.thread_loss, torque, drives);
     motor_acceleration = (drives.speed - speed_before) / rig.control_period();
@@ -253,7 +244,7 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
     const Placement previous = fk.placement;  // warm start from the last tick
     if (const Status s = plant_fk(model, plant_lengths(model, motor, options.twist_in_plant), kind, previous, nuts, fk);
         s != Status::Ok)
-      return fail(issue, s, k + 1, trajectory);
+      return detail::fail_at(issue, s, k + 1, trajectory);
   }
   return Status::Ok;
 }

@@ -322,6 +322,35 @@ static void test_leg_effects(void) {
     CHECK(fabs(c_down[i] - (plain_down[i] - 50e-6)) < 1e-15, "leg %d: the reversal crosses the play (%g)", i + 1,
           c_down[i] - plain_down[i]);
   }
+  /* The report and the forward kinematics under the same inputs: the report's command is the
+     real-time one, and the warm legs at the warm command stand at the commanded pose (a LinuxCNC
+     module's inverse and forward kinematics with a temperature pin). */
+  hexatwist_command_report report;
+  CHECK(hexatwist_compute_commands_under(m, up, &in, NULL, &report) == HEXATWIST_OK, "report under");
+  CHECK(max_abs_diff(report.compensated, warm, 6) < 1e-12, "report's command vs the real-time one: %g",
+        max_abs_diff(report.compensated, warm, 6));
+  hexatwist_fk_tracker tracker;
+  hexatwist_fk_result fk;
+  hexatwist_fk_tracker_reset(&tracker);
+  const long fk_before = allocations;
+  const hexatwist_status s_warm = hexatwist_forward_kinematics_tracked_under(m, warm, &in, NULL, &tracker, NULL, &fk);
+  CHECK(!PROBE || allocations == fk_before, "%ld allocations in the tracked forward kinematics",
+        allocations - fk_before);
+  CHECK(s_warm == HEXATWIST_OK && max_abs_diff(fk.pose, up, 6) < 1e-9, "warm FK of the warm command: %s, %g",
+        hexatwist_status_name(s_warm), max_abs_diff(fk.pose, up, 6));
+  hexatwist_fk_tracker_reset(&tracker);
+  CHECK(hexatwist_forward_kinematics_tracked_under(m, warm, NULL, NULL, &tracker, NULL, &fk) == HEXATWIST_OK &&
+            fk.pose[2] < up[2] - 30e-6,
+        "the warm command on legs at the reference stands lower: %g m", fk.pose[2] - up[2]);
+  in.temperature[0] = 250.0;
+  CHECK(hexatwist_compute_commands_under(m, up, &in, NULL, &report) == HEXATWIST_INVALID_ARGUMENT,
+        "a temperature above 200 degC in the report");
+  CHECK(hexatwist_motor_commands_under(m, up, HEXATWIST_COMPENSATED, &in, NULL, warm, &limit) ==
+            HEXATWIST_INVALID_ARGUMENT,
+        "a temperature above 200 degC in the command");
+  CHECK(hexatwist_forward_kinematics_tracked_under(m, plain, &in, NULL, &tracker, NULL, &fk) ==
+            HEXATWIST_INVALID_ARGUMENT,
+        "a temperature above 200 degC in the forward kinematics");
   in.temperature[0] = INFINITY;
   CHECK(hexatwist_motor_commands_under(m, up, HEXATWIST_COMPENSATED, &in, NULL, warm, &limit) ==
             HEXATWIST_NON_FINITE_INPUT,

@@ -174,36 +174,27 @@ struct HeldOut {
 inline HeldOut held_out(const Model& nominal, const Identification& id, const Truth& truth, double translation,
                         double rotation, int count, std::mt19937_64& rng) {
   const Model corrected(id.corrected), real(truth.spec);
-  std::vector<Vector3d> target, actual;
+  std::vector<Vector6d> poses;
   HeldOut out;
-  while (static_cast<int>(target.size()) < count) {
+  while (static_cast<int>(poses.size()) < count) {
     const Pose p = random_pose(rng, translation, rotation);
     Vector6d command, command_nominal;
     LimitReport limit;
     if (motor_commands(corrected, p, Strategy::Compensated, command, limit) != Status::Ok) continue;
     if (motor_commands(nominal, p, Strategy::Compensated, command_nominal, limit) != Status::Ok) continue;
-    FkResult fk, fk_nominal;
-    EXPECT_EQ(forward_kinematics(real, command, LengthKind::Motor, placement_from_pose(p), fk), Status::Ok);
+    FkResult fk_nominal;
     EXPECT_EQ(forward_kinematics(real, command_nominal, LengthKind::Motor, placement_from_pose(p), fk_nominal),
               Status::Ok);
-    target.push_back(platform_point_B(corrected, placement_from_pose(p), id.corrected.observation_P));
-    actual.push_back(platform_point_B(real, fk.placement, truth.spec.observation_P));
     out.nominal_miss =
         std::max(out.nominal_miss, (platform_point_B(real, fk_nominal.placement, truth.spec.observation_P) -
                                     platform_point_B(nominal, placement_from_pose(p), nominal.spec().observation_P))
                                        .norm());
+    poses.push_back(p.to_vector());
   }
-  std::vector<PointPair> pairs;
-  for (std::size_t k = 0; k < target.size(); ++k) {
-    out.gauge.push_back((actual[k] - target[k]).norm());
-    pairs.push_back({target[k], actual[k]});
-  }
-  Registration reg;
-  EXPECT_EQ(register_points(pairs, reg), Status::Ok);
-  for (std::size_t k = 0; k < target.size(); ++k)
-    out.aligned.push_back((apply(reg.X_BT, target[k]) - actual[k]).norm());
-  std::sort(out.gauge.begin(), out.gauge.end());
-  std::sort(out.aligned.begin(), out.aligned.end());
+  CommandAccuracy accuracy;
+  EXPECT_EQ(command_accuracy(corrected, real, poses, accuracy), Status::Ok);
+  out.gauge = accuracy.gauge;
+  out.aligned = accuracy.aligned;
   return out;
 }
 

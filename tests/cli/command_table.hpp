@@ -87,6 +87,7 @@ inline std::map<std::string, std::vector<std::string>> base_arguments(const Inpu
       {"stream", {"--config", c}},
       {"ik", {"--config", c}},
       {"fk", {"--config", c, "--lengths=1.9,1.9,1.9,1.9,1.9,1.9"}},
+      {"compare", {c, c, "--stations", "8"}},
       {"config", {"--config", c}},
       {"linuxcnc", {"--config", c}},
       {"mjcf", {"--config", c}},

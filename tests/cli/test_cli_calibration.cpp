@@ -577,3 +577,58 @@ TEST(CliIdentify, TheLogsClockIsFoundFromTheRestsAndALogOfAnotherRunIsRefusedAsM
 }
 
 }  // namespace
+
+// ---- checking a calibration: the real platform as a configuration, synth --real, compare --------
+
+TEST(CliCompare, SynthsRealPlatformDrivesTheSameLogAndCompareReadsItsErrorsBack) {
+  namespace fs = std::filesystem;
+  // synth writes the real platform as a configuration (FILE.real.yaml); a second synth on it with
+  // --real and no errors measures the same log, byte for byte (the platform survives its YAML
+  // exactly); compare of the nominal configuration against it finds the truth's joints (written by
+  // another path, truth.json) and a miss of the nominal commands, the platform against itself none.
+  const fs::path dir = temp_dir() / "compare";
+  fs::create_directories(dir);
+  const std::string a = (dir / "a.csv").string(), b = (dir / "b.csv").string();
+  const Outcome first =
+      run({"synth", "--stations", "8", "--station-seed", "3", "--joint-errors-mm", "1", "--lead-error-pct", "2",
+           "--offsets-mm", "0.5", "--play-um", "30", "--seed", "9", "--out", a});
+  ASSERT_EQ(first.code, 0) << first.err;
+  const std::string real = (dir / "a.real.yaml").string();
+  ASSERT_TRUE(fs::exists(real)) << first.out;
+  EXPECT_NE(first.out.find("a.real.yaml"), std::string::npos) << first.out;
+  const Outcome second =
+      run({"synth", "--stations", "8", "--station-seed", "3", "--real", real, "--seed", "9", "--out", b});
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_EQ(read_file(a), read_file(b)) << "the same real platform measured the same way";
+  const Outcome c = run({"compare", (std::string(HEXATWIST_SOURCE_DIR) + "/configs/seed.yaml"), real, "--json"});
+  ASSERT_EQ(c.code, 0) << c.err;
+  const YAML::Node j = json(c);
+  EXPECT_EQ(j["schema"].as<std::string>(), "hexatwist.compare/1");
+  const YAML::Node truth = YAML::LoadFile((dir / "a.truth.json").string());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < 6; ++i)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double moved = truth["errors"]["base_offset_B"][i][k].as<double>();
+      worst = std::max(worst, std::abs(j["legs"][i]["base"][k].as<double>() - moved));
+    }
+  EXPECT_LT(worst, 1e-15) << "the base joints' differences are the truth's offsets";
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_NEAR(j["legs"][i]["lead"].as<double>(), 0.02 * 0.010, 1e-15);
+    EXPECT_NEAR(j["legs"][i]["play"].as<double>(), 30e-6, 1e-18);
+    EXPECT_EQ(j["legs"][i]["drive_lead"].as<double>(), 0.0) << "the drives keep the nominal lead";
+  }
+  EXPECT_GT(j["accuracy"]["gauge_median"].as<double>(), 1e-3) << "the nominal commands miss the real platform";
+  EXPECT_EQ(j["accuracy"]["stations"].as<int>(), 60);
+  const Outcome self = run({"compare", real, real, "--json", "--stations", "10"});
+  ASSERT_EQ(self.code, 0) << self.err;
+  EXPECT_EQ(json(self)["largest_joint"].as<double>(), 0.0);
+  EXPECT_LT(json(self)["accuracy"]["gauge_max"].as<double>(), 1e-14);
+  // The real platform given and its errors too: refused, nothing written.
+  const Outcome both =
+      run({"synth", "--stations", "8", "--real", real, "--joint-errors-mm", "1", "--out", (dir / "c.csv").string()});
+  EXPECT_EQ(both.code, 2);
+  EXPECT_FALSE(fs::exists(dir / "c.csv"));
+  const Outcome missing = run({"compare", real, (dir / "nope.yaml").string()});
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_EQ(missing.err.rfind("hexatwist: error: B: ", 0), 0u) << missing.err;
+}

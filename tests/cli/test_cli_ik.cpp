@@ -1,4 +1,6 @@
 // hexatwist ik: the commands of one pose, and the pose errors every command shares.
+#include <fmt/format.h>
+
 #include "cli_support.hpp"
 
 using namespace hexatwist::cli_test;
@@ -142,6 +144,32 @@ TEST(Cli, IkWithLegEffectsReportsEachEffectAndCompensatesIt) {
     EXPECT_EQ(r.code, 2) << bad;
     EXPECT_EQ(r.err.rfind("hexatwist: error: --temperature-c", 0), 0u) << r.err;
   }
+}
+
+TEST(Cli, FkOfWarmLegsInvertsIkAtTheSameTemperatures) {
+  const std::string config =
+      seed_with_effects("warm.yaml", "  stiffness: 2.0e8\n  length_expansion: 11.5e-6\n  lead_expansion: 11.0e-6\n");
+  const std::string temperatures = "24,26,21.5,30,19,23";
+  const Outcome ik =
+      run({"ik", "--config", config, "--pose=0.05,-0.02,0.1,2,-1,5", "--temperature-c", temperatures, "--json"});
+  ASSERT_EQ(ik.code, 0) << ik.err;
+  std::string motor;
+  for (std::size_t i = 0; i < 6; ++i)
+    motor += (i ? "," : "") + fmt::format("{:.17g}", json(ik)["legs"][i]["command_compensated"].as<double>());
+  const Outcome warm =
+      run({"fk", "--config", config, "--motor", "--lengths", motor, "--temperature-c", temperatures, "--json"});
+  const Outcome cold = run({"fk", "--config", config, "--motor", "--lengths", motor, "--json"});
+  ASSERT_EQ(warm.code, 0) << warm.err;
+  ASSERT_EQ(cold.code, 0) << cold.err;
+  const double expected[6] = {0.05, -0.02, 0.1, 2 * kPi / 180, -kPi / 180, 5 * kPi / 180};
+  for (std::size_t k = 0; k < 6; ++k) {
+    EXPECT_NEAR(json(warm)["pose"][k].as<double>(), expected[k], 1e-10) << "coordinate " << k;
+  }
+  // The warm command on legs at the reference temperature: the legs are shorter, the platform lower.
+  EXPECT_LT(json(cold)["pose"][2].as<double>(), 0.1 - 30e-6);
+  const Outcome geometric = run({"fk", "--config", config, "--lengths", motor, "--temperature-c", "22"});
+  EXPECT_EQ(geometric.code, 2);
+  EXPECT_NE(geometric.err.find("--temperature-c"), std::string::npos) << geometric.err;
 }
 
 TEST(Cli, LinuxcncRefusesPlayItCannotFollowNamingTheBacklash) {

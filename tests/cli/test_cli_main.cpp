@@ -6,7 +6,7 @@ using namespace hexatwist::cli_test;
 namespace {
 
 TEST(Cli, UnknownSubcommandOrOptionIsBadInput) {
-  expect_error(run({"bogus"}), 2, {"'bogus'", "ik, fk, config, linuxcnc or mjcf"});
+  expect_error(run({"bogus"}), 2, {"'bogus'", "ik, fk, config, linuxcnc, mjcf or compare"});
   expect_error(run({}), 2, {"subcommand"});
   expect_error(run({"ik", "--bogus"}), 2, {"--bogus"});
   expect_error(run({"fk"}), 2, {"--lengths"});

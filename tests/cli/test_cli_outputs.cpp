@@ -386,8 +386,8 @@ TEST(CliOutputs, AConfigurationThatIsAFifoIsReadWithABoundNotWaitedOnForever) {
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   for (const auto& [command, args] : base_arguments(in)) {
     std::vector<std::string> a = args;
-    for (std::size_t k = 0; k + 1 < a.size(); ++k)
-      if (a[k] == "--config") a[k + 1] = fifo.string();
+    for (std::string& arg : a)  // --config's value, and a configuration given as an argument (compare)
+      if (arg == in.config) arg = fifo.string();
     // No writer: an empty configuration, refused at once (the test's own timeout bounds it).
     const auto t0 = std::chrono::steady_clock::now();
     const Outcome r = run_in(dir, command_line(command, a));

@@ -67,6 +67,7 @@ def main() -> int:
         run(["synth", "--stations", "20", "--joint-errors-mm", "0.5", "--stiffness-n-per-um", "200", "--play-um",
              "30", "--temperature-rise-k", "1", "--out", "warm.csv"])
         file("warm.truth.json")
+        printed(["compare", str(root / "configs" / "seed.yaml"), "warm.real.yaml", "--stations", "10", "--json"])
         printed(["identify", "--stations", "20", "--points", "log.csv", "--out", "id.yaml", "--json"])
         printed(["identify", "--stations", "20", "--points", "warm.csv", "--effects", "none", "--json"], (0, 5))
         printed(["identify", "--stations", "20", "--points", "warm.csv", "--out", "warm.yaml", "--json"], (0, 5))
@@ -77,6 +78,14 @@ def main() -> int:
             run([command, *args])
             file(f"{out}/summary.json")
             file(f"{out}/.hexatwist-run.json")
+        # The study of a configuration with every leg effect: its leg_effects table.
+        seed = (root / "configs" / "seed.yaml").read_text()
+        (work / "effects.yaml").write_text(
+            seed.replace("  angular_amplitude_deg: 30 ", "  angular_amplitude_deg: 5 ")
+            + "\nleg_effects:\n  stiffness: 2.0e8\n  play: 50.0e-6\n  length_expansion: 11.5e-6\n")
+        run(["study", "--config", "effects.yaml", "--tests", "Rz", "--temperature-rise-k", "1", "--no-figures",
+             "--no-csv", "--out", "fx"])
+        file("fx/summary.json")
         run(["synth", "--test", "Lz", "--out", "lz.csv"])
         run(["measure", "--test", "Lz", "--points", "lz.csv", "--no-figures", "--no-csv", "--out", "me"])
         file("me/summary.json")

@@ -268,3 +268,33 @@ TEST(LegEffects, ImplausibleValuesAreRefusedNamingTheField) {
 
 }  // namespace
 }  // namespace hexatwist::test
+
+namespace hexatwist::test {
+namespace {
+
+TEST(LegEffects, AWarmScrewCrossesTheNutsGapInAShorterMotorSideMove) {
+  // The gap is b along the thread; a warm lead moves the thread by the motor-side change times
+  // 1 + a_P dT, so that b / (1 + a_P dT) of motor-side travel crosses it: exactly what the
+  // commands jump by at a reversal (command_travel), and the plant's nuts must agree.
+  const Config config = seed_with_effects("  play: 50.0e-6\n  lead_expansion: 11.0e-6\n");
+  const Model& model = config.rig.model();
+  const Vector6d warm = Vector6d::Constant(model.reference_temperature() + 10.0);
+  const double scale = 1.0 + 11.0e-6 * 10.0;
+  const Vector6d start = model.home_command();
+  NutGap hot, cold;
+  EXPECT_EQ(follow_nuts(model, start, warm, hot), Vector6d::Ones()) << "homing leaves each nut on its +1 side";
+  (void)follow_nuts(model, start, cold);
+  const Vector6d back = start - Vector6d::Constant(50.0e-6 / scale);
+  const Vector6d d_hot = follow_nuts(model, back, warm, hot);
+  const Vector6d d_cold = follow_nuts(model, back, cold);
+  EXPECT_LT((d_hot + Vector6d::Ones()).cwiseAbs().maxCoeff(), 1e-9) << "crossed at the warm lead";
+  EXPECT_NEAR(d_cold[0], -1.0 + 2.0 * (1.0 - 1.0 / scale), 1e-9) << "not quite at the reference lead";
+  // At the reference temperature both overloads are one.
+  NutGap a, b;
+  for (const double dz : {0.0, -20e-6, 10e-6, 60e-6, -1e-6})
+    EXPECT_EQ(follow_nuts(model, start + Vector6d::Constant(dz), a),
+              follow_nuts(model, start + Vector6d::Constant(dz), Vector6d::Constant(model.reference_temperature()), b));
+}
+
+}  // namespace
+}  // namespace hexatwist::test

@@ -111,3 +111,37 @@ def test_study_metrics_are_the_clis_side_by_side(tmp_path):
         saturated += p["saturated_ticks"]
         assert 0 < p["max_torque"] <= 6.5 and p["max_following_error"] > 0 and p["max_orientation_error"] > 0
     assert saturated > 0, "the weak motor saturates"
+
+
+def test_the_leg_effects_costs_are_the_clis_and_their_compensation_removes_them(tmp_path):
+    """A configuration with every leg effect: study()'s summary.leg_effects and `hexatwist study
+    --temperature-rise-k` report the same costs, number for number; each effect moves point A by
+    micrometres, compensated by less than a nanometre; a warm-up is refused where it means nothing."""
+    import json
+    import subprocess
+
+    from conftest import tool
+
+    config = tmp_path / "effects.yaml"
+    config.write_text(hexatwist.seed_config_yaml().replace("  angular_amplitude_deg: 30 ", "  angular_amplitude_deg: 5 ")
+                      + "\nleg_effects:\n  stiffness: 2.0e8\n  play: 50.0e-6\n  length_expansion: 11.5e-6\n"
+                        "  lead_expansion: 11.0e-6\n")
+    out = tmp_path / "out"
+    run = subprocess.run([tool("HEXATWIST_CLI"), "study", "--config", str(config), "--tests", "Rz", "--no-figures",
+                          "--no-csv", "--temperature-rise-k", "2", "--out", str(out)], capture_output=True, text=True,
+                         timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert "legs' effects, perfect servos" in run.stdout, run.stdout
+    cli = json.loads((out / "summary.json").read_text())["tests"][0]["leg_effects"]
+    py = hexatwist.study(str(config), test="Rz", temperature_rise=2.0).summary
+    assert py.status == "ok"
+    assert [e.effect for e in py.leg_effects] == ["load", "play", "heat", "all"]
+    for c, p in zip(cli, py.leg_effects):
+        assert c["effect"] == p.effect
+        for column in ("conventional", "twist_compensated", "compensated"):
+            assert c[column]["max"] == p[column].max and c[column]["rms"] == p[column].rms, (p.effect, column)
+        assert p.twist_compensated.max > 0.5e-6 and p.compensated.max < 2e-11, p
+    with pytest.raises(hexatwist.InputError, match="temperature_rise"):
+        hexatwist.study(str(config), test="Rz", temperature_rise=60.0)
+    with pytest.raises(hexatwist.InputError, match="do not expand"):
+        hexatwist.study(None, test="Rz", temperature_rise=[1, 1, 1, 1, 1, 2])

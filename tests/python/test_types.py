@@ -278,6 +278,9 @@ def calls():
         "simulate refused": hexatwist.simulate(rig, poses=q_far),
         "study": hexatwist.study(rig, poses=q_sim),
         "study refused": hexatwist.study(rig, poses=q_far),
+        "study with leg effects": hexatwist.study(
+            hexatwist.seed_config_yaml() + "\nleg_effects:\n  play: 30.0e-6\n  length_expansion: 11.5e-6\n",
+            poses=q_sim, temperature_rise=1.0),
         "read_point_log": log,
         "measured_test": hexatwist.measured_test(rig, "Rz"),
         "stations_run": run,

@@ -165,6 +165,11 @@ void hexatwist_model_stroke(const hexatwist_model* model, double* length_min, do
  * leg has play (docs/theory/kinematics.md §4b). */
 int hexatwist_model_play(const hexatwist_model* model, double play[HEXATWIST_LEGS]);
 
+/** Non-zero if the model's legs expand with their temperature (`leg_effects`: length_expansion or
+ * lead_expansion); its reference temperature [degC] written to `reference_temperature` (may be
+ * NULL), the temperature at which the commands are those without expansion. */
+int hexatwist_model_expands(const hexatwist_model* model, double* reference_temperature);
+
 /* ---- Real-time calls ----------------------------------------------------------------------- */
 
 /** Motor-side commands for `pose` [m, rad] with `strategy`, every limit checked. `command` [m]
@@ -194,6 +199,15 @@ hexatwist_status hexatwist_motor_commands_under(const hexatwist_model* model, co
 hexatwist_status hexatwist_compute_commands(const hexatwist_model* model, const double pose[6],
                                             hexatwist_command_report* report);
 
+/** hexatwist_compute_commands under the conditions `inputs` (NULL: the defaults) with the play's
+ * directions from `play` (NULL: each leg approached from home; not moved on, as
+ * hexatwist_motor_commands_under does). The compensated command includes the legs' effects where the
+ * model has them. HEXATWIST_INVALID_ARGUMENT for a temperature outside -60 to 200 degC,
+ * HEXATWIST_NON_FINITE_INPUT for an infinite force or temperature. */
+hexatwist_status hexatwist_compute_commands_under(const hexatwist_model* model, const double pose[6],
+                                                  const hexatwist_leg_inputs* inputs, const hexatwist_play_state* play,
+                                                  hexatwist_command_report* report);
+
 /** Twist of each leg relative to home [rad] at `pose` (limits not checked). */
 hexatwist_status hexatwist_twist(const hexatwist_model* model, const double pose[6], double twist[HEXATWIST_LEGS]);
 
@@ -212,6 +226,16 @@ hexatwist_status hexatwist_forward_kinematics_tracked(const hexatwist_model* mod
                                                       const double lengths[HEXATWIST_LEGS], hexatwist_length_kind kind,
                                                       hexatwist_fk_tracker* tracker,
                                                       const hexatwist_fk_options* options, hexatwist_fk_result* result);
+
+/** hexatwist_forward_kinematics_tracked of the drives' motor-side lengths `motor` [m] under the
+ * conditions `inputs` (NULL: the defaults) with the play's directions from `play` (NULL or not
+ * started: each leg approached from home): where the real legs, deflected, warm and with their
+ * play, have these lengths (docs/theory/kinematics.md §4b). The same acceptance as the call above;
+ * statuses as hexatwist_compute_commands_under for the inputs. */
+hexatwist_status hexatwist_forward_kinematics_tracked_under(
+    const hexatwist_model* model, const double motor[HEXATWIST_LEGS], const hexatwist_leg_inputs* inputs,
+    const hexatwist_play_state* play, hexatwist_fk_tracker* tracker, const hexatwist_fk_options* options,
+    hexatwist_fk_result* result);
 
 /** Forgets the tracker's solution: the next tracked call starts from home. */
 void hexatwist_fk_tracker_reset(hexatwist_fk_tracker* tracker);

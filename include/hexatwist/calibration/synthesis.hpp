@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "hexatwist/calibration/measurement.hpp"
@@ -34,7 +35,14 @@ struct SynthesisOptions {
   /// The log gets the machine's temperature at each point (PointLog::temperatures), the legs' mean
   /// [degC], as a sensor on the machine read with each point would give it.
   bool log_temperature = false;
+  /// The real platform itself (e.g. the real platform of an earlier synthesis, to drive it with a
+  /// corrected configuration's commands: a validation run); when set, `errors` is not used.
+  std::optional<ModelSpec> real;
 };
+
+/// The real platform of `options` for the nominal model `nominal`: options.real, or
+/// real_model(nominal, options.errors). Throws hexatwist::Error as Model does.
+Model real_platform(const Model& nominal, const SynthesisOptions& options);
 
 /// A synthetic log and its truth.
 struct SyntheticLog {

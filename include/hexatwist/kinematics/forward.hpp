@@ -106,6 +106,13 @@ struct FkTracker {
                                                 FkTracker& tracker, FkResult& out,
                                                 const FkOptions& options = {}) noexcept;
 
+/// forward_kinematics_tracked for the motor-side lengths `motor` [m] of a model whose legs have
+/// effects, under `inputs` and with the play's directions `direction` (null: from home), solved as
+/// the effects' forward_kinematics above; the same acceptance and statuses.
+[[nodiscard]] Status forward_kinematics_tracked(const Model& model, const Vector6d& motor, const LegInputs& inputs,
+                                                const Vector6d* direction, FkTracker& tracker, FkResult& out,
+                                                const FkOptions& options = {}, LegEffects* effects = nullptr) noexcept;
+
 /// Sets `tracker` to a known placement (after homing, or as a fallback start) with that
 /// placement's assembly mode for lengths of `kind`. Returns the status of inverse kinematics or of
 /// the Jacobian (SingularJacobian where its determinant is zero); `tracker` is unchanged then.

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <limits>
+#include <string_view>
 
 #include "hexatwist/kinematics/kinematics.hpp"
 
@@ -37,6 +38,12 @@ struct LegInputs {
   /// Each leg's temperature [degC]; NaN = the model's reference temperature (no expansion).
   Vector6d temperature = Vector6d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
+
+/// Why `inputs` cannot be used (empty when they can): a temperature outside kMinTemperature to
+/// kMaxTemperature (NaN allowed: the reference) or an infinite force (NaN allowed: the static
+/// force). The commands and forward kinematics refuse such inputs (InvalidArgument for a
+/// temperature out of range, NonFiniteInput for an infinite value), the stream's settings too.
+[[nodiscard]] std::string_view check_leg_inputs(const LegInputs& inputs) noexcept;
 
 /// The direction of each leg's last motion, for its play (caller-owned: one per stream, controller
 /// or C API handle; no sharing between threads).
@@ -71,6 +78,10 @@ struct NutGap {
 /// them) and returns each leg's play direction for forward kinematics, -g / (b/2) in [-1, 1]
 /// (home_direction where a leg has no play): the effect's term -(b/2)(d - d_home) is then g - g_home.
 Vector6d follow_nuts(const Model& model, const Vector6d& motor, NutGap& nuts) noexcept;
+
+/// The same with the legs at `temperature` [degC]: a warm screw's longer lead moves the thread by
+/// the motor-side change times 1 + a_P dT, so that a smaller motor-side change crosses the gap.
+Vector6d follow_nuts(const Model& model, const Vector6d& motor, const Vector6d& temperature, NutGap& nuts) noexcept;
 
 /// What the effects change at one pose, leg by leg.
 struct LegEffects {

@@ -9,6 +9,8 @@ step to $HEXATWIST_LINUXCNC_RESULTS. When it exits, LinuxCNC shuts down.
 A plan is {"steps": [step, ...], "pins": [HAL pin names read after each step]}; a step is one of
   {"home": true}                       estop reset, machine on, home all joints
   {"mdi": "G0 X1 Y2 ..."}               one MDI command, run to completion
+  {"setp": {"pin": value, ...}}         sets HAL input pins (e.g. a leg's temperature), then lets
+                                       a few servo cycles pass
   {"program": "/abs/file.ngc", "pauses": N}   a G-code program, held N times on its way (feed
                                        hold until the machine stands still) for a snapshot
   {"program": "/abs/file.ngc", "trace": S}    a G-code program run through, its commanded joints
@@ -144,6 +146,10 @@ def run(plan):
             record["done"] = home()
         elif "mdi" in step:
             record["done"] = mdi(step["mdi"])
+        elif "setp" in step:
+            for name, value in step["setp"].items():
+                hal.set_p(name, repr(float(value)))
+            record["done"] = True
         elif "program" in step:
             record["trace"] = []
             record["done"], record["samples"] = program(step["program"], step.get("pauses", 0), pins,

@@ -37,22 +37,28 @@ def cli(*args, check=True):
     return r
 
 
-def ik(world, config=None):
-    """`hexatwist ik --json` for a LinuxCNC world pose [mm, deg] (Z absolute)."""
+def temperature_args(temperatures):
+    return ["--temperature-c", ",".join(repr(float(t)) for t in temperatures)] if temperatures else []
+
+
+def ik(world, config=None, temperatures=None):
+    """`hexatwist ik --json` for a LinuxCNC world pose [mm, deg] (Z absolute), the legs at
+    `temperatures` [degC] (default: the reference)."""
     home_height = model_json(config)["home_height"]
     x, y, z, a, b, c = world
     pose = "%r,%r,%r,%r,%r,%r" % (x / 1000.0, y / 1000.0, z / 1000.0 - home_height, a, b, c)
-    args = ["ik", "--json", "--pose=" + pose] + (["--config", config] if config else [])
+    args = ["ik", "--json", "--pose=" + pose] + (["--config", config] if config else []) + temperature_args(temperatures)
     r = cli(*args, check=False)
     assert r.returncode in (0, 3), r.stderr
     return json.loads(r.stdout)
 
 
-def fk(joints, config=None):
+def fk(joints, config=None, temperatures=None):
     """`hexatwist fk --motor --json` of LinuxCNC joints [mm] as a LinuxCNC world pose [mm, deg]."""
     home_height = model_json(config)["home_height"]
     lengths = ",".join(repr(j / 1000.0) for j in joints)
-    rep = json.loads(cli("fk", "--motor", "--json", "--lengths=" + lengths, *(["--config", config] if config else [])).stdout)
+    rep = json.loads(cli("fk", "--motor", "--json", "--lengths=" + lengths, *(["--config", config] if config else []),
+                         *temperature_args(temperatures)).stdout)
     x, y, z, a, b, c = rep["pose"]
     return [1000 * x, 1000 * y, 1000 * (z + home_height), math.degrees(a), math.degrees(b), math.degrees(c)]
 
@@ -434,3 +440,58 @@ def test_a_station_plan_runs_on_linuxcnc_as_its_gcode_program_with_the_plans_tim
     print("gcode: %d stations over %.1f s; joints at rest within %.3g mm of the plan's commands; LinuxCNC's arrivals "
           "= %.4f s + %.5f x the plan's, within %.3f s" % (n - 1, rows[-1][0], worst_joint, offset, rate, worst))
     assert abs(rate - 1.0) < 0.02 and -0.1 < offset < 1.0 and worst < 0.05, (offset, rate, worst)
+
+
+def test_warm_legs_read_from_the_temperature_pins_are_compensated_and_seen_by_the_forward_kinematics():
+    """Issue 27: a configuration whose legs expand gets a temperature pin per leg (at the reference
+    until set). LinuxCNC's joints are `hexatwist ik --temperature-c` of the pins' values and its FK
+    pose the commanded one, at rest while the legs warm too (the joints follow the pins); a pin
+    outside -60..200 degC stops the machine where it stands."""
+    work = os.path.join(OUT, "warm")
+    os.makedirs(work, exist_ok=True)
+    config = os.path.join(work, "warm.yaml")
+    with open(os.path.join(HERE, "..", "..", "..", "configs", "seed.yaml")) as f:
+        seed = f.read()
+    with open(config, "w") as f:
+        f.write(seed + "\nleg_effects:\n  stiffness: 2.0e8\n  length_expansion: 11.5e-6\n"
+                "  lead_expansion: 11.0e-6\n  reference_temperature: 20\n")
+    home_z = 1000 * model_json(config)["home_height"]
+    warm = [24.0, 26.0, 21.5, 30.0, 19.0, 23.0]
+    temperature_pins = ["hexatwistkins.leg.%d.temperature" % i for i in range(1, 7)]
+    first, second = [40, -20, home_z + 60, 3, -2, 10], [-30, 25, home_z - 40, -2, 4, -15]
+    steps = [{"home": True}, {"mdi": g0(first)}, {"setp": dict(zip(temperature_pins, warm))}, {"mdi": g0(second)},
+             {"setp": {temperature_pins[0]: 250.0}, "expect_off": True}]
+    run = harness.run(ini_for(config), {"steps": steps, "pins": PINS + temperature_pins}, timeout=120,
+                      keep_dir=os.path.join(work, "run"))
+    assert run.results and len(run.results) == len(steps), run.log[-3000:]
+    at_first, warmed, at_second, hot = run.results[1:]
+    # Until set, the pins hold the reference temperature: the commands are those without expansion.
+    assert [at_first["pins"][p] for p in temperature_pins] == [20.0] * 6
+    check_pose_steps(harness.LinuxcncRun([at_first], "", 0), config)
+    # Warmed at rest: motion computes the commanded pose's joints every servo period, so that they
+    # follow the pins: the warm legs are driven shorter by their growth and the platform holds its
+    # pose (the FK of the warm legs, as `hexatwist fk --temperature-c` computes it, is the pose).
+    held = [1000.0 * leg["command_compensated"] for leg in ik(first, config, warm)["legs"]]
+    assert_close(warmed["joint_actual_position"], held, JOINT_TOL_MM, "joints of the held pose, warm")
+    assert_close(warmed["actual_position"], first, POSE_TOL, "FK pose while warming")
+    assert_close(fk(warmed["joint_actual_position"], config, warm), first, POSE_TOL, "hexatwist fk of the warm joints")
+    moved = max(a - b for a, b in zip(at_first["joint_actual_position"], warmed["joint_actual_position"]))
+    assert 0.02 < moved < 0.5, moved
+    # A move with warm legs: the joints are the warm legs' compensated commands, the FK pose the
+    # commanded pose.
+    assert at_second["done"] and not at_second["errors"], at_second
+    command = [1000.0 * leg["command_compensated"] for leg in ik(second, config, warm)["legs"]]
+    cold = [1000.0 * leg["command_compensated"] for leg in ik(second, config)["legs"]]
+    worst = assert_close(at_second["joint_actual_position"], command, JOINT_TOL_MM, "warm joints")
+    for c, w, t in zip(cold, command, warm):  # a warm leg is commanded shorter, a cool one longer
+        assert (c - w) * (t - 20.0) > 0 and abs(c - w) > 0.005 * abs(t - 20.0), (c, w, t)
+    assert_close(at_second["actual_position"], second, POSE_TOL, "FK pose after the warm move")
+    # 250 degC is no temperature a leg can have: both kinematics refuse it (status 100), and LinuxCNC
+    # stops as on any failure of the inverse kinematics: the machine off, the joints where they were.
+    assert hot["pins"]["hexatwistkins.ik-status"] == 100 and hot["pins"]["hexatwistkins.fk-status"] == 100, hot["pins"]
+    assert hot["pins"]["hexatwistkins.fk-fail"]
+    assert any("kinematicsInverse" in e for e in hot["errors"]), hot["errors"]
+    assert hot["task_state"] != 4, "the machine is no longer on (linuxcnc.STATE_ON)"
+    assert_close(hot["joint_actual_position"], at_second["joint_actual_position"], 1e-12, "joints after the refusal")
+    print("warm legs: joints within %.3g mm of hexatwist ik --temperature-c; warming at rest shortened the joints "
+          "by up to %.4f mm, the pose held" % (worst, moved))
