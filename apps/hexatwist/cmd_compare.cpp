@@ -22,8 +22,8 @@ struct CompareOptions {
 // "+0.0123" mm from metres, rounding-level values as 0.
 std::string mm(double m) { return fmt::format("{:+.4f}", 1e3 * tidy(m)); }
 
-std::string text_report(const CompareOptions& o, const Model& a, const Model& b, const PlatformDifference& d,
-                        const StationsSpec& run, const CommandAccuracy& acc) {
+std::string text_report(const CompareOptions& o, const Model& a, const PlatformDifference& d, const StationsSpec& run,
+                        const CommandAccuracy& acc) {
   std::string s = fmt::format("hexatwist compare: B {} against A {} (B - A)\n", printable(o.b), printable(o.a));
   s += fmt::format("{:<12} {:>32}   {:>32} {:>10}\n", "joint", "A: x, y, z [mm]", "B - A: x, y, z [mm]", "|B - A|");
   for (const bool platform : {false, true})
@@ -120,7 +120,7 @@ int run_compare(const CompareOptions& o) {
   if (const Status s = command_accuracy(a, b, stations, acc); s != Status::Ok)
     throw ExitError(kExitOutOfLimit, fmt::format("{}: A's commands at its stations do not give B a pose: {}",
                                                  printable(o.b), describe(s)));
-  write_stdout(o.json ? json_report(o, d, run, acc) : text_report(o, a, b, d, run, acc));
+  write_stdout(o.json ? json_report(o, d, run, acc) : text_report(o, a, d, run, acc));
   return kExitOk;
 }
 
@@ -139,7 +139,7 @@ Command make_compare_command(CLI::App& root) {
   app->add_option("B", o->b, "The second configuration (YAML): the platform they drive")->required();
   app->add_option("--stations", o->stations, "Random stations A's commands are tried at, 4 to 10000")
       ->capture_default_str()
-      ->check(CLI::Range(4, kMaxStations));
+      ->check(CLI::Range(kMinAccuracyStations, kMaxStations));
   app->add_option("--station-seed", o->station_seed, "Seed of the stations")->capture_default_str();
   app->add_option("--range", o->range,
                   "X_M,ROT_DEG: the stations within ±X_M [m] of home in x, y, z and ±ROT_DEG [deg] in roll, pitch, "

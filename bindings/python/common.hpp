@@ -160,6 +160,7 @@ void expose_simulation(py::module_& m);
 void expose_measurement(py::module_& m);
 void expose_identification(py::module_& m);
 void expose_station_plan(py::module_& m);
+void expose_validation(py::module_& m);
 void expose_stream(py::module_& m);
 void expose_trajectory(py::module_& m);
 void expose_rig(py::module_& m);

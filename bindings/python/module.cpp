@@ -15,6 +15,7 @@ PYBIND11_MODULE(_hexatwist, m) {
   expose_measurement(m);
   expose_identification(m);
   expose_station_plan(m);
+  expose_validation(m);
   expose_stream(m);
   expose_trajectory(m);
   expose_rig(m);

@@ -165,6 +165,10 @@ def _simulate(rig: _RigLike = None, test: str | None = None, poses: npt.ArrayLik
 def _study(rig: _RigLike = None, test: str | None = None, poses: npt.ArrayLike | None = None,
            temperature_rise: float | npt.ArrayLike = 0.0) -> _Raw: ...
 
+# validation.cpp
+def _compare(a: Model, b: Model, stations: int = 60, station_seed: int = 1, translation: float = 0.25,
+             rotation: float = ...) -> _Raw: ...
+
 # measurement.cpp, identification.cpp, station_plan.cpp, registration.cpp
 def _read_point_log(path_or_text: _Source, time_column: str = "t", length_unit: float = 0.0, indexed: bool = False,
                     target_column: str = "", temperature_column: str = "") -> _Raw: ...

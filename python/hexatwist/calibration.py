@@ -24,6 +24,7 @@ __all__ = [
     "plan_stations", "PointLog", "CommandedRun", "StationsRun", "Observations", "Identification", "CorrectedPlatform",
     "StationsQuality", "StationPlan",
     "StationResidual", "SignFit", "CrossValidation", "PredictedAccuracy", "Registration",
+    "compare", "PlatformComparison", "LegDifference", "CommandAccuracy",
 ]
 
 
@@ -460,3 +461,74 @@ def register_points(points_T: ArrayLike, points_B: ArrayLike, max_condition: flo
     """Best-fit rigid transform X_BT (registration.hpp, Kabsch/Umeyama, no scale) mapping points measured
     in the tracker frame ``points_T`` (N, 3) [m, T] onto the same points ``points_B`` (N, 3) [m, B]."""
     return Registration(**_core._register_points(points_T, points_B, max_condition))
+
+
+@dataclass(frozen=True)
+class LegDifference(Result):
+    """One leg of B against the same leg of A, B - A (validation.hpp)."""
+
+    base: FloatArray
+    """(3,) base joint centre [m, B]."""
+    platform: FloatArray
+    """(3,) platform joint centre [m, P]."""
+    base_axis_angle: float
+    """Angle between the fixed base axes [rad]."""
+    platform_axis_angle: float
+    """Angle between the fixed platform axes [rad]."""
+    lead: float
+    """[m]"""
+    drive_lead: float
+    """[m]"""
+    length_offset: float
+    """Zero offset [m]."""
+    home_command: float
+    """The drive's reading at its reference [m]."""
+    compliance: float
+    """1 / stiffness [m/N]."""
+    play: float
+    """[m]"""
+    thread_differs: bool
+
+
+@dataclass(frozen=True)
+class CommandAccuracy(Result):
+    """Where A's compensated commands put point A on B at the stations (validation.hpp)."""
+
+    gauge: FloatArray
+    """(N,) the distance at each station in the gauge frames, sorted [m]."""
+    aligned: FloatArray
+    """(N,) the same after the best rigid re-alignment, sorted [m]."""
+    gauge_median: float
+    gauge_max: float
+    aligned_median: float
+    aligned_max: float
+
+
+@dataclass(frozen=True)
+class PlatformComparison(Result):
+    """Two platforms compared (``hexatwist compare A B --json``, number for number)."""
+
+    legs: tuple[LegDifference, ...]
+    """Legs 1 to 6."""
+    observation_point: FloatArray
+    """(3,) B - A of point A [m, P]."""
+    home_height: float
+    """[m]"""
+    largest_joint: float
+    """The largest joint centre's difference [m]."""
+    largest_joint_leg: int
+    """Its leg, 1 to 6."""
+    largest_joint_side: str
+    """"base" or "platform"."""
+    accuracy: CommandAccuracy
+
+
+def compare(a: Model, b: Model, stations: int = 60, station_seed: int = 1, translation: float = 0.25,
+            rotation: float = float(np.radians(15.0))) -> PlatformComparison:
+    """What differs between the platforms ``a`` and ``b`` leg by leg (B - A), and where ``a``'s
+    compensated commands put point A on ``b`` at ``stations`` random stations within
+    +-``translation`` [m] and +-``rotation`` [rad] (theory §13c): a corrected configuration against the
+    real platform of a rehearsal (synth's FILE.real.yaml), the nominal one or a later calibration."""
+    d = _core._compare(a, b, stations, station_seed, translation, rotation)
+    return PlatformComparison(**_fields(d, legs=tuple(LegDifference(**leg) for leg in d["legs"]),
+                                        accuracy=CommandAccuracy(**d["accuracy"])))

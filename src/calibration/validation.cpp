@@ -54,7 +54,7 @@ PlatformDifference compare_platforms(const Model& a, const Model& b) noexcept {
 Status command_accuracy(const Model& commanding, const Model& actual, std::span<const Vector6d> poses,
                         CommandAccuracy& out) {
   out = CommandAccuracy{};
-  if (poses.size() < 4) return Status::InvalidArgument;
+  if (poses.size() < static_cast<std::size_t>(kMinAccuracyStations)) return Status::InvalidArgument;
   std::vector<PointPair> pairs;
   pairs.reserve(poses.size());
   FkResult fk;

@@ -177,3 +177,27 @@ def test_the_legs_effects_are_chosen_and_fitted_alike_by_python_and_the_cli(tmp_
     assert set(plain.diagnosis) == {"load", "heat"} and np.isnan(plain.diagnosis["heat"]), plain.diagnosis
     with pytest.raises(ValueError, match="warp"):
         hexatwist.identify(model, obs.motor, obs.points, effects="heat,warp")
+
+
+def test_compare_is_the_clis_number_for_number(log_dir):
+    """compare() and `hexatwist compare --json` on the nominal platform against the real one synth
+    measured (s.real.yaml): the same differences and accuracy; the real platform against itself: none."""
+    real_path = str(log_dir / "s.real.yaml")
+    cli = json.loads(run("compare", os.path.join(os.path.dirname(__file__), "..", "..", "configs", "seed.yaml"),
+                         real_path, "--stations", "20", "--station-seed", "3", "--json", cwd=log_dir).stdout)
+    nominal, real = hexatwist.default_model(), hexatwist.load_model(real_path)
+    py = hexatwist.compare(nominal, real, stations=20, station_seed=3)
+    for leg_cli, leg_py in zip(cli["legs"], py.legs):
+        for key in ("base", "platform"):
+            assert list(getattr(leg_py, key)) == leg_cli[key], key
+        for key in ("lead", "drive_lead", "length_offset", "home_command", "compliance", "play", "base_axis_angle"):
+            assert getattr(leg_py, key) == leg_cli[key], key
+    assert py.largest_joint == cli["largest_joint"] and py.largest_joint_leg == cli["largest_joint_leg"]
+    for key in ("gauge_median", "gauge_max", "aligned_median", "aligned_max"):
+        assert py.accuracy[key] == cli["accuracy"][key], key
+    assert py.accuracy.gauge.shape == (20,) and py.accuracy.gauge_median > 1e-4
+    assert abs(py.legs[0].lead - 0.02 * 0.010) < 1e-15
+    same = hexatwist.compare(real, real, stations=10)
+    assert same.largest_joint == 0.0 and same.accuracy.gauge_max < 1e-14
+    with pytest.raises(hexatwist.InputError, match="stations"):
+        hexatwist.compare(real, real, stations=3)

@@ -289,6 +289,7 @@ def calls():
                                        accuracy_poses=20),
         "identify refused": hexatwist.identify(model, obs.motor[:20], obs.points[:20], calibration="basic"),
         "plan_stations": hexatwist.plan_stations(rig, count=13, candidates=40, accuracy_poses=20),
+        "compare": hexatwist.compare(model, model, stations=6),
         "register_points": hexatwist.register_points(np.eye(3) * 2 + 1, np.eye(3) * 2),
         "required_workspace": w,
         "workspace_volume": hexatwist.workspace_volume(model, cell=0.1, refine=1),

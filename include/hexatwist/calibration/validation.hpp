@@ -51,7 +51,10 @@ struct CommandAccuracy {
   RigidTransform alignment;  ///< the re-alignment: points of `actual` = alignment of `commanding`'s targets
 };
 
-/// CommandAccuracy at `poses` [m, rad] (at least 4, each inside every limit of `commanding`, as
+/// Fewest stations command_accuracy takes (a rigid re-alignment of fewer says little).
+inline constexpr int kMinAccuracyStations = 4;
+
+/// CommandAccuracy at `poses` [m, rad] (at least kMinAccuracyStations, each inside every limit of `commanding`, as
 /// random_stations draws them). Returns the first failure: a limit of the commands (the pose is
 /// not one to validate on), the forward kinematics on `actual`, or the registration of the points.
 [[nodiscard]] Status command_accuracy(const Model& commanding, const Model& actual, std::span<const Vector6d> poses,
