@@ -79,7 +79,14 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
       fixed(study.linear.acceleration * unit), fixed(study.linear.acceleration * unit),
       fixed(rad2deg(study.angular.velocity)), fixed(rad2deg(study.angular.velocity)),
       fixed(rad2deg(study.angular.acceleration)), fixed(rad2deg(study.angular.acceleration)));
-  t += fmt::format("[KINS]\nKINEMATICS = {}\nJOINTS = 6\n\n", kins);
+  t += fmt::format("[KINS]\nKINEMATICS = {}\nJOINTS = 6\n", kins);
+  if (model.has_thermal())
+    t += fmt::format(
+        "# The legs expand (leg_effects): the module reads each leg's temperature from its input pin\n"
+        "# hexatwistkins.leg.N.temperature [degC], at {:g} degC (the reference) until set: net your sensors to them\n"
+        "# (integrations/linuxcnc/README.md, \"Legs that deflect, warm and have play\").\n",
+        model.reference_temperature());
+  t += "\n";
 
   for (int i = 0; i < kLegs; ++i) {
     t += fmt::format(

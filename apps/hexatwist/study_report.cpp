@@ -222,8 +222,11 @@ std::string effects_md(const std::vector<ReportedTest>& tests, const Vector6d& t
       "**conventional**: commands that ignore the twist and the effect; **twist compensated**: Eq. (12) alone, "
       "the effect left; **compensated**: both (the legs' temperatures known to the commands).";
   if (temperature_rise.any())
-    s += fmt::format(" Heat: the legs warm by {:g} to {:g} K over each test (along synth's warm-up).",
-                     temperature_rise.minCoeff(), temperature_rise.maxCoeff());
+    s +=
+        temperature_rise.minCoeff() == temperature_rise.maxCoeff()
+            ? fmt::format(" Heat: the legs warm by {:g} K over each test (along synth's warm-up).", temperature_rise[0])
+            : fmt::format(" Heat: the legs warm by {:g} to {:g} K over each test (along synth's warm-up).",
+                          temperature_rise.minCoeff(), temperature_rise.maxCoeff());
   s += "\n\n";
   s += "| effect | commands |";
   for (const ReportedTest& t : tests) s += fmt::format(" {} max | {} RMS |", t.name, t.name);

@@ -461,7 +461,9 @@ def test_warm_legs_read_from_the_temperature_pins_are_compensated_and_seen_by_th
     first, second = [40, -20, home_z + 60, 3, -2, 10], [-30, 25, home_z - 40, -2, 4, -15]
     steps = [{"home": True}, {"mdi": g0(first)}, {"setp": dict(zip(temperature_pins, warm))}, {"mdi": g0(second)},
              {"setp": {temperature_pins[0]: 250.0}, "expect_off": True}]
-    run = harness.run(ini_for(config), {"steps": steps, "pins": PINS + temperature_pins}, timeout=120,
+    ini = ini_for(config)
+    assert "hexatwistkins.leg.N.temperature [degC], at 20 degC" in ini, "the INI names the pins"
+    run = harness.run(ini, {"steps": steps, "pins": PINS + temperature_pins}, timeout=120,
                       keep_dir=os.path.join(work, "run"))
     assert run.results and len(run.results) == len(steps), run.log[-3000:]
     at_first, warmed, at_second, hot = run.results[1:]
