@@ -5,7 +5,7 @@
 // --stations 40 --station-seed 4 --offsets-mm 0.33 --seed 3 --rate 10`), determines the legs'
 // zero offsets. The twin of examples/python/06_identify.py, which also compares with the truth.
 //
-//   example_06_identify [EXAMPLES_DIR]      (default: examples)
+//   example_06_identify [EXAMPLES_DIR]      (default: this source folder, from any working directory)
 #include <hexatwist/hexatwist.hpp>
 
 #include <cstdio>
@@ -38,10 +38,7 @@ void identify_log(const Model& model, const std::string& path, const std::string
       std::printf("  %s: %+.4f mm +- %.4f mm\n", id.parameters.name(k).c_str(), 1e3 * id.estimate[k], 1e3 * id.sd[k]);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const std::string dir = argc > 1 ? argv[1] : "examples";
+void identify_both(const std::string& dir) {
   const Config config = default_config();
   const Model& model = config.rig.model();
   const double dt = config.rig.control_period();
@@ -56,5 +53,16 @@ int main(int argc, char** argv) {
   stations.seed = 4;
   identify_log(model, dir + "/tracker_stations.csv", "tracker_stations.csv",
                stations_trajectory(model, Strategy::Compensated, stations, dt));
-  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    identify_both(argc > 1 ? argv[1] : HEXATWIST_EXAMPLES_DIR);
+    return 0;
+  } catch (const Error& e) {  // a missing or unreadable log: say which, as the CLI does
+    std::fprintf(stderr, "example_06_identify: %s\n", e.what());
+    return 1;
+  }
 }

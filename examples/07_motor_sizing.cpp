@@ -3,7 +3,7 @@
 // peaks and largest torque parts, and where the cue leaves the seed motor's envelope. The twin of
 // examples/python/07_motor_sizing.py, which draws the torque-speed plane.
 //
-//   example_07_motor_sizing [EXAMPLES_DIR]      (default: examples)
+//   example_07_motor_sizing [EXAMPLES_DIR]      (default: this source folder, from any working directory)
 #include <hexatwist/hexatwist.hpp>
 
 #include <algorithm>
@@ -12,9 +12,11 @@
 #include <numeric>
 #include <string>
 
-int main(int argc, char** argv) {
+namespace {
+
+int size_along(const std::string& dir) {
   using namespace hexatwist;
-  const std::string path = std::string(argc > 1 ? argv[1] : "examples") + "/motion_simulator.csv";
+  const std::string path = dir + "/motion_simulator.csv";
   const Config config = default_config();  // the seed: 3 kW-class servo motors, 1500 kg load
   const Rig& rig = config.rig;
   const Trajectory cue = resample(parse_trajectory_csv(read_text_file(path, "trajectory", kMaxDataBytes), path),
@@ -48,4 +50,15 @@ int main(int argc, char** argv) {
                 v.bound * (speed ? rpm : 1.0), speed ? "rpm" : "N m");
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return size_along(argc > 1 ? argv[1] : HEXATWIST_EXAMPLES_DIR);
+  } catch (const hexatwist::Error& e) {  // a missing or unreadable data file: say which, as the CLI does
+    std::fprintf(stderr, "example_07_motor_sizing: %s\n", e.what());
+    return 1;
+  }
 }

@@ -54,6 +54,21 @@ void write_stdout(std::string_view text) {
                                                    errno != 0 ? std::strerror(errno) : "write error"));
 }
 
+std::string defaults_note(const Config& config) {
+  if (config.defaulted.empty()) return {};
+  std::string names;
+  for (std::size_t k = 0; k < config.defaulted.size(); ++k)
+    names += (k == 0 ? "" : k + 1 == config.defaulted.size() ? " and " : ", ") + config.defaulted[k];
+  return fmt::format(" ({}: the seed's defaults, not in the file)", names);
+}
+
+Strategy strategy_option(const std::string& text, const char* option) {
+  if (Strategy s; parse_strategy(text, s)) return s;
+  throw ExitError(kExitBadInput,
+                  fmt::format("{}: expected {} or {}, got '{}'", option, to_string(Strategy::Conventional),
+                              to_string(Strategy::Compensated), printable(text)));
+}
+
 Model load_model_from(const ModelOptions& opts) {
   try {
     if (opts.config.empty()) return default_model();

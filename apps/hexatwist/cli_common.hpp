@@ -47,6 +47,13 @@ struct ModelOptions {
 /// Adds --config to a subcommand.
 void add_model_options(CLI::App& app, ModelOptions& opts);
 
+/// For a report's header after the platform's name: "" when the configuration gives its drives and
+/// load, else " (servo, load: the seed's defaults, not in the file)" naming the sections it leaves out.
+std::string defaults_note(const Config& config);
+
+/// The strategy `text` names (parse_strategy); ExitError(2) naming `option` for any other text.
+Strategy strategy_option(const std::string& text, const char* option = "--strategy");
+
 /// Loads the model named by --config (or the embedded default); errors become ExitError(2).
 Model load_model_from(const ModelOptions& opts);
 

@@ -132,9 +132,9 @@ std::string report_json(const Model& model, const DesignCommandOptions& o, const
 }
 
 std::string report_text(const Model& model, const DesignCommandOptions& o, const RequiredPoses& req,
-                        const DesignOptions& d, const AxisDesign& r, double seconds) {
+                        const DesignOptions& d, const AxisDesign& r, double seconds, const std::string& defaults) {
   const DesignEvaluation &b = r.before, &a = r.after;
-  std::string out = fmt::format("hexatwist design on {}: {}\n", model_source(o.model), model.spec().name);
+  std::string out = fmt::format("hexatwist design on {}: {}{}\n", model_source(o.model), model.spec().name, defaults);
   out += fmt::format("required workspace: {}\n", req.description);
   out += fmt::format("objective: largest {}; symmetry: {}{}; volume kept within {:g} %\n",
                      o.objective == "twist"          ? "|twist|"
@@ -221,7 +221,8 @@ int run_design(const DesignCommandOptions& o) {
   files.add(o.out, yaml);
   files.commit();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  files.finish(o.json ? report_json(model, o, req, d, r) : report_text(model, o, req, d, r, seconds));
+  files.finish(o.json ? report_json(model, o, req, d, r)
+                      : report_text(model, o, req, d, r, seconds, defaults_note(config)));
   return kExitOk;
 }
 

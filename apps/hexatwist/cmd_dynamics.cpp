@@ -201,9 +201,11 @@ std::string largest_terms(const MotorSummary& m) {
                      to_string(kTerms[order[1]]), 100.0 * m.share[order[1]]);
 }
 
-std::string table(const Rig& rig, const DynamicsOptions& o, const Trajectory& traj, const MotorSizing& s) {
+std::string table(const Config& config, const DynamicsOptions& o, const Trajectory& traj, const MotorSizing& s) {
+  const Rig& rig = config.rig;
   const ServoSpec& servo = rig.servo();
-  std::string out = fmt::format("hexatwist dynamics on {}: {}\n", model_source(o.model), rig.model().spec().name);
+  std::string out = fmt::format("hexatwist dynamics on {}: {}{}\n", model_source(o.model), rig.model().spec().name,
+                                defaults_note(config));
   out += fmt::format("trajectory: {}: {:.3f} s, {} samples at {:g} Hz\n", printable(o.trajectory), traj.duration(),
                      s.samples.size(), 1.0 / traj.dt);
   out += fmt::format("motor: peak {:g} N m up to {:.0f} rpm, {:g} N m at {:.0f} rpm; continuous {:g} N m\n\n",
@@ -268,7 +270,7 @@ int run_dynamics(const DynamicsOptions& o) {
   files.commit();
 
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::string text = table(rig, o, traj, sizing);
+  std::string text = table(config, o, traj, sizing);
   text += fmt::format("\n{} files written to {} in {:.1f} s\n", files.paths().size(), o.out, wall);
   files.finish(text);
   // A motor outside its envelope is the run's finding: the report is complete and kept.

@@ -22,7 +22,8 @@ struct FkOptionsCli {
 };
 
 int run_fk(const FkOptionsCli& o) {
-  const Model model = load_model_from(o.model);
+  const Config config = load_config_from(o.model);
+  const Model& model = config.rig.model();
   const auto v = parse_numbers(o.lengths, 6, "--lengths", "six leg lengths L1..L6 [m]");
   Vector6d lengths;
   for (int i = 0; i < kLegs; ++i) {
@@ -62,8 +63,8 @@ int run_fk(const FkOptionsCli& o) {
     j.end_object();
     write_stdout(j.str());
   } else {
-    std::string out = fmt::format("hexatwist fk on {} ({} lengths{})\n", model_source(o.model), kind_name,
-                                  o.motor ? ", twist included" : "");
+    std::string out = fmt::format("hexatwist fk on {}{} ({} lengths{})\n", model_source(o.model), defaults_note(config),
+                                  kind_name, o.motor ? ", twist included" : "");
     if (status == Status::Ok)
       out += fmt::format("pose: x={:.9f} y={:.9f} z={:.9f} m, roll={:.9f} pitch={:.9f} yaw={:.9f} deg\n", tidy(q[0]),
                          tidy(q[1]), tidy(q[2]), rad2deg(tidy(q[3])), rad2deg(tidy(q[4])), rad2deg(tidy(q[5])));

@@ -55,6 +55,7 @@ struct Report {
   std::string run_description;
   ClockFit clock;
   std::size_t outside = 0;  // points of the log outside the run (--time-offset auto)
+  std::string defaults;     // defaults_note of the configuration
 
   int line_of(std::size_t observation) const { return log.lines[set.points[observation]]; }
   const ParameterSet& ps() const { return id.parameters; }
@@ -160,7 +161,8 @@ std::string axes_phrase(const Identification& id) {
 std::string text_report(const Report& r) {
   const Identification& id = r.id;
   const IdentifyOptions& o = r.o;
-  std::string t = fmt::format("hexatwist identify on {}: {}\n", model_source(o.run.model), r.nominal.spec().name);
+  std::string t =
+      fmt::format("hexatwist identify on {}: {}{}\n", model_source(o.run.model), r.nominal.spec().name, r.defaults);
   t += fmt::format(
       "points: {}: {} points, {} at rest (commanded pose still for {:g} s) at {} stations, {} target{}; {}; {} "
       "commands\n",
@@ -376,53 +378,36 @@ std::string json_report(const Report& r, const std::string& failure, bool writte
   return j.str();
 }
 
-// The map of the predicted accuracy: positions in the x-y plane at the range's middle height, each
-// drawn in the colour of its error band.
+// The map of the predicted accuracy at the calibrated range's centre: the x-y plane at its middle
+// height and the x-z plane at its middle y, each a continuous colour scale of its own (so that the
+// small differences of the x-y plane show), with the re-aligned figures and the frames in plain words.
 Figure accuracy_figure(const Identification& id, const std::string& stem) {
   Figure fig;
   fig.stem = stem;
-  fig.title = "predicted error of point A after calibration (gauge frames, no rotation; blank: outside a limit)";
+  const AccuracyPrediction& acc = id.accuracy;
+  fig.title = "predicted error of point A after calibration, no rotation (blank: outside a limit)";
+  // What the frames mean, and the figures after re-alignment, in the panels' titles (one line each).
+  const std::array<std::string, 2> notes{
+      "measured from frames fitted to the six joints: a rigid shift of the whole machine is not counted",
+      fmt::format("after a rigid re-alignment to the tracker: median {:.1f} um, largest {:.1f} um",
+                  1e6 * acc.aligned_median, 1e6 * acc.aligned_max)};
   const Eigen::MatrixXd C = id.covariance.topLeftCorner(id.parameters.platform_size(), id.parameters.platform_size());
   const std::array<std::pair<int, int>, 2> planes{{{0, 1}, {0, 2}}};
-  std::vector<AccuracyMap> maps;
-  double lo = INFINITY, hi = -INFINITY;
   for (const auto& [a, b] : planes) {
     AccuracyMap map;
-    if (accuracy_map(id.parameters, id.estimate, id.twist_sign, C, id.accuracy, a, b, 41, map) != Status::Ok) continue;
-    for (const double e : map.error)
-      if (std::isfinite(e)) lo = std::min(lo, 1e6 * e), hi = std::max(hi, 1e6 * e);
-    maps.push_back(std::move(map));
-  }
-  if (!std::isfinite(lo)) return fig;
-  // Five bands of equal width from the smallest to the largest error of both maps, each its own
-  // colour, with enough decimals to tell their edges apart.
-  std::array<double, 6> edges{};
-  for (std::size_t k = 0; k < edges.size(); ++k) edges[k] = lo + (hi - lo) * static_cast<double>(k) / 5.0;
-  const double step = (hi - lo) / 5.0;
-  const int decimals = step >= 5.0 ? 0 : step >= 0.5 ? 1 : 2;
-  for (const AccuracyMap& map : maps) {
-    const int a = map.axis_u, b = map.axis_v;
-    Panel panel;
-    panel.title = fmt::format("{}-{} plane, {} = {:.3f} m", "xyz"[a], "xyz"[b], "xyz"[3 - a - b],
-                              0.5 * (id.accuracy.range_low[3 - a - b] + id.accuracy.range_high[3 - a - b]));
-    panel.xlabel = fmt::format("{} [m]", "xyz"[a]);
-    panel.ylabel = fmt::format("{} [m]", "xyz"[b]);
-    for (std::size_t band = 0; band + 1 < edges.size(); ++band) {
-      Series s;
-      s.style = Series::Style::Points;
-      s.label = fmt::format("{:.{}f}-{:.{}f} um", edges[band], decimals, edges[band + 1], decimals);
-      const bool last = band + 2 == edges.size();
-      for (std::size_t jv = 0; jv < map.v.size(); ++jv)
-        for (std::size_t iu = 0; iu < map.u.size(); ++iu) {
-          const double e = 1e6 * map.error[jv * map.u.size() + iu];
-          if (!(e >= edges[band] && (e < edges[band + 1] || (last && e <= edges[band + 1])))) continue;
-          s.x.push_back(map.u[iu]);
-          s.y.push_back(map.v[jv]);
-        }
-      // An empty band keeps its place in the legend, so that a colour means one band in both panels.
-      if (s.x.empty()) s.x = {std::nan("")}, s.y = {std::nan("")};
-      panel.series.push_back(std::move(s));
-    }
+    if (accuracy_map(id.parameters, id.estimate, id.twist_sign, C, acc, a, b, 41, map) != Status::Ok) continue;
+    if (std::none_of(map.error.begin(), map.error.end(), [](double e) { return std::isfinite(e); })) continue;
+    const int c = 3 - a - b;
+    Panel panel(fmt::format("{}-{} plane at {} = {:.3f} m (the range's centre); {}", "xyz"[a], "xyz"[b], "xyz"[c],
+                            0.5 * (acc.range_low[c] + acc.range_high[c]), notes[fig.panels.size()]),
+                fmt::format("{} [m]", "xyz"[a]), fmt::format("{} [m]", "xyz"[b]));
+    HeatMap heat;
+    heat.u = map.u;
+    heat.v = map.v;
+    heat.label = "predicted error of point A [um]";
+    for (const double e : map.error) heat.values.push_back(1e6 * e);
+    panel.map = std::move(heat);
+    panel.equal_axes = true;
     fig.panels.push_back(std::move(panel));
   }
   return fig;
@@ -492,7 +477,7 @@ int run_identify(const IdentifyOptions& o) {
   const ObservationSet set = observations_at_rest(model, run.commanded, log, alignment, strategy_of(o.run), o.settle);
   Identification id;
   const Status status = identify(model, set.observations, id, library_options(o));
-  const Report report{o, model, set, log, id, run.test.description, clock, outside};
+  const Report report{o, model, set, log, id, run.test.description, clock, outside, defaults_note(config)};
   // A failure still prints the JSON (with the reason, and null where there is no value) when asked.
   const auto fail = [&](const ExitError& e) {
     if (o.json) write_stdout(json_report(report, e.what(), false));

@@ -20,7 +20,8 @@ struct IkOptions {
 };
 
 int run_ik(const IkOptions& o) {
-  const Model model = load_model_from(o.model);
+  const Config config = load_config_from(o.model);
+  const Model& model = config.rig.model();
   const Pose pose = parse_pose_m_deg(o.pose, "--pose");
   auto report = std::make_unique<CommandReport>();
   LegInputs inputs;
@@ -79,7 +80,8 @@ int run_ik(const IkOptions& o) {
     j.end_array().end_object();
     write_stdout(j.str());
   } else {
-    std::string out = fmt::format("hexatwist ik on {}: {}\n", model_source(o.model), model.spec().name);
+    std::string out =
+        fmt::format("hexatwist ik on {}: {}{}\n", model_source(o.model), model.spec().name, defaults_note(config));
     out += fmt::format("pose: x={:.6g} y={:.6g} z={:.6g} m, roll={:.6g} pitch={:.6g} yaw={:.6g} deg\n",
                        pose.position.x(), pose.position.y(), pose.position.z(), rad2deg(pose.rpy[0]),
                        rad2deg(pose.rpy[1]), rad2deg(pose.rpy[2]));

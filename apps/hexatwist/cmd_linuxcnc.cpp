@@ -31,7 +31,7 @@ std::string fixed(double v) { return fmt::format("{:.9f}", tidy(v)); }
 std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::string& command_line) {
   const Model& model = config.rig.model();
   const double unit = o.units == "mm" ? 1000.0 : o.units == "inch" ? 1.0 / 0.0254 : 1.0;
-  const Strategy strategy = o.strategy == "conventional" ? Strategy::Conventional : Strategy::Compensated;
+  const Strategy strategy = strategy_option(o.strategy);
   const LimitSpec& lim = model.spec().limits;
   const double home_z = model.spec().home_height;
   // The drives' reference: the joints read these after homing (home_commands, theory §4).

@@ -87,7 +87,7 @@ int run_measure(const MeasureOptions& o) {
   measured.window = window;
 
   std::vector<ReportedTest> tests{std::move(run.test)};
-  const ReportOptions ro{o.out, "measure", model_source(o.run.model), !o.no_figures, !o.no_csv};
+  const ReportOptions ro{o.out, "measure", model_source(o.run.model), defaults_note(config), !o.no_figures, !o.no_csv};
   // After the simulation: the part after the registration window, as the measurement is evaluated.
   const auto compare = [&](std::vector<ReportedTest>& ts) {
     ReportedTest& t = ts[0];

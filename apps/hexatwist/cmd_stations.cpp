@@ -93,8 +93,8 @@ std::string quality_row(const std::string& label, const StationsQuality& q) {
 }
 
 std::string text_report(const StationsOptions& o, const Model& model, const StationPlanSpec& spec,
-                        const StationPlan& plan, const Trajectory& run) {
-  std::string t = fmt::format("hexatwist stations on {}: {}\n", model_source(o.model), model.spec().name);
+                        const StationPlan& plan, const Trajectory& run, const std::string& defaults) {
+  std::string t = fmt::format("hexatwist stations on {}: {}{}\n", model_source(o.model), model.spec().name, defaults);
   t += fmt::format(
       "plan: {} stations within ±{:g} m and ±{:g} deg, {} commands, for the {} model ({} parameters; the tracker "
       "frame a nuisance): the Ds criterion over {} candidates inside the limits ({} drawn, seed {}), {} exchanges in "
@@ -188,7 +188,7 @@ int run_stations(const StationsOptions& o) {
   files.output("--stream-out", o.stream_out);
   const Config config = load_config_from(o.model);
   const Model& model = config.rig.model();
-  const Strategy strategy = o.strategy == "conventional" ? Strategy::Conventional : Strategy::Compensated;
+  const Strategy strategy = strategy_option(o.strategy);
   const StationPlanSpec spec = plan_spec(model, o);
   const std::size_t every = rows_every(config.rig, o.rate);
   StationPlan plan;
@@ -220,7 +220,8 @@ int run_stations(const StationsOptions& o) {
   }
   if (!o.stream_out.empty()) files.add(o.stream_out, stream_input(run));
   files.commit();
-  files.finish(o.json ? json_report(o, model, spec, plan, run) : text_report(o, model, spec, plan, run));
+  files.finish(o.json ? json_report(o, model, spec, plan, run)
+                      : text_report(o, model, spec, plan, run, defaults_note(config)));
   return kExitOk;
 }
 

@@ -119,8 +119,7 @@ E parse_choice(const std::string& text, const std::string& option,
 
 StreamSettings settings_from(const StreamOptions& o) {
   StreamSettings s;
-  s.strategy = parse_choice<Strategy>(
-      o.strategy, "--strategy", {{"compensated", Strategy::Compensated}, {"conventional", Strategy::Conventional}});
+  s.strategy = strategy_option(o.strategy);
   s.on_reject = parse_choice<RejectPolicy>(o.on_reject, "--on-reject",
                                            {{"hold", RejectPolicy::Hold}, {"skip", RejectPolicy::Skip}});
   s.period = 1.0 / o.rate;

@@ -33,11 +33,11 @@ struct StudyFiles {
   }
 };
 
-int finish(const Rig& rig, const StudyOptions& o, const std::string& command, std::vector<ReportedTest>& tests,
+int finish(const Config& config, const StudyOptions& o, const std::string& command, std::vector<ReportedTest>& tests,
            OutputFiles& files, std::chrono::steady_clock::time_point start) {
-  ReportOptions ro{o.out, command, model_source(o.model), !o.no_figures, !o.no_csv};
-  ro.temperature_rise = temperature_rise_option(o.temperature_rise_k, &rig.model());
-  simulate_and_report(rig, ro, tests, files, start);
+  ReportOptions ro{o.out, command, model_source(o.model), defaults_note(config), !o.no_figures, !o.no_csv};
+  ro.temperature_rise = temperature_rise_option(o.temperature_rise_k, &config.rig.model());
+  simulate_and_report(config.rig, ro, tests, files, start);
   return kExitOk;
 }
 
@@ -63,7 +63,7 @@ int run_study(const StudyOptions& o) {
     begin = comma + 1;
   }
   StudyFiles out("study", o);
-  return finish(config.rig, o, "study", tests, out.files, start);
+  return finish(config, o, "study", tests, out.files, start);
 }
 
 int run_simulate(const StudyOptions& o) {
@@ -71,7 +71,7 @@ int run_simulate(const StudyOptions& o) {
   const Config config = load_config_from(o.model);
   StudyFiles out("simulate", o);
   std::vector<ReportedTest> tests{reported_trajectory_file(o.trajectory, config.rig.control_period())};
-  return finish(config.rig, o, "simulate", tests, out.files, start);
+  return finish(config, o, "simulate", tests, out.files, start);
 }
 
 void add_common(CLI::App& app, StudyOptions& o) {

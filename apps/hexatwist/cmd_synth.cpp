@@ -266,10 +266,11 @@ std::string log_csv(const SyntheticLog& log, bool targets) {
 // What synth tells the user: the run, the real platform's errors, the tracker, the files.
 std::string summary_text(const SynthOptions& o, const Rig& rig, const Run& run, const SynthesisOptions& so,
                          const SyntheticLog& log, const std::string& out, const std::string& truth,
-                         const std::string& real_yaml) {
+                         const std::string& real_yaml, const std::string& defaults) {
   const bool targets = !so.extra_targets_P.empty();
   const Vector3d& origin = log.X_BT.t;
-  std::string text = fmt::format("hexatwist synth on {}: {}\n", model_source(o.run.model), rig.model().spec().name);
+  std::string text =
+      fmt::format("hexatwist synth on {}: {}{}\n", model_source(o.run.model), rig.model().spec().name, defaults);
   text += fmt::format("run: {}, {} commands, {:.2f} s: {} points at {:g} Hz\n", run.test.description, o.run.strategy,
                       run.test.trajectory.duration(), log.log.points_T.size(), so.rate);
   const bool one_lead = (so.errors.lead_error.array() == so.errors.lead_error[0]).all();
@@ -350,7 +351,7 @@ int run_synth(const SynthOptions& o) {
                                     static_cast<std::size_t>(std::llround(rig.simulation().control_rate / so.rate))));
   files.commit();
 
-  files.finish(summary_text(o, rig, run, so, log, out, truth, real_yaml));
+  files.finish(summary_text(o, rig, run, so, log, out, truth, real_yaml, defaults_note(config)));
   return kExitOk;
 }
 

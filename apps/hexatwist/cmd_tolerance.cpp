@@ -16,11 +16,15 @@
 #include "figures.hpp"
 #include "json.hpp"
 #include "output_files.hpp"
+#include "progress.hpp"
 #include "schemas.hpp"
 #include "study_report.hpp"
 
 namespace hexatwist::cli {
 namespace {
+
+// On a terminal, the Monte Carlo runs in this many parts, the progress line redrawn after each.
+constexpr std::uint64_t kProgressParts = 100;
 
 namespace fs = std::filesystem;
 
@@ -103,7 +107,7 @@ CalibrationChoice calibration_of(const ToleranceCommandOptions& o) {
   return c;
 }
 
-bool tracker_calibration(const CalibrationChoice& c) { return c.name == "plan" || c.name.starts_with("stations:"); }
+bool tracker_calibration(const CalibrationChoice& c) { return is_tracker_calibration(c.name); }
 
 void tracker_json(JsonWriter& j, const ToleranceCommandOptions& o, const CalibrationChoice& c) {
   if (!tracker_calibration(c)) {
@@ -340,8 +344,9 @@ std::string calibration_failures(const ToleranceSummary& sm) {
 
 std::string report_text(const Model& model, const ToleranceCommandOptions& o, const RequiredPoses& req,
                         const ToleranceSigmas& s, const CalibrationChoice& c, const ToleranceSummary& sm, int workers,
-                        double seconds) {
-  std::string out = fmt::format("hexatwist tolerance on {}: {}\n", model_source(o.model), model.spec().name);
+                        double seconds, const std::string& defaults) {
+  std::string out =
+      fmt::format("hexatwist tolerance on {}: {}{}\n", model_source(o.model), model.spec().name, defaults);
   out += fmt::format("required workspace: {}\n", req.description);
   out += fmt::format(
       "manufacturing errors (standard deviations, every leg): joint centres {:g} um (base), {:g} um (platform) per "
@@ -410,8 +415,20 @@ int run_tolerance(const ToleranceCommandOptions& o) {
   ToleranceChunk chunk;
   if (!o.scheduler.empty()) {
     chunk = chunk_on_cluster(o, req, sigmas, calibration, workers);
-  } else if (const Status s = tolerance_chunk(model, req.poses, to, 0, o.platforms, chunk, &linear); s != Status::Ok) {
-    throw ExitError(kExitOutOfLimit, fmt::format("the study failed: {} ({})", describe(s), to_string(s)));
+  } else {
+    // On a terminal, in parts with a progress line between them (platform k depends on the seed and
+    // k alone, so the parts append to the same result bit for bit); else in one call.
+    Progress bar(o.platforms, !o.json);
+    const std::uint64_t part = bar.drawn() ? std::max<std::uint64_t>(1, o.platforms / kProgressParts) : o.platforms;
+    for (std::uint64_t first = 0; first < o.platforms; first += part) {
+      const std::uint64_t count = std::min(part, o.platforms - first);
+      ToleranceChunk next;
+      if (const Status s = tolerance_chunk(model, req.poses, to, first, count, first == 0 ? chunk : next, &linear);
+          s != Status::Ok)
+        throw ExitError(kExitOutOfLimit, fmt::format("the study failed: {} ({})", describe(s), to_string(s)));
+      if (first > 0) append_chunk(chunk, next);
+      bar.update(first + count, fmt::format("{} of {} platforms", first + count, o.platforms));
+    }
   }
   const ToleranceSummary sm = summarize_tolerance(chunk, req.poses.size(), &linear, 0);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -432,7 +449,8 @@ int run_tolerance(const ToleranceCommandOptions& o) {
   for (Figure& f : figs) f.stem = set.external(f.stem, {".png", ".svg"});
   if (!figs.empty()) write_figures(figs);
   set.commit();
-  std::string text = o.json ? json : report_text(model, o, req, sigmas, calibration, sm, workers, seconds);
+  std::string text =
+      o.json ? json : report_text(model, o, req, sigmas, calibration, sm, workers, seconds, defaults_note(config));
   if (!o.json) text += fmt::format("\n{} files written to {}\n", set.paths().size(), o.out);
   set.finish(text);
   return kExitOk;
@@ -501,8 +519,7 @@ Command make_tolerance_command(CLI::App& root) {
   add_scheduler_option(*app, o->scheduler);
   return {app, [o, app] {
             // The tracker's options have an effect only on a tracker calibration: refused, not ignored, without one.
-            const bool tracker =
-                o->calibration.rfind("stations:", 0) == 0 || o->calibration == "plan" || !o->station_plan.empty();
+            const bool tracker = is_tracker_calibration(o->calibration) || !o->station_plan.empty();
             for (const char* option : {"--tracker-noise-um", "--points-per-station", "--calibration-frames"})
               if (!tracker && app->count(option) > 0)
                 throw ExitError(kExitBadInput,

@@ -465,8 +465,10 @@ std::vector<Figure> figures(const Results& r, const fs::path& dir, const std::st
   return out;
 }
 
-std::string text_report(const Model& model, const WorkspaceCommandOptions& o, const Results& r) {
-  std::string out = fmt::format("hexatwist workspace on {}: {}\n", model_source(o.model), model.spec().name);
+std::string text_report(const Model& model, const WorkspaceCommandOptions& o, const Results& r,
+                        const std::string& defaults) {
+  std::string out =
+      fmt::format("hexatwist workspace on {}: {}{}\n", model_source(o.model), model.spec().name, defaults);
   out += fmt::format(
       "orientation: {}{}\n", orientation_label(r.rpy),
       r.workers > 0 ? fmt::format("; volume and map on {} Dask workers ({})", r.workers, printable(o.scheduler)) : "");
@@ -556,7 +558,7 @@ int run_workspace(const WorkspaceCommandOptions& o) {
     return kExitOk;
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::string text = text_report(model, o, r);
+  std::string text = text_report(model, o, r, defaults_note(config));
   text += fmt::format("\n{} files written to {} in {:.1f} s\n", set.paths().size(), o.out, wall);
   set.finish(text);
   return kExitOk;

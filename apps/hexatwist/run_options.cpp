@@ -9,9 +9,7 @@
 
 namespace hexatwist::cli {
 
-Strategy strategy_of(const RunOptions& o) {
-  return o.strategy == "conventional" ? Strategy::Conventional : Strategy::Compensated;
-}
+Strategy strategy_of(const RunOptions& o) { return strategy_option(o.strategy); }
 
 Run build_run(const Config& config, const RunOptions& o) {
   if (int{!o.test.empty()} + int{!o.trajectory.empty()} + int{o.stations > 0} != 1)

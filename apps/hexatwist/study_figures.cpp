@@ -30,7 +30,7 @@ double displacement(const ReportedTest& t, const SimulationSample& s) { return d
 Figure measured_figure(const fs::path& dir, const ReportedTest& t) {
   const ReportedMeasurement& r = *t.measured;
   const Measurement& m = r.measurement;
-  const char* strategy = strategy_name(r.strategy);
+  const char* strategy = to_string(r.strategy).data();
   Series measured{fmt::format("measured ({})", strategy), {}, {}, Series::Style::Solid};
   Series simulated{fmt::format("simulated ({}, closed loop)", strategy), {}, {}, Series::Style::Dashed};
   std::array<Series, 3> axes;

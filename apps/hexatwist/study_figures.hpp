@@ -15,7 +15,6 @@ namespace hexatwist::cli {
 inline constexpr const char* kCoordinateNames[6] = {"x", "y", "z", "roll", "pitch", "yaw"};
 
 /// "compensated" or "conventional".
-inline const char* strategy_name(Strategy s) { return s == Strategy::Compensated ? "compensated" : "conventional"; }
 
 /// The swept coordinate of a sample as plotted: m for translations, deg for rotations, or the time
 /// for a user trajectory.

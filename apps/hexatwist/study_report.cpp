@@ -13,6 +13,7 @@
 #include "cli_common.hpp"
 #include "json.hpp"
 #include "output_files.hpp"
+#include "progress.hpp"
 #include "schemas.hpp"
 #include "study_figures.hpp"
 
@@ -108,7 +109,7 @@ void measured_json(JsonWriter& j, const ReportedMeasurement& r) {
   for (const MeasuredPoint& p : m.points) registered += p.registered ? 1 : 0;
   j.begin_object()
       .field("points_file", r.source)
-      .field("strategy", strategy_name(r.strategy))
+      .field("strategy", to_string(r.strategy).data())
       .field("points", static_cast<int>(m.points.size()))
       .field("evaluated", static_cast<int>(m.points.size() - m.window));
   j.key("registration").begin_object();
@@ -292,7 +293,7 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
           "among "
           "the {} of {} (t <= {:.3f} s): rms residual {} mm, largest {} mm (line {}), noise estimate {} mm per axis, "
           "condition {:.3g}. The {} points after them are evaluated (`{}_measured.csv`).\n",
-          t.name, r.source, strategy_name(r.strategy), reg.count, m.window, r.window, m.window_end,
+          t.name, r.source, to_string(r.strategy).data(), reg.count, m.window, r.window, m.window_end,
           mm(reg.rms_residual), mm(reg.max_residual), worst_line(m), mm(reg.sigma), reg.condition,
           m.points.size() - m.window, t.name);
     }
@@ -315,32 +316,18 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
   return s;
 }
 
-// A progress bar on stderr, drawn only on a terminal.
-class Progress {
- public:
-  explicit Progress(std::size_t total) : total_(total), tty_(isatty(fileno(stderr)) != 0) {}
-  void update(std::size_t done, const std::string& what) {
-    if (!tty_ || total_ == 0) return;
-    const int percent = static_cast<int>(100.0 * static_cast<double>(done) / static_cast<double>(total_));
-    if (percent == last_) return;
-    last_ = percent;
-    const int filled = percent * 30 / 100;
-    std::fprintf(stderr, "\r[%s%s] %3d%%  %-24s", std::string(static_cast<std::size_t>(filled), '#').c_str(),
-                 std::string(static_cast<std::size_t>(30 - filled), '.').c_str(), percent, what.c_str());
-    std::fflush(stderr);
-  }
-  void finish() {
-    if (tty_ && last_ >= 0) std::fprintf(stderr, "\r%*s\r", 60, "");
-  }
-
- private:
-  std::size_t total_;
-  bool tty_;
-  int last_ = -1;
-};
-
 std::string where(const ReportedTest& t, const SimulationIssue& issue) {
   return fmt::format("{}: t = {:.3f} s", t.label, issue.time);
+}
+
+// For one of the paper's tests: which configuration key sets the sweep that left the limits (a small
+// machine's stroke is less than the seed's default amplitudes).
+std::string amplitude_hint(const ReportedTest& t, Status s) {
+  if (t.coordinate < 0 || !is_limit(s) || s == Status::MotorSpeedAboveMax || s == Status::TorqueAboveMax) return {};
+  const bool linear = t.coordinate < 3;
+  return fmt::format("; the test sweeps +-{:g} {} (the configuration's study.{}): give a smaller amplitude there",
+                     linear ? t.amplitude : rad2deg(t.amplitude), linear ? "m" : "deg",
+                     linear ? "linear_amplitude" : "angular_amplitude_deg");
 }
 
 }  // namespace
@@ -349,9 +336,9 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const Vect
   for (const ReportedTest& t : tests) {
     SimulationIssue issue;
     if (const Status s = check_trajectory(rig, t.trajectory, issue); s != Status::Ok)
-      throw ExitError(kExitOutOfLimit,
-                      fmt::format("{}: {}; nothing was simulated", where(t, issue),
-                                  is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+      throw ExitError(kExitOutOfLimit, fmt::format("{}: {}; nothing was simulated{}", where(t, issue),
+                                                   is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s)),
+                                                   amplitude_hint(t, s)));
   }
   std::size_t total = 0;
   for (const ReportedTest& t : tests) total += 3 * t.trajectory.poses.size();
@@ -392,7 +379,8 @@ void simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<Rep
   const std::string preamble = after_simulation ? after_simulation(tests) : std::string();
   write_report(rig, o, tests, files);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::string out = fmt::format("hexatwist {} on {}: {}\n", o.command, o.config_source, rig.model().spec().name);
+  std::string out =
+      fmt::format("hexatwist {} on {}: {}{}\n", o.command, o.config_source, rig.model().spec().name, o.defaults);
   out += preamble + "\n";
   out += summary_table(tests);
   out += report_notes(rig, tests);
@@ -415,7 +403,7 @@ std::string summary_table(const std::vector<ReportedTest>& tests) {
   for (const Strategy strategy : {Strategy::Conventional, Strategy::Compensated}) {
     const auto measured = [strategy](const ReportedTest& t) { return t.measured && t.measured->strategy == strategy; };
     if (std::none_of(tests.begin(), tests.end(), measured)) continue;
-    s += fmt::format("{:<13} {:<14}", "experiment", strategy_name(strategy));
+    s += fmt::format("{:<13} {:<14}", "experiment", to_string(strategy));
     for (const ReportedTest& t : tests)
       s += fmt::format(" {:>10}", measured(t) ? mm(t.measured->measurement.error.max) : std::string());
     s += "\n";
@@ -442,6 +430,7 @@ ReportedTest reported_test(const StudyTest& test) {
       fmt::format("{}, +-{:g} {}", test.description, test.coordinate < 3 ? test.amplitude : rad2deg(test.amplitude),
                   test.coordinate < 3 ? "m" : "deg");
   t.coordinate = test.coordinate;
+  t.amplitude = test.amplitude;
   return t;
 }
 

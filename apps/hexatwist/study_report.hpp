@@ -29,6 +29,7 @@ struct ReportedTest {
   std::string label;        ///< how messages name it: "Lz", or the trajectory file
   std::string description;  ///< "translation along z", or the trajectory file
   int coordinate = -1;      ///< swept pose coordinate 0..5; -1 = a user trajectory (plotted against time)
+  double amplitude = 0.0;   ///< the sweep's amplitude [m or rad] (a study test)
   Trajectory trajectory;
   TestRun run;
   std::optional<ReportedMeasurement> measured;  ///< with `measure`: the experiment
@@ -49,6 +50,7 @@ struct ReportOptions {
   std::string out_dir;                           ///< created if missing
   std::string command;                           ///< "study", "simulate" or "measure", for the summary
   std::string config_source;                     ///< where the configuration came from
+  std::string defaults;                          ///< defaults_note of the configuration
   bool figures = true;                           ///< draw PNG + SVG figures with gnuplot
   bool csv = true;                               ///< write the per-tick CSVs
   Vector6d temperature_rise = Vector6d::Zero();  ///< the legs' warm-up over each test, for the effects' costs [K]

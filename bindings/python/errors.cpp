@@ -89,8 +89,7 @@ py::array_t<double> new_rows(std::size_t n, std::size_t cols, bool single) {
 }
 
 Strategy strategy_from(const std::string& name) {
-  if (name == "compensated") return Strategy::Compensated;
-  if (name == "conventional") return Strategy::Conventional;
+  if (Strategy s; parse_strategy(name, s)) return s;
   raise_input("strategy: expected 'compensated' or 'conventional', got '" + name + "'");
 }
 

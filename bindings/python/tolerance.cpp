@@ -92,7 +92,7 @@ CalibrationChoice choice_of(const std::string& calibration, const py::object& tr
   CalibrationChoice c;
   c.name = calibration;
   if (tracker.is_none()) return c;
-  if (calibration.rfind("stations:", 0) != 0 && calibration != "plan")
+  if (!is_tracker_calibration(calibration))
     raise_input(
         "tracker: only with a tracker calibration (calibration=\"stations:N[,SEED]\" or \"plan\"), not with "
         "calibration=\"" +

@@ -405,6 +405,8 @@ Status calibrated_linear(const Model& nominal, const std::vector<Pose>& poses, c
 
 // ---------------------------------------------------------------------------------------------
 
+bool is_tracker_calibration(std::string_view name) noexcept { return name == "plan" || name.starts_with("stations:"); }
+
 namespace {
 
 // The plan a choice names; empty for none and perfect.

@@ -437,7 +437,7 @@ Config load_config(std::string_view yaml_text, std::string_view source) {
   ConfigSpec spec;
   spec.rig.model = parse(yaml_text, source, locs, spec);
   try {
-    Config config{Rig(spec.rig), spec.study};
+    Config config{Rig(spec.rig), spec.study, spec.defaulted};
     check_study(spec.study, config.rig.control_period());
     return config;
   } catch (const Error& e) {

@@ -167,6 +167,8 @@ void read_sections(const Reader& r, const Field& top, Locations& locs, ConfigSpe
   sections.mechanism(out.rig.mechanism);
   sections.simulation(out.rig.simulation);
   sections.study(out.study);
+  for (const char* name : {"servo", "load", "mechanism"})
+    if (!Reader::child(top, name).present()) out.defaulted.emplace_back(name);
 }
 
 }  // namespace hexatwist::config_detail

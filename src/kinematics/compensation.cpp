@@ -222,4 +222,17 @@ Status detail::commands_through_state(const Model& model, const Pose& pose, bool
   return Status::Ok;
 }
 
+std::string_view to_string(Strategy strategy) noexcept {
+  return strategy == Strategy::Conventional ? "conventional" : "compensated";
+}
+
+bool parse_strategy(std::string_view name, Strategy& out) noexcept {
+  for (const Strategy s : {Strategy::Conventional, Strategy::Compensated})
+    if (name == to_string(s)) {
+      out = s;
+      return true;
+    }
+  return false;
+}
+
 }  // namespace hexatwist

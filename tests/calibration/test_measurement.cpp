@@ -146,7 +146,7 @@ TEST(Measurement, CalibrationMovesVisitEachStationThenTheTestFollows) {
 Config ideal_screws() {
   ConfigSpec spec = parse_config_spec(seed_config_yaml(), "seed.yaml");
   spec.rig.mechanism.efficiency = spec.rig.mechanism.back_efficiency = 1.0;
-  return Config{Rig(spec.rig), spec.study};
+  return Config{Rig(spec.rig), spec.study, spec.defaulted};
 }
 
 struct ShortRun {

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Runs every `$ hexatwist ...` example of README.md and compares its output, digit for digit.
+"""Runs every `$ hexatwist ...` example of README.md and of the user guide (docs/guide/*.md) and
+compares its output, digit for digit.
 
 An example is a fenced block (```) whose first line starts with "$ ". Each "$ " line is run with
 bash (stdout and stderr merged, as a terminal shows them) in one scratch folder per block, in
@@ -19,7 +20,8 @@ putting
     <!-- readme-example: skip -->
 on the line just before its opening fence (or before its setup lines).
 
-Usage: readme_examples.py README.md path/to/hexatwist [--keep]
+Usage: readme_examples.py FILE.md [FILE.md ...] path/to/hexatwist [--keep]
+(examples/ and configs/ are those of the repository holding the first file.)
 """
 import os
 import re
@@ -76,11 +78,37 @@ def matches(expected, actual):
     return re.fullmatch(pattern, actual) is not None
 
 
+def repository_root(path):
+    """The nearest folder above `path` that holds examples/ and configs/."""
+    folder = os.path.dirname(os.path.abspath(path))
+    while not all(os.path.isdir(os.path.join(folder, d)) for d in ("examples", "configs")):
+        parent = os.path.dirname(folder)
+        if parent == folder:
+            sys.exit(f"{path}: no repository (examples/ and configs/) above it")
+        folder = parent
+    return folder
+
+
 def main():
-    readme_path, cli = sys.argv[1], os.path.abspath(sys.argv[2])
-    root = os.path.dirname(os.path.abspath(readme_path))
-    with open(readme_path, encoding="utf-8") as f:
-        readme = f.read()
+    args = [a for a in sys.argv[1:] if a != "--keep"]
+    if len(args) < 2:
+        sys.exit(__doc__)
+    paths, cli = args[:-1], os.path.abspath(args[-1])
+    root = repository_root(paths[0])
+    failures = checked = 0
+    for path in paths:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+        name = os.path.relpath(path, root)
+        file_failures, file_checked = check_file(name, text, root, cli)
+        failures += file_failures
+        checked += file_checked
+    print(f"{checked} examples run in {len(paths)} files, {failures} differ")
+    return 1 if failures else 0
+
+
+def check_file(name, readme, root, cli):
+    """Runs the examples of one file; returns (failures, examples run)."""
     failures = 0
     checked = 0
     for line_no, setup, steps in blocks(readme):
@@ -97,7 +125,7 @@ def main():
                                       stderr=subprocess.STDOUT, text=True, timeout=600)
                 if made.returncode != 0:
                     failures += 1
-                    print(f"README.md:{line_no}: setup failed: {command}\n{made.stdout}")
+                    print(f"{name}:{line_no}: setup failed: {command}\n{made.stdout}")
             for command, expected in steps:
                 checked += 1
                 errors_only = bool(expected) and all(e.startswith("hexatwist: ") for e in expected)
@@ -109,17 +137,16 @@ def main():
                 ok = len(actual) == len(expected) and all(matches(e, a) for e, a in zip(expected, actual))
                 if not ok:
                     failures += 1
-                    print(f"README.md:{line_no}: $ {command}")
+                    print(f"{name}:{line_no}: $ {command}")
                     for k in range(max(len(expected), len(actual))):
                         e = expected[k] if k < len(expected) else "<none>"
                         a = actual[k] if k < len(actual) else "<none>"
                         if e == "<none>" or a == "<none>" or not matches(e, a):
-                            print(f"  line {k + 1}:\n    README: {e}\n    actual: {a}")
+                            print(f"  line {k + 1}:\n    shown:  {e}\n    actual: {a}")
         finally:
             if "--keep" not in sys.argv:
                 shutil.rmtree(scratch, ignore_errors=True)
-    print(f"{checked} README examples run, {failures} differ")
-    return 1 if failures else 0
+    return failures, checked
 
 
 if __name__ == "__main__":

@@ -1,4 +1,8 @@
 // hexatwist synth, measure and identify: the experiment and the identification, end to end.
+#include <fmt/format.h>
+
+#include <regex>
+
 #include "cli_support.hpp"
 
 using namespace hexatwist::cli_test;
@@ -217,6 +221,26 @@ TEST(CliMeasure, TheShippedExampleRecoversItsTruth) {
 }
 
 // ---- identify -----------------------------------------------------------------------------------
+
+TEST(CliIdentify, TheAccuracyMapIsAColourScaleOfEachPlaneWithTheRealignedFigures) {
+  // The shipped stations log (synth --stations 40 --station-seed 4): the map beside the configuration,
+  // each plane its own continuous scale (a colour bar, not bands), the frames said in plain words.
+  const std::string dir = std::string(HEXATWIST_SOURCE_DIR) + "/examples/";
+  const std::filesystem::path yaml = temp_dir() / "mapped.yaml";
+  const Outcome r = run({"identify", "--points", dir + "tracker_stations.csv", "--stations", "40", "--station-seed",
+                         "4", "--out", yaml.string(), "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const YAML::Node acc = json(r)["accuracy"];
+  const std::string svg = read_file(temp_dir() / "mapped_accuracy.svg");
+  ASSERT_FALSE(svg.empty());
+  EXPECT_GT(std::filesystem::file_size(temp_dir() / "mapped_accuracy.png"), 10000u);
+  for (const char* part : {"x-y plane at z = ", "x-z plane at y = ", "the range's centre",
+                           "predicted error of point A [um]", "frames fitted to the six joints", "rigid re-alignment"})
+    EXPECT_NE(svg.find(part), std::string::npos) << part;
+  EXPECT_FALSE(std::regex_search(svg, std::regex(R"(\d-\d+(\.\d+)? um<)"))) << "a band's legend entry";
+  // The re-aligned figures of the title are the report's.
+  EXPECT_NE(svg.find(fmt::format("median {:.1f} um", 1e6 * acc["aligned_median"].as<double>())), std::string::npos);
+}
 
 // synth of a stations run of a platform with every error identify estimates (issue 21: joint centres
 // off by up to 1 mm, a 2.5 % longer lead, the other thread hand, offsets, the point, a tracker

@@ -52,6 +52,34 @@ TEST(Cli, IkTextOutputHasOneRowPerLeg) {
   EXPECT_NE(r.out.find("status: ok"), std::string::npos);
 }
 
+TEST(Cli, AHeaderSaysWhichSectionsAreTheSeedsDefaults) {
+  // A configuration of the geometry alone: each report's first line says its drives and load are the
+  // seed's; the seed's own file (every section given) says nothing.
+  const std::string geometry = write_file("geometry-only.yaml", hexatwist::test::kSymmetricYaml);
+  const std::string with_load =
+      write_file("with-load.yaml", hexatwist::test::kSymmetricYaml + "load: {mass: 900}\nmechanism: {}\n");
+  const std::string note = "(servo, load and mechanism: the seed's defaults, not in the file)";
+  const auto first_line = [](const Outcome& r) { return r.out.substr(0, r.out.find('\n')); };
+  for (const std::vector<std::string>& command :
+       {std::vector<std::string>{"ik", "--pose=0,0,0.1,0,0,10"},
+        {"fk", "--lengths=1.8,1.8,1.8,1.8,1.8,1.8"},
+        {"stations", "--count", "14", "--out", (temp_dir() / "notes-run.csv").string()}}) {
+    std::vector<std::string> args = command;
+    args.insert(args.end(), {"--config", geometry});
+    const Outcome r = run(args);
+    ASSERT_EQ(r.code, 0) << command[0] << ": " << r.err;
+    EXPECT_NE(first_line(r).find(note), std::string::npos) << first_line(r);
+    args.back() = with_load;
+    const Outcome l = run(args);
+    ASSERT_EQ(l.code, 0) << l.err;
+    EXPECT_NE(first_line(l).find("(servo: the seed's defaults, not in the file)"), std::string::npos) << first_line(l);
+    args.back() = HEXATWIST_SOURCE_DIR "/configs/seed.yaml";
+    const Outcome s = run(args);
+    ASSERT_EQ(s.code, 0) << s.err;
+    EXPECT_EQ(s.out.find("defaults"), std::string::npos) << first_line(s);
+  }
+}
+
 TEST(Cli, NegativeNumbersWorkWithAndWithoutEquals) {
   const Outcome eq = run({"ik", "--pose=-0.1,0,0,0,0,-5", "--json"});
   const Outcome space = run({"ik", "--pose", "-0.1,0,0,0,0,-5", "--json"});

@@ -78,9 +78,24 @@ TEST(Cli, StudyRunsTheChosenTestsAndRefusesUnknownOnes) {
       write_file("weak.yaml", std::string(hexatwist::test::kSymmetricYaml) +
                                   "servo:\n  torque_limit: 3\n  peak_torque_at_max_speed: 2\n  continuous_torque: 2\n");
   // 4.92 N m for the platform, the rest for the legs' own weight.
+  const Outcome held = run({"study", "--config", weak, "--out", out.string()});
   expect_error(
-      run({"study", "--config", weak, "--out", out.string()}), 3,
+      held, 3,
       {"Lz: t = 0.000 s", "leg 1", "holding the load takes 5.2", "servo.torque_limit", "nothing was simulated"});
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // A small machine: the default sweeps leave its stroke, and the message names the key that sets them
+  // (not for the motor's limits above, which the amplitude does not cause).
+  EXPECT_EQ(held.err.find("amplitude"), std::string::npos) << held.err;
+  const std::string small = write_file("small.yaml",
+                                       "symmetric: {Ra: 0.12, Rb: 0.15, da: 0.02, db: 0.03, H: 0.15}\n"
+                                       "screw: {lead: 0.002, thread: right, driven_side: base}\n"
+                                       "limits: {length_min: 0.12, length_max: 0.22, bend_max_deg: 40, "
+                                       "singularity_margin_deg: 5}\n");
+  expect_error(run({"study", "--config", small, "--tests", "Rz", "--out", out.string()}), 3,
+               {"Rz: t = ", "limits.length_max", "nothing was simulated", "+-30 deg", "study.angular_amplitude_deg",
+                "smaller amplitude"});
+  expect_error(run({"study", "--config", small, "--tests", "Lx", "--out", out.string()}), 3,
+               {"Lx: t = ", "+-0.5 m", "study.linear_amplitude"});
   EXPECT_FALSE(std::filesystem::exists(out));
   const std::string file = write_file("blocked", "a file, not a folder");
   expect_error(run({"study", "--tests", "Rz", "--no-figures", "--out", file}), 4, {"--out", file});

@@ -217,6 +217,26 @@ TEST(ToleranceCalibration, BadInputsAreRefusedNamingTheField) {
   }
 }
 
+TEST(ToleranceCalibration, TheTrackerCalibrationsAreTheOnesPrepareGivesATrackerStep) {
+  // The front ends decide from is_tracker_calibration whether the tracker's options apply; the study
+  // prepares a tracker step (its linear answer from the identification's covariance) for exactly those.
+  const std::vector<Pose> poses = workspace(0);
+  for (const char* name : {"none", "perfect", "stations:20", "stations:20,3", "plan"}) {
+    SCOPED_TRACE(name);
+    CalibrationChoice choice;
+    choice.name = name;
+    if (choice.name == "plan") choice.plan = random_station_plan(test::seed_model(), StationsSpec{.count = 20});
+    ToleranceOptions o;
+    ToleranceLinear l;
+    ASSERT_EQ(prepare_calibration(test::seed_model(), poses, choice, o, l), Status::Ok);
+    const bool tracker = std::string_view(name).starts_with("stations:") || choice.name == "plan";
+    EXPECT_EQ(is_tracker_calibration(name), tracker);
+    EXPECT_EQ(o.calibration != nullptr, choice.name != "none");
+  }
+  for (const char* name : {"Stations:4", "plan ", "stations", "tracker", ""})
+    EXPECT_FALSE(is_tracker_calibration(name));
+}
+
 TEST(ToleranceCalibration, APlanOfTooFewStationsIsNotIdentifiableNotACrash) {
   // 5 and 13 stations give fewer equations than the geometric model (with every axis) has
   // parameters: the plan's Jacobian is wide, and the study says NotIdentifiable; 14 determine it.

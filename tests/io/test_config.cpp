@@ -519,6 +519,17 @@ std::string config_error(const std::string& yaml) {
   return "";
 }
 
+TEST(Config, TheSectionsLeftToTheSeedsDefaultsAreNamed) {
+  // kRigSections gives servo and load; the mechanism is left out, as the geometry alone leaves all three.
+  EXPECT_EQ(load_config(test::kSymmetricYaml + kRigSections, "rig.yaml").defaulted,
+            std::vector<std::string>{"mechanism"});
+  EXPECT_EQ(load_config(test::kSymmetricYaml, "geometry.yaml").defaulted,
+            (std::vector<std::string>{"servo", "load", "mechanism"}));
+  EXPECT_TRUE(default_config().defaulted.empty());  // the seed gives every section
+  EXPECT_EQ(parse_config_spec(test::kSymmetricYaml + "load: {mass: 10}\n", "l.yaml").defaulted,
+            (std::vector<std::string>{"servo", "mechanism"}));
+}
+
 TEST(Config, RigSectionsReachTheRigInSiUnits) {
   const Config c = load_config(test::kSymmetricYaml + kRigSections, "rig.yaml");
   EXPECT_NEAR(c.rig.servo().max_speed, 1500 * 2 * kPi / 60, 1e-12);

@@ -350,5 +350,20 @@ TEST(Compensation, CompensatedCommandIsCheckedAgainstTheStrokeToo) {
   EXPECT_EQ(compute_commands(tight, p, rep), Status::StrokeBelowMin);
 }
 
+TEST(Compensation, EachStrategyHasOneNameThatParsesBack) {
+  for (const Strategy s : {Strategy::Conventional, Strategy::Compensated}) {
+    Strategy back = s == Strategy::Conventional ? Strategy::Compensated : Strategy::Conventional;
+    EXPECT_TRUE(parse_strategy(to_string(s), back)) << to_string(s);
+    EXPECT_EQ(back, s);
+  }
+  EXPECT_EQ(to_string(Strategy::Compensated), "compensated");
+  EXPECT_EQ(to_string(Strategy::Conventional), "conventional");
+  Strategy kept = Strategy::Conventional;
+  for (const char* bad : {"Compensated", "compensated ", "comp", "", "conventional\n"}) {
+    EXPECT_FALSE(parse_strategy(bad, kept)) << bad;
+    EXPECT_EQ(kept, Strategy::Conventional);
+  }
+}
+
 }  // namespace
 }  // namespace hexatwist::test

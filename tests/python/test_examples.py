@@ -33,12 +33,12 @@ def run_pair(number, tmp_path):
     binary = os.path.join(BUILD, "examples", f"example_{name}")
     if not os.path.exists(binary):
         pytest.skip(f"{binary} not built")
-    cpp_args = [os.path.join(SOURCE, "examples")] if number in ("06", "07") else []
     with open(py) as f:
         py_args = [str(tmp_path)] if "[out_dir]" in f.read() else []
-    c = subprocess.run([binary, *cpp_args], capture_output=True, text=True, timeout=240)
+    # Both run as a user would from a folder of their own: the data files are found without an argument.
+    c = subprocess.run([binary], capture_output=True, text=True, timeout=240, cwd=tmp_path)
     p = subprocess.run([sys.executable, py, *py_args], capture_output=True, text=True, timeout=240,
-                       env=dict(os.environ, MPLBACKEND="Agg"))
+                       env=dict(os.environ, MPLBACKEND="Agg"), cwd=tmp_path)
     assert c.returncode == 0 and p.returncode == 0, c.stderr + p.stderr
     return c.stdout.splitlines(), p.stdout.splitlines()
 
@@ -47,6 +47,17 @@ def run_pair(number, tmp_path):
 def test_the_pair_prints_the_same_lines(number, tmp_path):
     cpp, py = run_pair(number, tmp_path)
     assert len(cpp) >= 2 and py[:len(cpp)] == cpp, "\n".join(["C++:", *cpp, "Python:", *py])
+
+
+@pytest.mark.parametrize("name", ["06_identify", "07_motor_sizing"])
+def test_a_missing_data_folder_is_one_line_naming_the_file(name, tmp_path):
+    binary = os.path.join(BUILD, "examples", f"example_{name}")
+    if not os.path.exists(binary):
+        pytest.skip(f"{binary} not built")
+    r = subprocess.run([binary, str(tmp_path / "nowhere")], capture_output=True, text=True, timeout=60)
+    lines = r.stderr.splitlines()
+    assert r.returncode == 1 and len(lines) == 1, r.stderr
+    assert lines[0].startswith(f"example_{name}: {tmp_path / 'nowhere'}/") and "No such file" in lines[0], lines[0]
 
 
 def test_the_realtime_loops_send_the_same_commands(tmp_path):

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "hexatwist/calibration/identification.hpp"
@@ -130,6 +131,10 @@ struct CalibrationChoice {
   int points = 50;  ///< points per station; one: the identification is given the tracker's noise (no scatter)
   CalibratedFrames frames = CalibratedFrames::Tracker;
 };
+
+/// Whether the calibration `name` is a tracker's (stations:N[,SEED] or plan: each platform identified
+/// from simulated tracker points, its errors small enough to report in um), as prepare_calibration reads it.
+bool is_tracker_calibration(std::string_view name) noexcept;
 
 /// Prepares a study for `choice`: options.calibration (empty for none), and the linear model for
 /// its summary and max_point_linear: tolerance_linear, or after a tracker calibration (seeded with

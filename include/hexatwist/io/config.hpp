@@ -3,6 +3,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "hexatwist/dynamics/rig.hpp"
 #include "hexatwist/simulation/study.hpp"
@@ -28,6 +29,9 @@ Model default_model();
 struct ConfigSpec {
   RigSpec rig;
   StudySpec study;
+  /// The sections of the drives and the load the text leaves out, in the order servo, load,
+  /// mechanism: their values are the seed's defaults (a report says so beside the platform's name).
+  std::vector<std::string> defaulted;
 };
 
 /// Parses a whole configuration (errors as parse_model_spec).
@@ -37,6 +41,7 @@ ConfigSpec parse_config_spec(std::string_view yaml_text, std::string_view source
 struct Config {
   Rig rig;
   StudySpec study;
+  std::vector<std::string> defaulted;  ///< as ConfigSpec::defaulted
 };
 
 /// parse_config_spec followed by validation of the rig and the study (errors located in the text).

@@ -2,6 +2,8 @@
 // (Eq. 11-12): what the servo must reach on the motor side.
 #pragma once
 
+#include <string_view>
+
 #include "hexatwist/kinematics/leg_effects.hpp"
 #include "hexatwist/kinematics/limits.hpp"
 #include "hexatwist/kinematics/twist.hpp"
@@ -15,6 +17,13 @@ enum class Strategy {
   /// where the model has them (leg_effects.hpp: deflection, thermal expansion, play)
   Compensated,
 };
+
+/// The strategy's name, as the command line, Python and JSON write it: "conventional" or "compensated".
+std::string_view to_string(Strategy strategy) noexcept;
+
+/// The strategy `name` names ("conventional" or "compensated") into `out`; false, `out` unchanged,
+/// for any other text.
+[[nodiscard]] bool parse_strategy(std::string_view name, Strategy& out) noexcept;
 
 /// Length error of each leg caused by its twist, Eq. (10) with the configured sign:
 /// real length - motor-side length = twist_gain_i * dtheta_i [m].
