@@ -218,6 +218,13 @@ void OutputFiles::output(std::string_view option, const std::string& path) {
       throw ExitError(kExitBadInput, fmt::format("{} and {} both name '{}': one run's outputs never overwrite each "
                                                  "other; nothing was written",
                                                  o.option, option, printable(path)));
+  // Its folder must be there before the run computes anything (a file's folder is never created).
+  const fs::path parent = fs::path(path).parent_path();
+  const fs::path dir = parent.empty() ? fs::path(".") : parent;
+  if (const fs::file_status st = fs::status(dir, ec); !fs::is_directory(st))
+    throw ExitError(kExitOutputFailed,
+                    fmt::format("{} '{}': the folder '{}' {}; nothing was written", option, printable(path),
+                                printable(dir.string()), fs::exists(st) ? "is not a folder" : "does not exist"));
   outputs_.push_back({std::string(option), path});
 }
 

@@ -216,6 +216,30 @@ TEST(CliOutputs, AFolderGivenAsAFileOutputIsRefusedNamingTheOption) {
   expect_error(run({"simulate", "--trajectory", write_file("f.csv", heave_csv()), "--out", ""}), 2, {"--out"});
 }
 
+TEST(CliOutputs, AFileOutputInAFolderThatIsNotThereIsRefusedBeforeTheRun) {
+  // Every command that writes named files: refused at once (not after the identification or the
+  // synthesis), naming the option, the file and the folder; nothing appears.
+  const std::string missing = (temp_dir() / "no-such-folder").string();
+  const std::string a_file = write_file("plain-file", "x");
+  const std::string log = HEXATWIST_SOURCE_DIR "/examples/tracker_stations.csv";
+  for (const std::vector<std::string>& command :
+       {std::vector<std::string>{"identify", "--points", log, "--stations", "40", "--station-seed", "4", "--out"},
+        {"synth", "--stations", "14", "--out"},
+        {"stations", "--count", "14", "--out"},
+        {"mjcf", "--out"},
+        {"linuxcnc", "--out"},
+        {"design", "--out"}}) {
+    for (const std::string& folder : {missing, a_file}) {
+      std::vector<std::string> args = command;
+      args.push_back(folder + "/out.file");
+      expect_error(
+          run(args), 4,
+          {"--out", "out.file", folder == missing ? "does not exist" : "is not a folder", "nothing was written"});
+    }
+  }
+  EXPECT_FALSE(std::filesystem::exists(missing));
+}
+
 TEST(CliOutputs, AFolderReusedByAnotherCommandHoldsOnlyThatRunsFilesAndSaysSo) {
   const std::string csv = write_file("h2.csv", heave_csv());
   const fs::path out = temp_dir() / "H2";
