@@ -62,6 +62,27 @@ std::string defaults_note(const Config& config) {
   return fmt::format(" ({}: the seed's defaults, not in the file)", names);
 }
 
+std::vector<Vector3d> targets_option(const std::string& text, const char* option) {
+  std::vector<Vector3d> out;
+  if (text.empty()) return out;
+  for (std::size_t begin = 0;;) {
+    const std::size_t semi = text.find(';', begin);
+    const std::vector<double> t =
+        parse_numbers(text.substr(begin, semi == std::string::npos ? std::string::npos : semi - begin), 3, option,
+                      "x,y,z [mm, platform] of each target, ';' between targets");
+    for (const double v : t) check_option(std::abs(v) < 1e4, option, v, "coordinates below 10 m in magnitude [mm]");
+    out.emplace_back(t[0] / 1e3, t[1] / 1e3, t[2] / 1e3);
+    if (semi == std::string::npos) break;
+    begin = semi + 1;
+  }
+  if (out.size() + 1 > kMaxTargets)
+    throw ExitError(kExitBadInput, fmt::format("{}: {} targets with the observation point, at most {}", option,
+                                               out.size() + 1, kMaxTargets));
+  return out;
+}
+
+std::string counted(std::size_t n, std::string_view noun) { return fmt::format("{} {}{}", n, noun, n == 1 ? "" : "s"); }
+
 Strategy strategy_option(const std::string& text, const char* option) {
   if (Strategy s; parse_strategy(text, s)) return s;
   throw ExitError(kExitBadInput,

@@ -51,6 +51,14 @@ void add_model_options(CLI::App& app, ModelOptions& opts);
 /// load, else " (servo, load: the seed's defaults, not in the file)" naming the sections it leaves out.
 std::string defaults_note(const Config& config);
 
+/// More targets on the platform besides the observation point, "x,y,z;x,y,z" [mm, P] as `option`
+/// takes them (empty: none), in metres; ExitError(2) naming the option for a malformed list, a
+/// coordinate of 10 m or more, or more than kMaxTargets targets with the observation point.
+std::vector<Vector3d> targets_option(const std::string& text, const char* option = "--targets-mm");
+
+/// "1 file", "2 files": a count and its noun (plural by an added s).
+std::string counted(std::size_t n, std::string_view noun);
+
 /// The strategy `text` names (parse_strategy); ExitError(2) naming `option` for any other text.
 Strategy strategy_option(const std::string& text, const char* option = "--strategy");
 

@@ -271,7 +271,7 @@ int run_dynamics(const DynamicsOptions& o) {
 
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::string text = table(config, o, traj, sizing);
-  text += fmt::format("\n{} files written to {} in {:.1f} s\n", files.paths().size(), o.out, wall);
+  text += fmt::format("\n{} written to {} in {:.1f} s\n", counted(files.paths().size(), "file"), o.out, wall);
   files.finish(text);
   // A motor outside its envelope is the run's finding: the report is complete and kept.
   if (sizing.violation.check != EnvelopeCheck::None)

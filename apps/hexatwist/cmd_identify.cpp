@@ -226,36 +226,30 @@ std::string text_report(const Report& r) {
   return t;
 }
 
-// A number, or null where there is none.
-void json_number(JsonWriter& w, std::string_view key, double v, bool known) {
-  w.key(key);
-  known&& std::isfinite(v) ? w.value(v) : w.null();
-}
-
 // The fit, its tests and the solves of both thread senses.
 void json_fit(JsonWriter& j, const Report& r) {
   const Identification& id = r.id;
-  json_number(j, "rms_before", id.rms_before, true);
-  json_number(j, "rms_after", id.rms_after, id.fitted);
-  json_number(j, "max_after", id.max_after, id.fitted);
+  j.number_or_null("rms_before", id.rms_before, true);
+  j.number_or_null("rms_after", id.rms_after, id.fitted);
+  j.number_or_null("max_after", id.max_after, id.fitted);
   j.key("max_after_line");
   id.fitted&& id.max_after_index >= 0 ? j.value(r.line_of(static_cast<std::size_t>(id.max_after_index))) : j.null();
-  json_number(j, "sigma", id.sigma, id.fitted);
-  json_number(j, "tracker_noise", id.tracker_noise, true);
-  json_number(j, "scatter", id.scatter, true);
-  json_number(j, "noise_ratio", id.sigma / id.tracker_noise, id.fitted);
-  json_number(j, "unexplained", id.unexplained, id.fitted);
+  j.number_or_null("sigma", id.sigma, id.fitted);
+  j.number_or_null("tracker_noise", id.tracker_noise, true);
+  j.number_or_null("scatter", id.scatter, true);
+  j.number_or_null("noise_ratio", id.sigma / id.tracker_noise, id.fitted);
+  j.number_or_null("unexplained", id.unexplained, id.fitted);
   j.key("diagnosis").begin_array(true);
   for (const Identification::EffectDiagnosis& d : id.diagnosis) {
     j.begin_object().field("effect", d.effect);
-    json_number(j, "z", d.z, true);
+    j.number_or_null("z", d.z, true);
     j.end_object();
   }
   j.end_array();
   j.key("fit_test").begin_object();
-  json_number(j, "statistic", id.fit_statistic, id.fitted);
+  j.number_or_null("statistic", id.fit_statistic, id.fitted);
   j.field("dof", id.fit_dof);
-  json_number(j, "z", id.fit_z, id.fitted);
+  j.number_or_null("z", id.fit_z, id.fitted);
   j.field("limit", library_options(r.o).fit_sigmas).end_object();
   j.key("worst_stations").begin_array(true);
   for (const StationResidual& w : id.worst) {
@@ -264,14 +258,14 @@ void json_fit(JsonWriter& j, const Report& r) {
     j.field("statistic", w.statistic).end_object();
   }
   j.end_array();
-  json_number(j, "condition", id.condition, true);
+  j.number_or_null("condition", id.condition, true);
   if (!id.undetermined.empty()) j.field("undetermined", id.undetermined);
-  json_number(j, "cost_ratio", id.cost_ratio, id.fitted);
-  json_number(j, "sign_separation", id.sign_separation, id.fitted);
+  j.number_or_null("cost_ratio", id.cost_ratio, id.fitted);
+  j.number_or_null("sign_separation", id.sign_separation, id.fitted);
   j.key("fits").begin_array(true);
   for (const SignFit& f : id.fits) {
     j.begin_object().field("twist_sign", f.twist_sign).field("status", describe(f.status));
-    json_number(j, "cost", f.cost, std::isfinite(f.cost));
+    j.number_or_null("cost", f.cost, std::isfinite(f.cost));
     j.field("iterations", f.iterations).field("lead_at_bound", f.lead_at_bound).end_object();
   }
   j.end_array();
@@ -287,16 +281,16 @@ void json_diagnostics(JsonWriter& j, const Identification& id) {
   j.end_array();
   const CrossValidation& cv = id.cross_validation;
   j.key("cross_validation").begin_object().field("folds", cv.folds).field("predicted", cv.predicted);
-  json_number(j, "rms", cv.rms, cv.folds > 0);
-  json_number(j, "max", cv.max, cv.folds > 0);
-  json_number(j, "expected", cv.expected, cv.folds > 0);
+  j.number_or_null("rms", cv.rms, cv.folds > 0);
+  j.number_or_null("max", cv.max, cv.folds > 0);
+  j.number_or_null("expected", cv.expected, cv.folds > 0);
   j.end_object();
   const AccuracyPrediction& acc = id.accuracy;
   j.key("accuracy").begin_object().field("poses", acc.poses);
-  json_number(j, "median", acc.median, acc.poses > 0);
-  json_number(j, "max", acc.max, acc.poses > 0);
-  json_number(j, "aligned_median", acc.aligned_median, acc.poses > 0);
-  json_number(j, "aligned_max", acc.aligned_max, acc.poses > 0);
+  j.number_or_null("median", acc.median, acc.poses > 0);
+  j.number_or_null("max", acc.max, acc.poses > 0);
+  j.number_or_null("aligned_median", acc.aligned_median, acc.poses > 0);
+  j.number_or_null("aligned_max", acc.aligned_max, acc.poses > 0);
   j.key("range_low").vector(acc.range_low);
   j.key("range_high").vector(acc.range_high);
   j.end_object();

@@ -198,24 +198,7 @@ SynthesisOptions synthesis_options(const SynthOptions& o, const Rig& rig) {
   check_option(o.axis_errors_deg >= 0.0 && o.axis_errors_deg <= 10.0, "--axis-errors-deg", o.axis_errors_deg,
                "a bound >= 0 and at most 10 [deg]");
   random_geometry_errors(rig.model(), o.joint_errors_mm / 1e3, deg2rad(o.axis_errors_deg), o.seed, so.errors);
-  if (!o.targets_mm.empty()) {
-    // "x,y,z;x,y,z" [mm, P]: more targets besides the observation point.
-    std::size_t begin = 0;
-    for (;;) {
-      const std::size_t semi = o.targets_mm.find(';', begin);
-      const std::vector<double> t =
-          parse_numbers(o.targets_mm.substr(begin, semi == std::string::npos ? std::string::npos : semi - begin), 3,
-                        "--targets-mm", "x,y,z [mm, platform] of each target, ';' between targets");
-      for (const double v : t)
-        check_option(std::abs(v) < 1e4, "--targets-mm", v, "coordinates below 10 m in magnitude [mm]");
-      so.extra_targets_P.emplace_back(t[0] / 1e3, t[1] / 1e3, t[2] / 1e3);
-      if (semi == std::string::npos) break;
-      begin = semi + 1;
-    }
-    if (so.extra_targets_P.size() + 1 > kMaxTargets)
-      throw ExitError(kExitBadInput, fmt::format("--targets-mm: {} targets with the observation point, at most {}",
-                                                 so.extra_targets_P.size() + 1, kMaxTargets));
-  }
+  so.extra_targets_P = targets_option(o.targets_mm);
 
   // The real legs' effects (theory §4b): stiffness, play, warming and expansion.
   if (!o.stiffness_n_per_um.empty())

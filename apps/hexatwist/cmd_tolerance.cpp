@@ -42,6 +42,8 @@ struct ToleranceCommandOptions {
   double tracker_noise_um = 10.0;
   int points_per_station = 50;
   std::string calibration_frames = "tracker";
+  std::string targets_mm;
+  int target_layouts = 0;
   std::string station_plan;
   std::string out = "tolerance-out";
   std::string scheduler;
@@ -87,6 +89,7 @@ CalibrationChoice calibration_of(const ToleranceCommandOptions& o) {
                o.points_per_station, fmt::format("1 to {} points", kMaxPointsPerStation));
   c.points = o.points_per_station;
   c.frames = o.calibration_frames == "joints" ? CalibratedFrames::Joints : CalibratedFrames::Tracker;
+  c.extra_targets_P = targets_option(o.targets_mm);
   if (!o.station_plan.empty()) {
     if (o.calibration != "none" && o.calibration != "plan")
       throw ExitError(kExitBadInput, fmt::format("--station-plan: a plan is its own calibration; --calibration is "
@@ -123,6 +126,11 @@ void tracker_json(JsonWriter& j, const ToleranceCommandOptions& o, const Calibra
       for (int k = 0; k < 6; ++k) j.value(q[k]);
       j.end_array();
     }
+    j.end_array();
+  }
+  if (!c.extra_targets_P.empty()) {  // besides point A [m, P]
+    j.key("targets").begin_array();
+    for (const Vector3d& t : c.extra_targets_P) j.vector(t);
     j.end_array();
   }
   j.end_object();
@@ -182,9 +190,34 @@ void quantiles_json(JsonWriter& j, const ErrorQuantiles& q) {
   j.begin_object().field("median", q.median).field("p95", q.p95).field("max", q.max).end_object();
 }
 
+// The layouts of targets compared (--target-layouts): null without.
+void layouts_json(JsonWriter& j, const std::vector<TargetLayout>& layouts) {
+  if (layouts.empty()) {
+    j.null();
+    return;
+  }
+  j.begin_array();
+  for (const TargetLayout& l : layouts) {
+    j.begin_object().key("extra_targets").begin_array();
+    for (const Vector3d& t : l.extra_targets_P) j.vector(t);
+    j.end_array();
+    j.field("status", std::string(to_string(l.status)));
+    for (const auto& [key, q] :
+         {std::pair{"point", &l.point}, {"position", &l.position}, {"orientation", &l.orientation}}) {
+      j.key(key).begin_object();
+      j.number_or_null("median", q->median, l.status == Status::Ok);
+      j.number_or_null("p95", q->p95, l.status == Status::Ok);
+      j.end_object();
+    }
+    j.end_object();
+  }
+  j.end_array();
+}
+
 std::string summary_json(const Model& model, const ToleranceCommandOptions& o, const RequiredPoses& req,
                          const ToleranceSigmas& s, const CalibrationChoice& calibration, const ToleranceSummary& sm,
-                         int workers, double seconds, const std::vector<std::string>& files) {
+                         const std::vector<TargetLayout>& layouts, int workers, double seconds,
+                         const std::vector<std::string>& files) {
   JsonWriter j;
   j.begin_document(schema::kTolerance);
   j.field("command", "tolerance");
@@ -226,7 +259,11 @@ std::string summary_json(const Model& model, const ToleranceCommandOptions& o, c
           "pooled over every (platform, pose): the point A, pivot position and orientation (rotation angle) errors of "
           "the sampled platform driven by its controller's compensated commands (after a tracker calibration: in the "
           "frames tracker.frames names); linearised: the same from the covariance of the linear model; "
-          "worst_per_platform: each platform's largest error over the poses");
+          "worst_per_platform: each platform's largest error over the poses; target_layouts (--target-layouts): "
+          "the linearised median and 95th percentile after a calibration measuring point A and the extra targets "
+          "[m, platform frame]");
+  j.key("target_layouts");
+  layouts_json(j, layouts);
   j.key("cluster");
   if (o.scheduler.empty())
     j.null();
@@ -322,9 +359,12 @@ std::string controller_text(const ToleranceCommandOptions& o, const CalibrationC
   if (c.name == "none") return "the nominal compensated commands";
   if (c.name == "perfect") return "a perfectly calibrated controller's compensated commands";
   return fmt::format(
-      "the compensated commands of each platform's controller after a tracker calibration ({}; {:g} um noise, {} "
+      "the compensated commands of each platform's controller after a tracker calibration ({}; {}{:g} um noise, {} "
       "points a station; errors in the {} frames)",
       c.name == "plan" ? fmt::format("{} stations of {}", c.plan.size(), printable(o.station_plan)) : c.name,
+      c.extra_targets_P.empty() ? std::string()
+                                : fmt::format("point A and {} more target{}, ", c.extra_targets_P.size(),
+                                              c.extra_targets_P.size() == 1 ? "" : "s"),
       1e6 * c.tracker_noise, c.points, o.calibration_frames == "joints" ? "joints' least-squares" : "tracker's");
 }
 
@@ -342,9 +382,38 @@ std::string calibration_failures(const ToleranceSummary& sm) {
                      sm.platforms, by);
 }
 
+// Where to put the targets: each layout's linearised quantiles.
+std::string layouts_text(const std::vector<TargetLayout>& layouts) {
+  if (layouts.empty()) return {};
+  std::string out =
+      "\nwhere to put the targets: each layout calibrated from the same stations (the linearised answer, 95th "
+      "percentile over the poses; the extra targets evenly spaced with point A on the circle through it about the "
+      "pivot):\n";
+  out += fmt::format("{:>7}  {:>12}  {:>10}  {:>18}  {}\n", "targets", "point A [um]", "pivot [um]",
+                     "orientation [urad]", "extra targets x,y,z [mm, platform]");
+  for (const TargetLayout& l : layouts) {
+    std::string where;
+    for (const Vector3d& t : l.extra_targets_P)
+      where += fmt::format("{}{:.1f},{:.1f},{:.1f}", where.empty() ? "" : "; ", tidy(1e3 * t.x()), tidy(1e3 * t.y()),
+                           tidy(1e3 * t.z()));
+    if (where.empty()) where = "(point A alone)";
+    if (l.status != Status::Ok)
+      out += fmt::format("{:>7}  {:>44}  {}\n", l.extra_targets_P.size() + 1,
+                         fmt::format("not determined ({})", to_string(l.status)), where);
+    else
+      out += fmt::format("{:>7}  {:>12.2f}  {:>10.2f}  {:>18.2f}  {}\n", l.extra_targets_P.size() + 1,
+                         1e6 * l.point.p95, 1e6 * l.position.p95, 1e6 * l.orientation.p95, where);
+  }
+  out +=
+      "(a tool point's error is at most the pivot's plus the orientation's times its distance from the pivot; "
+      "give a layout with --targets-mm to see its Monte Carlo)\n";
+  return out;
+}
+
 std::string report_text(const Model& model, const ToleranceCommandOptions& o, const RequiredPoses& req,
-                        const ToleranceSigmas& s, const CalibrationChoice& c, const ToleranceSummary& sm, int workers,
-                        double seconds, const std::string& defaults) {
+                        const ToleranceSigmas& s, const CalibrationChoice& c, const ToleranceSummary& sm,
+                        const std::vector<TargetLayout>& layouts, int workers, double seconds,
+                        const std::string& defaults) {
   std::string out =
       fmt::format("hexatwist tolerance on {}: {}{}\n", model_source(o.model), model.spec().name, defaults);
   out += fmt::format("required workspace: {}\n", req.description);
@@ -376,6 +445,7 @@ std::string report_text(const Model& model, const ToleranceCommandOptions& o, co
       scale * sm.worst_point.median, length, scale * sm.worst_point.p95, length, scale * sm.worst_point.max, length,
       scale * sm.worst_point_linear.median, scale * sm.worst_point_linear.p95, scale * sm.worst_point_linear.max,
       length);
+  out += layouts_text(layouts);
   return out;
 }
 
@@ -431,6 +501,10 @@ int run_tolerance(const ToleranceCommandOptions& o) {
     }
   }
   const ToleranceSummary sm = summarize_tolerance(chunk, req.poses.size(), &linear, 0);
+  const std::vector<TargetLayout> layouts =
+      o.target_layouts > 0
+          ? target_layouts(model, req.poses, to, tracker_calibration_of(model, calibration, o.seed), o.target_layouts)
+          : std::vector<TargetLayout>{};
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   const fs::path dir(o.out);
@@ -443,15 +517,16 @@ int run_tolerance(const ToleranceCommandOptions& o) {
   }
   names.push_back("summary.json");
   if (!o.no_csv) set.add((dir / "platforms.csv").string(), platforms_csv(chunk));
-  const std::string json = summary_json(model, o, req, sigmas, calibration, sm, workers, seconds, names);
+  const std::string json = summary_json(model, o, req, sigmas, calibration, sm, layouts, workers, seconds, names);
   set.add((dir / "summary.json").string(), json);
   set.stage();
   for (Figure& f : figs) f.stem = set.external(f.stem, {".png", ".svg"});
   if (!figs.empty()) write_figures(figs);
   set.commit();
   std::string text =
-      o.json ? json : report_text(model, o, req, sigmas, calibration, sm, workers, seconds, defaults_note(config));
-  if (!o.json) text += fmt::format("\n{} files written to {}\n", set.paths().size(), o.out);
+      o.json ? json
+             : report_text(model, o, req, sigmas, calibration, sm, layouts, workers, seconds, defaults_note(config));
+  if (!o.json) text += fmt::format("\n{} written to {}\n", counted(set.paths().size(), "file"), o.out);
   set.finish(text);
   return kExitOk;
 }
@@ -511,6 +586,16 @@ Command make_tolerance_command(CLI::App& root) {
                   "joints (the least-squares frames of the real joints, the identification's gauge)")
       ->check(CLI::IsMember({"tracker", "joints"}))
       ->capture_default_str();
+  app->add_option("--targets-mm", o->targets_mm,
+                  "The calibration's tracker: more targets on the platform besides point A, measured at every "
+                  "station, \"x,y,z;x,y,z\" [mm, platform frame] (synth's option): with them the pivot and the "
+                  "orientation calibrate as point A does");
+  app->add_option("--target-layouts", o->target_layouts,
+                  "Also compare layouts of 1 to 1+N targets (point A and N more evenly on the circle through it about "
+                  "the pivot) calibrated from the same stations: the linearised point A, pivot and orientation errors "
+                  "of each, to choose where to put the targets; 0 = none")
+      ->check(CLI::Range(0, kMaxLayoutTargets))
+      ->capture_default_str();
   app->add_option("--out", o->out, "Output folder (created if missing), written as a set: all files or none (exit 4)")
       ->capture_default_str();
   app->add_flag("--json", o->json, "Print summary.json instead of the text report");
@@ -520,7 +605,8 @@ Command make_tolerance_command(CLI::App& root) {
   return {app, [o, app] {
             // The tracker's options have an effect only on a tracker calibration: refused, not ignored, without one.
             const bool tracker = is_tracker_calibration(o->calibration) || !o->station_plan.empty();
-            for (const char* option : {"--tracker-noise-um", "--points-per-station", "--calibration-frames"})
+            for (const char* option : {"--tracker-noise-um", "--points-per-station", "--calibration-frames",
+                                       "--targets-mm", "--target-layouts"})
               if (!tracker && app->count(option) > 0)
                 throw ExitError(kExitBadInput,
                                 fmt::format("{}: only with a tracker calibration (--calibration "

@@ -559,7 +559,7 @@ int run_workspace(const WorkspaceCommandOptions& o) {
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::string text = text_report(model, o, r, defaults_note(config));
-  text += fmt::format("\n{} files written to {} in {:.1f} s\n", set.paths().size(), o.out, wall);
+  text += fmt::format("\n{} written to {} in {:.1f} s\n", counted(set.paths().size(), "file"), o.out, wall);
   set.finish(text);
   return kExitOk;
 }

@@ -78,6 +78,11 @@ class JsonWriter {
     key(k);
     return value(v);
   }
+  /// key(k) and the number `v`, or null where there is none (`known` false, or v not finite).
+  JsonWriter& number_or_null(std::string_view k, double v, bool known = true) {
+    key(k);
+    return known && std::isfinite(v) ? value(v) : null();
+  }
 
   std::string str() const { return out_ + "\n"; }
 

@@ -489,11 +489,12 @@ std::string OutputFiles::folder_note() const {
   if (folder_.empty() || earlier_.entries.empty()) return {};
   if (earlier_.entries.size() == 1 && earlier_.entries[0] == kRunManifest) return {};
   std::string note = fmt::format(
-      "hexatwist {}: note: {} '{}' was not empty: {} files replaced, {} of an earlier run "
+      "hexatwist {}: note: {} '{}' was not empty: {} replaced, {} of an earlier run "
       "removed",
-      command_, folder_option_, printable(folder_.string()), replaced_, removed_);
+      command_, folder_option_, printable(folder_.string()), counted(replaced_, "file"), removed_);
   if (!others_.empty()) {
-    note += fmt::format("; {} other files left (not written by hexatwist, or changed since):", others_.size());
+    note +=
+        fmt::format("; {} left (not written by hexatwist, or changed since):", counted(others_.size(), "other file"));
     for (std::size_t k = 0; k < others_.size() && k < 5; ++k) note += " " + printable(others_[k]);
     if (others_.size() > 5) note += " ...";
   }

@@ -384,8 +384,8 @@ void simulate_and_report(const Rig& rig, const ReportOptions& o, std::vector<Rep
   out += preamble + "\n";
   out += summary_table(tests);
   out += report_notes(rig, tests);
-  out += fmt::format("\n{:.1f} s simulated ({} runs) in {:.1f} s; {} files written to {} in {:.1f} s in all\n",
-                     simulated, 3 * tests.size(), sim_wall, files.paths().size(), o.out_dir, wall);
+  out += fmt::format("\n{:.1f} s simulated ({} runs) in {:.1f} s; {} written to {} in {:.1f} s in all\n", simulated,
+                     3 * tests.size(), sim_wall, counted(files.paths().size(), "file"), o.out_dir, wall);
   files.finish(out);
 }
 

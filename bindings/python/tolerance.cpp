@@ -100,8 +100,9 @@ CalibrationChoice choice_of(const std::string& calibration, const py::object& tr
   const py::dict t = tracker;
   for (const auto& kv : t) {
     const std::string k = kv.first.cast<std::string>();
-    if (k != "noise" && k != "points_per_station" && k != "frames" && k != "stations")
-      raise_input("tracker: unknown key '" + k + "'; expected noise [m], points_per_station, frames, stations");
+    if (k != "noise" && k != "points_per_station" && k != "frames" && k != "stations" && k != "targets")
+      raise_input("tracker: unknown key '" + k +
+                  "'; expected noise [m], points_per_station, frames, stations, targets [m, platform]");
   }
   if (t.contains("noise")) c.tracker_noise = t["noise"].cast<double>();
   if (t.contains("points_per_station")) c.points = t["points_per_station"].cast<int>();
@@ -114,6 +115,13 @@ CalibrationChoice choice_of(const std::string& calibration, const py::object& tr
     const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(t["stations"]);
     if (!a || a.ndim() != 2 || a.shape(1) != 6) raise_input("tracker: stations must be an (N, 6) array [m, rad]");
     for (py::ssize_t r = 0; r < a.shape(0); ++r) c.plan.push_back(Eigen::Map<const Vector6d>(a.data(r, 0)));
+  }
+  if (t.contains("targets") && !t["targets"].is_none()) {  // the library checks them (check_tracker_calibration)
+    const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(t["targets"]);
+    if (!a || !(a.ndim() == 2 && a.shape(1) == 3) && !(a.ndim() == 1 && a.shape(0) == 0))
+      raise_input("tracker: targets must be an (N, 3) array [m, platform]");
+    for (py::ssize_t r = 0; a.ndim() == 2 && r < a.shape(0); ++r)
+      c.extra_targets_P.push_back(Eigen::Map<const Vector3d>(a.data(r, 0)));
   }
   return c;
 }
@@ -184,6 +192,42 @@ py::dict linear_py(const py::object& config, const py::object& poses_in, const p
   return d;
 }
 
+// The layouts of 0..max_extra extra targets (target_layouts) for the tracker calibration `calibration`.
+py::list layouts_py(const py::object& config, const py::object& poses_in, const py::dict& required,
+                    const py::dict& sigmas, int threads, const std::string& calibration, const py::object& tracker,
+                    std::uint64_t seed, int max_extra) {
+  const PlatformSource p = platform_of(config);
+  const std::vector<Pose> poses = design_poses(p, poses_in, required);
+  ToleranceOptions o;
+  o.sigmas = sigmas_of(sigmas);
+  o.seed = seed;
+  o.threads = threads;
+  if (!is_tracker_calibration(calibration))
+    raise_input(
+        "target_layouts: calibration must be a tracker calibration (\"stations:N[,SEED]\" or \"plan\"), got \"" +
+        calibration + "\"");
+  const TrackerCalibration c = tracker_calibration_of(*p.model, choice_of(calibration, tracker), seed);
+  std::vector<TargetLayout> layouts;
+  {
+    py::gil_scoped_release release;
+    layouts = target_layouts(*p.model, poses, o, c, max_extra);
+  }
+  py::list out;
+  for (const TargetLayout& l : layouts) {
+    py::dict d;
+    py::array_t<double> t({static_cast<py::ssize_t>(l.extra_targets_P.size()), py::ssize_t{3}});
+    for (std::size_t k = 0; k < l.extra_targets_P.size(); ++k)
+      for (int a = 0; a < 3; ++a) t.mutable_at(static_cast<py::ssize_t>(k), a) = l.extra_targets_P[k][a];
+    d["extra_targets"] = t;
+    d["status"] = std::string(to_string(l.status));
+    d["point"] = quantiles_dict(l.point);
+    d["position"] = quantiles_dict(l.position);
+    d["orientation"] = quantiles_dict(l.orientation);
+    out.append(d);
+  }
+  return out;
+}
+
 ErrorQuantiles quantiles_of(const py::dict& d) {
   ErrorQuantiles q;
   q.median = d["median"].cast<double>();
@@ -228,6 +272,8 @@ void expose_tolerance(py::module_& m) {
   m.def("_tolerance_linear", &linear_py, py::arg("platform"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
         py::arg("threads") = 1, py::arg("calibration") = "none", py::arg("tracker") = py::none(), py::arg("seed") = 1);
   m.def("_tolerance_summary", &summary_py, py::arg("chunk"), py::arg("poses"), py::arg("linear"));
+  m.def("_target_layouts", &layouts_py, py::arg("platform"), py::arg("poses"), py::arg("required"), py::arg("sigmas"),
+        py::arg("threads"), py::arg("calibration"), py::arg("tracker"), py::arg("seed"), py::arg("max_extra"));
   m.attr("HISTOGRAM_BINS") = ErrorHistogram::kBins;
 }
 

@@ -26,7 +26,7 @@ __all__ = [
     "orientation_workspace", "tilt_torsion_rotation", "workspace_map", "design_axes", "tolerance",
     "RequiredWorkspace", "VolumeGrid", "WorkspaceVolume", "WorkspaceSlice", "OrientationWorkspace", "MapGrid",
     "WorkspaceMap", "LimitMargin", "Margins", "DesignEvaluation", "AxisDesign", "Quantiles", "LinearTolerance",
-    "ToleranceSummary", "Tolerance",
+    "ToleranceSummary", "Tolerance", "TargetLayout", "target_layouts",
 ]
 
 PlatformLike = Union[Model, RigLike]
@@ -292,6 +292,20 @@ class ToleranceSummary(Result):
 
 
 @dataclass(frozen=True)
+class TargetLayout(Result):
+    """A layout of targets for a tracker calibration and what it buys (the linearised answer)."""
+
+    extra_targets: FloatArray
+    """(N, 3) targets besides point A [m, platform frame]."""
+    status: str
+    """"ok", or why the plan does not determine the calibration with them."""
+    point: Quantiles
+    position: Quantiles
+    orientation: Quantiles
+    """Median and 95th percentile over the poses [m, m, rad]; max is NaN."""
+
+
+@dataclass(frozen=True)
 class Tolerance(Result):
     """A tolerance study (tolerance.hpp): per platform (P,), histograms (HISTOGRAM_BINS,)."""
 
@@ -448,7 +462,9 @@ def tolerance(platform: PlatformLike = None, poses: ArrayLike | None = None, *, 
     configuration identify finds from a simulated tracker log of that platform at N random stations or at
     ``tracker["stations"]``, (K, 6) [m, rad from home], errors then in the frames the tracker sees;
     ``tracker``: ``noise`` [m per coordinate, default 10e-6], ``points_per_station`` [default 50],
-    ``frames`` "tracker" or "joints") over the required workspace (``poses``, or the
+    ``frames`` "tracker" or "joints", ``targets`` (N, 3) more targets on the platform besides point A
+    [m, platform frame], measured at every station: with them the pivot and the orientation calibrate as
+    point A does) over the required workspace (``poses``, or the
     :func:`required_workspace` settings in ``workspace``). ``max_point_linear`` after a tracker calibration
     comes from the identification's covariance and the sample's own tracker noise. With a dask ``client`` the platforms
     are sampled and evaluated on the workers (``chunk`` platforms a task, poses generated there) and
@@ -469,3 +485,19 @@ def tolerance(platform: PlatformLike = None, poses: ArrayLike | None = None, *, 
     per_platform = {k: v for k, v in chunk_result.items() if k != "first"}
     return Tolerance(**per_platform, linear=LinearTolerance(**_quantiles(linear)),
                      summary=ToleranceSummary(**_quantiles(summary)))
+
+
+def target_layouts(platform: PlatformLike = None, poses: ArrayLike | None = None, *, max_extra: int = 3,
+                   calibration: str = "stations:40", tracker: Mapping[str, Any] | None = None, seed: int = 1,
+                   sigmas: Mapping[str, float] | None = None, **workspace: Any) -> list[TargetLayout]:
+    """Where to put the targets (tolerance_calibration.hpp ``target_layouts``, ``tolerance --target-layouts``):
+    the layouts of point A and 0 to ``max_extra`` more targets evenly spaced on the circle through A about the
+    pivot, each calibrated as :func:`tolerance`'s ``calibration`` (a tracker calibration) with ``tracker``'s
+    settings, answered by the linear model over the required workspace: the point A, pivot and orientation
+    errors' median and 95th percentile. The CLI's numbers."""
+    w = _workspace_spec(workspace)
+    sig = {k: float(v) for k, v in (sigmas or {}).items()}
+    layouts = _core._target_layouts(platform, poses, w, sig, get_num_threads(), calibration,
+                                    None if tracker is None else dict(tracker), int(seed), int(max_extra))
+    return [TargetLayout(extra_targets=d["extra_targets"], status=d["status"],
+                         **{k: Quantiles(**d[k]) for k in ("point", "position", "orientation")}) for d in layouts]

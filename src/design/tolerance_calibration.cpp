@@ -37,29 +37,47 @@ Status station_commands(const Model& nominal, const TrackerCalibration& c, std::
   return Status::Ok;
 }
 
+// The targets a calibration measures, in order: the observation point of `platform`, then the extra ones [m, P].
+std::vector<Vector3d> targets_P(const Model& platform, const TrackerCalibration& c) {
+  std::vector<Vector3d> out{platform.spec().observation_P};
+  out.insert(out.end(), c.extra_targets_P.begin(), c.extra_targets_P.end());
+  return out;
+}
+
 // The plan's observations of the nominal platform without noise, the tracker frame at B: the
-// points of a station repeated, so that its group weighs as many points as the tracker records.
+// points of a station and target repeated, so that its group weighs as many points as the tracker
+// records (the order of tracker_observations: station, target, point).
 Status plan_observations(const Model& nominal, const TrackerCalibration& c, std::vector<Observation>& out) {
   out.clear();
   std::vector<Vector6d> commands;
   if (const Status s = station_commands(nominal, c, commands); s != Status::Ok) return s;
-  for (std::size_t k = 0; k < c.stations.size(); ++k) {
-    Observation o;
-    o.motor = commands[k];
-    o.p_T =
-        platform_point_B(nominal, placement_from_pose(Pose::from_vector(c.stations[k])), nominal.spec().observation_P);
-    out.insert(out.end(), static_cast<std::size_t>(c.points), o);
-  }
+  const std::vector<Vector3d> targets = targets_P(nominal, c);
+  for (std::size_t k = 0; k < c.stations.size(); ++k)
+    for (std::size_t t = 0; t < targets.size(); ++t) {
+      Observation o;
+      o.motor = commands[k];
+      o.target = static_cast<int>(t);
+      o.p_T = platform_point_B(nominal, placement_from_pose(Pose::from_vector(c.stations[k])), targets[t]);
+      out.insert(out.end(), static_cast<std::size_t>(c.points), o);
+    }
   return Status::Ok;
+}
+
+// The nominal parameters of `set` with the extra targets where the calibration puts them.
+Eigen::VectorXd plan_theta(const ParameterSet& set, const TrackerCalibration& c) {
+  Eigen::VectorXd theta = set.nominal_vector();
+  for (std::size_t t = 0; t < c.extra_targets_P.size(); ++t)
+    theta.segment<3>(set.target_index() + 3 * static_cast<Eigen::Index>(t + 1)) = c.extra_targets_P[t];
+  return theta;
 }
 
 // The identification's Jacobian (platform parameters, then the tracker frame) of the plan's groups
 // at the nominal parameters: the rows identify's Evaluator gives, each weighted by sqrt(points).
-Status plan_jacobian(const ParameterSet& set, std::span<const Observation> observations,
+Status plan_jacobian(const ParameterSet& set, const Eigen::VectorXd& theta, std::span<const Observation> observations,
                      const ObservationGroups& groups, const FkOptions& fk, Eigen::MatrixXd& J) {
   detail::Evaluator evaluator(set, observations, groups, fk);
   Eigen::VectorXd e;
-  return evaluator.evaluate(set.nominal_vector(), 1.0, RigidTransform{}, e, &J);
+  return evaluator.evaluate(theta, 1.0, RigidTransform{}, e, &J);
 }
 
 }  // namespace
@@ -93,7 +111,34 @@ void check_tracker_calibration(const TrackerCalibration& c) {
         "calibration: one point per station has no scatter to measure the tracker's noise by; record two or more, or "
         "give identification.tracker_noise",
         "points_per_station");
+  if (c.extra_targets_P.size() + 1 > kMaxTargets)
+    throw ParameterError(fmt::format("calibration: {} targets with the observation point, at most {}",
+                                     c.extra_targets_P.size() + 1, kMaxTargets),
+                         "targets");
+  for (std::size_t t = 0; t < c.extra_targets_P.size(); ++t) {
+    const Vector3d& p = c.extra_targets_P[t];
+    if (!(p.allFinite() && p.norm() <= 10.0))
+      throw ParameterError(
+          fmt::format("calibration: target {} must be finite and within 10 m of the platform frame's origin", t + 2),
+          "targets");
+  }
 }
+
+namespace {
+
+// The targets apart: ParameterError when two (the observation point among them) are within 1 mm.
+void check_targets_apart(const Model& nominal, const TrackerCalibration& c) {
+  const std::vector<Vector3d> targets = targets_P(nominal, c);
+  for (std::size_t a = 0; a < targets.size(); ++a)
+    for (std::size_t b = a + 1; b < targets.size(); ++b)
+      if ((targets[a] - targets[b]).norm() < 1e-3)
+        throw ParameterError(fmt::format("calibration: targets {} and {} are within 1 mm of each other (target 1 is "
+                                         "the observation point): one point cannot be measured twice",
+                                         a + 1, b + 1),
+                             "targets");
+}
+
+}  // namespace
 
 std::vector<Vector6d> random_station_plan(const Model& nominal, const StationsSpec& spec) {
   std::vector<Vector6d> plan{Vector6d::Zero()};
@@ -138,7 +183,8 @@ Status joint_frames(const Model& nominal, const Model& real, RigidTransform& X_B
 
 std::vector<Vector3d> tracker_noise(const TrackerCalibration& c, std::uint64_t index) {
   detail::SampleStream random(c.seed ^ kNoiseStream, index);
-  std::vector<Vector3d> noise(c.stations.size() * static_cast<std::size_t>(std::max(c.points, 0)));
+  std::vector<Vector3d> noise(c.stations.size() * (1 + c.extra_targets_P.size()) *
+                              static_cast<std::size_t>(std::max(c.points, 0)));
   for (Vector3d& n : noise)
     for (int a = 0; a < 3; ++a) n[a] = c.noise * random.normal();
   return noise;
@@ -147,23 +193,27 @@ std::vector<Vector3d> tracker_noise(const TrackerCalibration& c, std::uint64_t i
 Status tracker_observations(const Model& nominal, const Model& real, const TrackerCalibration& c, std::uint64_t index,
                             std::vector<Observation>& out) {
   out.clear();
-  out.reserve(c.stations.size() * static_cast<std::size_t>(std::max(c.points, 0)));
   const RigidTransform X_TB = inverse(sample_tracker_frame(c, index));
   const std::vector<Vector3d> noise = tracker_noise(c, index);
+  out.reserve(noise.size());
   auto next = noise.begin();
   std::vector<Vector6d> commands;
   if (const Status s = station_commands(nominal, c, commands); s != Status::Ok) return s;
+  const std::vector<Vector3d> targets = targets_P(real, c);
   FkResult fk;
   for (std::size_t station = 0; station < c.stations.size(); ++station) {
     Observation o;
     o.motor = commands[station];
-    // Where the held commands put the real platform, and its observation point there.
+    // Where the held commands put the real platform, and its targets there.
     const Placement guess = placement_from_pose(Pose::from_vector(c.stations[station]));
     if (const Status s = forward_kinematics(real, o.motor, LengthKind::Motor, guess, fk); s != Status::Ok) return s;
-    const Vector3d p_T = apply(X_TB, platform_point_B(real, fk.placement, real.spec().observation_P));
-    for (int k = 0; k < c.points; ++k) {
-      o.p_T = p_T + *next++;
-      out.push_back(o);
+    for (std::size_t t = 0; t < targets.size(); ++t) {
+      o.target = static_cast<int>(t);
+      const Vector3d p_T = apply(X_TB, platform_point_B(real, fk.placement, targets[t]));
+      for (int k = 0; k < c.points; ++k) {
+        o.p_T = p_T + *next++;
+        out.push_back(o);
+      }
     }
   }
   return Status::Ok;
@@ -238,16 +288,20 @@ AxisSelection chosen_axes(const TrackerCalibration& c, const PlanModel& m) {
 Status plan_model(const Model& nominal, const ToleranceSigmas& sigmas, const TrackerCalibration& c, PlanModel& m,
                   CalibratedLinear& lin) {
   const IdentificationOptions& o = c.identification;
+  check_targets_apart(nominal, c);
   std::vector<Observation> observations;
   if (const Status s = plan_observations(nominal, c, observations); s != Status::Ok) return s;
   m.groups = group_observations(observations);
   m.noise = std::max(c.noise, o.tracker_noise_floor);
   AxisSelection all;
   all.fill(true);
-  m.every = ParameterSet(nominal, CalibrationModel::Geometry, o.lead_effect, all, 1, o.leads);
-  if (const Status s = plan_jacobian(m.every, observations, m.groups, o.fk, m.J_all); s != Status::Ok) return s;
+  const int targets = 1 + static_cast<int>(c.extra_targets_P.size());
+  m.every = ParameterSet(nominal, CalibrationModel::Geometry, o.lead_effect, all, targets, o.leads);
+  if (const Status s = plan_jacobian(m.every, plan_theta(m.every, c), observations, m.groups, o.fk, m.J_all);
+      s != Status::Ok)
+    return s;
   const AxisSelection chosen = chosen_axes(c, m);
-  lin.parameters = ParameterSet(nominal, CalibrationModel::Geometry, o.lead_effect, chosen, 1, o.leads);
+  lin.parameters = ParameterSet(nominal, CalibrationModel::Geometry, o.lead_effect, chosen, targets, o.leads);
   std::vector<double> sd;
   for (Eigen::Index j = 0; j < m.every.axis_index(); ++j) m.fitted.push_back(j);
   for (int a = 0, j = m.every.axis_index(); a < 2 * kLegs; ++a) {
@@ -365,7 +419,7 @@ Status calibrated_linear(const Model& nominal, const std::vector<Pose>& poses, c
   // The identified parameters' response to the left axes: (J^T J)^-1 J^T J_u, scaled by their sd.
   const Eigen::MatrixXd K = lin.covariance * lin.jacobian.transpose() * m.J_all(Eigen::all, m.left) *
                             m.left_sd.asDiagonal() / (m.noise * m.noise);
-  const Eigen::VectorXd theta = m.every.nominal_vector();
+  const Eigen::VectorXd theta = plan_theta(m.every, c);
   const Model platform(m.every.platform(theta, 1.0));
   const std::size_t n = poses.size();
   for (auto* v : {&out.point_covariance, &out.position_covariance, &out.orientation_covariance}) v->resize(n);
@@ -437,25 +491,78 @@ std::vector<Vector6d> chosen_plan(const Model& nominal, const CalibrationChoice&
 
 }  // namespace
 
+TrackerCalibration tracker_calibration_of(const Model& nominal, const CalibrationChoice& choice, std::uint64_t seed) {
+  TrackerCalibration c;
+  c.stations = chosen_plan(nominal, choice);
+  if (c.stations.empty() && choice.name == "plan")
+    throw ParameterError("calibration: plan needs a station plan (none given)", "station_plan");
+  if (c.stations.empty() && !choice.extra_targets_P.empty())
+    throw ParameterError(
+        fmt::format("calibration: targets are measured by a tracker calibration, not by calibration {}", choice.name),
+        "targets");
+  c.noise = choice.tracker_noise;
+  c.points = choice.points;
+  c.seed = seed;
+  c.frames = choice.frames;
+  c.extra_targets_P = choice.extra_targets_P;
+  if (c.points == 1) c.identification.tracker_noise = c.noise;  // no scatter to measure it by
+  return c;
+}
+
 Status prepare_calibration(const Model& nominal, const std::vector<Pose>& poses, const CalibrationChoice& choice,
                            ToleranceOptions& options, ToleranceLinear& linear) {
   options.calibration = nullptr;
-  const std::vector<Vector6d> plan = chosen_plan(nominal, choice);
-  if (plan.empty() && choice.name == "plan")
-    throw ParameterError("calibration: plan needs a station plan (none given)", "station_plan");
-  if (plan.empty()) {
+  const TrackerCalibration c = tracker_calibration_of(nominal, choice, options.seed);
+  if (c.stations.empty()) {
     if (choice.name == "perfect") options.calibration = perfect_calibration_step();
     return tolerance_linear(nominal, poses, options.sigmas, linear, options.threads);
   }
-  TrackerCalibration c;
-  c.stations = plan;
-  c.noise = choice.tracker_noise;
-  c.points = choice.points;
-  c.seed = options.seed;
-  c.frames = choice.frames;
-  if (c.points == 1) c.identification.tracker_noise = c.noise;  // no scatter to measure it by
   options.calibration = tracker_calibration_step(c);
   return calibrated_linear(nominal, poses, options, c, linear);
+}
+
+std::vector<Vector3d> target_layout(const Model& nominal, int extra) {
+  const ModelSpec& spec = nominal.spec();
+  const Vector3d a = spec.observation_P - spec.pivot_P;
+  double radius = a.head<2>().norm();
+  double angle = std::atan2(a.y(), a.x());
+  if (radius < 0.1) {
+    radius = 0.0;
+    for (const LegSpec& leg : spec.legs) radius += (leg.platform_P - spec.pivot_P).head<2>().norm() / kLegs;
+    angle = 0.0;
+  }
+  std::vector<Vector3d> out;
+  for (int k = 1; k <= extra; ++k) {
+    const double phi = angle + 2.0 * kPi * k / (extra + 1);
+    out.emplace_back(spec.pivot_P.x() + radius * std::cos(phi), spec.pivot_P.y() + radius * std::sin(phi),
+                     spec.observation_P.z());
+  }
+  return out;
+}
+
+std::vector<TargetLayout> target_layouts(const Model& nominal, const std::vector<Pose>& poses,
+                                         const ToleranceOptions& study, const TrackerCalibration& calibration,
+                                         int max_extra) {
+  if (max_extra < 0 || max_extra > kMaxLayoutTargets)
+    throw ParameterError(
+        fmt::format("target layouts: expected 0 to {} extra targets, got {}", kMaxLayoutTargets, max_extra),
+        "target_layouts");
+  std::vector<TargetLayout> out;
+  for (int extra = 0; extra <= max_extra; ++extra) {
+    TrackerCalibration c = calibration;
+    c.extra_targets_P = target_layout(nominal, extra);
+    TargetLayout& layout = out.emplace_back();
+    layout.extra_targets_P = c.extra_targets_P;
+    ToleranceLinear linear;
+    layout.status = calibrated_linear(nominal, poses, study, c, linear);
+    if (layout.status != Status::Ok) continue;
+    ToleranceSummary summary;
+    linear_quantiles(linear, summary, study.threads);
+    layout.point = summary.point_linear;
+    layout.position = summary.position_linear;
+    layout.orientation = summary.orientation_linear;
+  }
+  return out;
 }
 
 }  // namespace hexatwist

@@ -103,7 +103,7 @@ def main():
         file_failures, file_checked = check_file(name, text, root, cli)
         failures += file_failures
         checked += file_checked
-    print(f"{checked} examples run in {len(paths)} files, {failures} differ")
+    print(f"{checked} examples run in {len(paths)} file{'' if len(paths) == 1 else 's'}, {failures} differ")
     return 1 if failures else 0
 
 

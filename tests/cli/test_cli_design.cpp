@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "cli_support.hpp"
 
 using namespace hexatwist::cli_test;
@@ -195,6 +197,53 @@ TEST(CliTolerance, AfterATrackerCalibrationFromAStationPlanMicrometresRemain) {
   ASSERT_EQ(a.size(), 4u);
   ASSERT_EQ(b.size(), 4u);
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i] / b[i], 1.0, 1e-4) << "platform " << i;
+}
+
+TEST(CliTolerance, TargetsAroundThePlatformCalibrateThePivotAndTheLayoutsSayWhereToPutThem) {
+  const std::vector<std::string> common = {
+      "tolerance", "--platforms",  "3",        "--workspace",   "random=40,samples=5",
+      "--json",    "--no-figures", "--no-csv", "--calibration", "stations:20"};
+  auto args = common;
+  args.insert(args.end(), {"--target-layouts", "2", "--out", (temp_dir() / "layouts").string()});
+  const Outcome r = run(args);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const YAML::Node j = YAML::Load(r.out);
+  const YAML::Node layouts = j["target_layouts"];
+  ASSERT_EQ(layouts.size(), 3u);
+  // Layout 1 is this study's own calibration: its linear answer is the summary's.
+  EXPECT_EQ(layouts[0]["extra_targets"].size(), 0u);
+  EXPECT_EQ(layouts[0]["position"]["p95"].as<double>(), j["linearised"]["position"]["p95"].as<double>());
+  EXPECT_EQ(layouts[2]["extra_targets"].size(), 2u);
+  // The layout of two more targets, given as --targets-mm: its Monte Carlo and its linear answer are
+  // the layout's, and the pivot far better than with point A alone (measured 24x at the p95).
+  std::string targets;
+  for (const YAML::Node& t : layouts[2]["extra_targets"])
+    targets += fmt::format("{}{:.17g},{:.17g},{:.17g}", targets.empty() ? "" : ";", 1e3 * t[0].as<double>(),
+                           1e3 * t[1].as<double>(), 1e3 * t[2].as<double>());
+  args = common;
+  args.insert(args.end(), {"--targets-mm", targets, "--out", (temp_dir() / "targets").string()});
+  const Outcome t = run(args);
+  ASSERT_EQ(t.code, 0) << t.err;
+  const YAML::Node k = YAML::Load(t.out);
+  EXPECT_EQ(k["tracker"]["targets"].size(), 2u);
+  EXPECT_NEAR(k["linearised"]["position"]["p95"].as<double>() / layouts[2]["position"]["p95"].as<double>(), 1.0, 1e-9);
+  EXPECT_GT(j["monte_carlo"]["position"]["p95"].as<double>(), 5 * k["monte_carlo"]["position"]["p95"].as<double>());
+  EXPECT_GT(j["monte_carlo"]["orientation"]["p95"].as<double>(),
+            5 * k["monte_carlo"]["orientation"]["p95"].as<double>());
+  // The text report's table, and the options refused where they mean nothing.
+  args = common;
+  args.erase(args.begin() + 5);  // --json
+  args.insert(args.end(), {"--target-layouts", "1", "--out", (temp_dir() / "layouts-text").string()});
+  const Outcome text = run(args);
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_NE(text.out.find("where to put the targets"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("(point A alone)"), std::string::npos);
+  expect_error(run({"tolerance", "--targets-mm", "100,0,0"}), 2, {"--targets-mm", "tracker calibration"});
+  expect_error(run({"tolerance", "--target-layouts", "2"}), 2, {"--target-layouts", "tracker calibration"});
+  expect_error(run({"tolerance", "--calibration", "stations:20", "--targets-mm", "100,0"}), 2, {"--targets-mm"});
+  expect_error(run({"tolerance", "--calibration", "stations:20", "--targets-mm", "1200,0,0.5"}), 2,
+               {"targets", "within 1 mm"});
+  expect_error(run({"tolerance", "--calibration", "stations:20", "--target-layouts", "9"}), 2, {"--target-layouts"});
 }
 
 TEST(CliDesignCommands, BadInputsAreOneLineWithTheirExitCodes) {

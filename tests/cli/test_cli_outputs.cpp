@@ -66,7 +66,7 @@ TEST(CliOutputs, AReusedFolderSaysSoAndItsSummaryListsOnlyThisRunsFiles) {
   write_file("reused-out/notes.txt", "mine\n");
   const Outcome second = run({"simulate", "--trajectory", csv, "--out", out.string(), "--no-figures", "--no-csv"});
   ASSERT_EQ(second.code, 0) << second.err;
-  EXPECT_NE(second.err.find("was not empty: 2 files replaced, 2 of an earlier run removed; 1 other files left"),
+  EXPECT_NE(second.err.find("was not empty: 2 files replaced, 2 of an earlier run removed; 1 other file left"),
             std::string::npos)
       << second.err;
   EXPECT_NE(second.err.find("notes.txt"), std::string::npos);
@@ -249,7 +249,7 @@ TEST(CliOutputs, AFolderReusedByAnotherCommandHoldsOnlyThatRunsFilesAndSaysSo) {
   const Outcome r = run({"dynamics", "--trajectory", csv, "--out", out.string(), "--no-figures"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("the earlier run was simulate"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("1 files replaced, 3 of an earlier run removed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("1 file replaced, 3 of an earlier run removed"), std::string::npos) << r.err;
   EXPECT_EQ(folder_entries(out), (std::vector<std::string>{".hexatwist-run.json", "h2_dynamics.csv", "summary.json"}));
   const YAML::Node s = YAML::LoadFile((out / "summary.json").string());
   EXPECT_EQ(s["command"].as<std::string>(), "dynamics");

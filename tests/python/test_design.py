@@ -1,10 +1,16 @@
 """The design functions from Python (docs/theory/design.md §16-19): the workspace's volume, slices, maps
 and orientation workspace against the batch functions, the designed configuration through its YAML,
 and the tolerance study's independence from threads."""
+import json
+import os
+import subprocess
+import tempfile
+
 import numpy as np
 import pytest
 
 import hexatwist
+from conftest import tool
 
 
 def test_volume_from_its_cells_equals_the_whole_computation(model):
@@ -117,6 +123,46 @@ def test_a_tracker_calibration_leaves_micrometres_and_its_linear_answer_agrees()
         hexatwist.tolerance(calibration="stations:5", tracker=dict(noise=-1.0), **settings)
     with pytest.raises(hexatwist.InputError, match="tracker"):
         hexatwist.tolerance(calibration="stations:5", tracker=dict(nois=1e-5), **settings)
+
+
+def test_targets_around_the_platform_calibrate_its_orientation_as_the_cli_does():
+    # Two more targets on point A's circle (the CLI's layout of 3 targets): the pivot and the
+    # orientation an order of magnitude better; the same numbers as `tolerance --targets-mm`.
+    settings = dict(platforms=3, random=40, test_samples=5, calibration="stations:20")
+    alone = hexatwist.tolerance(**settings)
+    targets = np.array([[-0.6, 1.0392304845413265, 0.0], [-0.6, -1.0392304845413265, 0.0]])
+    three = hexatwist.tolerance(tracker=dict(targets=targets), **settings)
+    assert np.all(three.calibration == 0)
+    assert alone.summary["position"]["p95"] > 5 * three.summary["position"]["p95"]
+    assert alone.summary["orientation"]["p95"] > 5 * three.summary["orientation"]["p95"]
+    cli = json.loads(subprocess.run(
+        [tool("HEXATWIST_CLI"), "tolerance", "--platforms", "3", "--workspace", "random=40,samples=5", "--calibration", "stations:20",
+         "--targets-mm", ";".join(",".join(repr(1e3 * v) for v in t) for t in targets), "--json", "--no-figures",
+         "--no-csv", "--out", os.path.join(tempfile.mkdtemp(), "t")],
+        capture_output=True, text=True, check=True).stdout)
+    for key in ("point", "position", "orientation"):
+        assert cli["monte_carlo"][key]["p95"] == pytest.approx(three.summary[key]["p95"], rel=1e-12)
+    # The layouts, as `tolerance --target-layouts 2` prints them: layout 3 is these targets, its linear
+    # answer this study's; point A alone is the one-target study's.
+    layouts = hexatwist.target_layouts(max_extra=2, calibration="stations:20", random=40, test_samples=5)
+    assert [len(l.extra_targets) for l in layouts] == [0, 1, 2]
+    assert all(l.status == "ok" for l in layouts)
+    assert np.allclose(layouts[2].extra_targets, targets, rtol=0, atol=1e-15)
+    assert layouts[2].position.p95 == pytest.approx(three.linear.position.p95, rel=1e-12)
+    assert layouts[0].orientation.p95 == pytest.approx(alone.linear.orientation.p95, rel=1e-12)
+    layout_cli = json.loads(subprocess.run(
+        [tool("HEXATWIST_CLI"), "tolerance", "--platforms", "3", "--workspace", "random=40,samples=5",
+         "--calibration", "stations:20", "--target-layouts", "2", "--json", "--no-figures", "--no-csv",
+         "--out", os.path.join(tempfile.mkdtemp(), "l")], capture_output=True, text=True, check=True).stdout)
+    for mine, theirs in zip(layouts, layout_cli["target_layouts"]):
+        assert np.array_equal(mine.extra_targets.reshape(-1, 3), np.array(theirs["extra_targets"]).reshape(-1, 3))
+        assert mine.orientation.p95 == theirs["orientation"]["p95"]
+    with pytest.raises(hexatwist.InputError, match="tracker calibration"):
+        hexatwist.target_layouts(calibration="none", random=40, test_samples=5)
+    with pytest.raises(hexatwist.InputError, match=r"\[targets\]"):
+        hexatwist.tolerance(tracker=dict(targets=[[1.2, 0.0, 0.0005]]), **settings)
+    with pytest.raises(hexatwist.InputError, match="targets must be"):
+        hexatwist.tolerance(tracker=dict(targets=[1.0, 2.0]), **settings)
 
 
 def test_every_public_function_pickles_by_reference():

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "hexatwist/calibration/identification.hpp"
+#include "hexatwist/calibration/point_log.hpp"
 #include "hexatwist/calibration/stations.hpp"
 #include "hexatwist/design/tolerance.hpp"
 #include "hexatwist/motion/trajectory.hpp"
@@ -37,8 +38,12 @@ struct TrackerCalibration {
   /// The plan: the poses the platform stops at, in order [m, rad from home]; each commanded by the
   /// nominal model's compensated commands (random_stations, or a planner's).
   std::vector<Vector6d> stations;
-  double noise = 10e-6;    ///< the tracker's Gaussian noise per coordinate [m]
-  int points = 50;         ///< points recorded per station (at rest)
+  double noise = 10e-6;  ///< the tracker's Gaussian noise per coordinate [m]
+  int points = 50;       ///< points recorded per station (at rest), of each target
+  /// More targets on the platform, each measured at every station beside the observation point
+  /// (target 0) [m, P]: the identification places them (their positions are parameters), and with
+  /// them the platform's orientation, so that the pivot and the orientation calibrate as point A does.
+  std::vector<Vector3d> extra_targets_P;
   std::uint64_t seed = 1;  ///< with a sample's index, the tracker's placement and noise
   IdentificationOptions identification = study_identification_options();
   CalibratedFrames frames = CalibratedFrames::Tracker;  ///< where the errors are measured
@@ -50,7 +55,9 @@ inline constexpr int kMaxPointsPerStation = 100000;
 /// Throws hexatwist::ParameterError naming the field when `calibration` is unusable: no station, a station
 /// that is not finite, a noise that is not finite and > 0, points outside 1..kMaxPointsPerStation,
 /// a single point per station without identification.tracker_noise (the scatter needs two), an
-/// identification of another model than Geometry (the study's errors move the joints).
+/// identification of another model than Geometry (the study's errors move the joints), more than
+/// kMaxTargets targets with the observation point, or one that is not finite, farther than 10 m from
+/// the platform frame's origin, or within 1 mm of another.
 void check_tracker_calibration(const TrackerCalibration& calibration);
 
 /// The plan of `count` random stations (random_stations, compensated commands) between home at the
@@ -69,15 +76,16 @@ RigidTransform sample_tracker_frame(const TrackerCalibration& calibration, std::
 /// gauge conditions of an identification's joints (theory §13).
 [[nodiscard]] Status joint_frames(const Model& nominal, const Model& real, RigidTransform& X_BJ, RigidTransform& X_PJ);
 
-/// The tracker's noise of sample `index`, every point of every station in order [m, T] (what
-/// tracker_observations adds).
+/// The tracker's noise of sample `index`, every point of every target of every station in order
+/// [m, T] (what tracker_observations adds).
 std::vector<Vector3d> tracker_noise(const TrackerCalibration& calibration, std::uint64_t index);
 
 /// What the tracker records of the platform `real` (the nominal model's sample `index` of a study)
 /// at every station: the nominal model's compensated commands held, the pose they give `real`
 /// (motor-side forward kinematics: its joints, leads, offsets, the drives' reference and scale),
-/// there its observation point, in a tracker frame drawn for the sample (random_tracker_frame),
-/// `points` times with independent Gaussian noise. Depends on (calibration.seed, index) alone.
+/// there its observation point and then each extra target (Observation::target 1, 2, ...), in a
+/// tracker frame drawn for the sample (random_tracker_frame), `points` times each with independent
+/// Gaussian noise. Depends on (calibration.seed, index) alone.
 /// Returns Ok, the status of a station the nominal model refuses, or of the forward kinematics.
 [[nodiscard]] Status tracker_observations(const Model& nominal, const Model& real,
                                           const TrackerCalibration& calibration, std::uint64_t index,
@@ -121,6 +129,31 @@ struct CalibratedLinear {
                                        const ToleranceOptions& study, const TrackerCalibration& calibration,
                                        ToleranceLinear& out, CalibratedLinear* detail = nullptr);
 
+/// Most extra targets target_layouts compares.
+inline constexpr int kMaxLayoutTargets = 5;
+
+/// The `extra` targets of a layout besides point A (theory design §18, "Where to put the targets"):
+/// with point A evenly spaced on the circle through A about the platform's z axis through the pivot,
+/// in A's plane; its radius that of A, or the platform joints' mean radius when A is within 0.1 m of
+/// the axis (then A's place on it is +x). [m, P]
+std::vector<Vector3d> target_layout(const Model& nominal, int extra);
+
+/// What a layout of targets buys: the calibration with it, linearised (calibrated_linear), its
+/// quantiles (linear_quantiles: median and 95th percentile over the poses).
+struct TargetLayout {
+  std::vector<Vector3d> extra_targets_P;  ///< besides point A [m, P]
+  Status status = Status::Ok;             ///< calibrated_linear's (NotIdentifiable: the plan does not determine it)
+  ErrorQuantiles point, position, orientation;  ///< point A, the pivot [m], the orientation [rad]
+};
+
+/// The layouts of 0 to `max_extra` extra targets (target_layout) for `calibration` (its plan, tracker
+/// and frames; its own targets replaced), each answered by the linear model over `poses` with
+/// `study`'s sigmas, seed and threads. Throws ParameterError for max_extra outside 0..kMaxLayoutTargets
+/// and as check_tracker_calibration.
+std::vector<TargetLayout> target_layouts(const Model& nominal, const std::vector<Pose>& poses,
+                                         const ToleranceOptions& study, const TrackerCalibration& calibration,
+                                         int max_extra);
+
 /// A study's calibration as the command line and Python name it.
 struct CalibrationChoice {
   /// none (the nominal controller), perfect (perfect_calibration_step), stations:N[,SEED]
@@ -130,7 +163,12 @@ struct CalibrationChoice {
   double tracker_noise = 10e-6;  ///< the tracker's noise per coordinate [m]
   int points = 50;  ///< points per station; one: the identification is given the tracker's noise (no scatter)
   CalibratedFrames frames = CalibratedFrames::Tracker;
+  std::vector<Vector3d> extra_targets_P;  ///< TrackerCalibration::extra_targets_P [m, P]
 };
+
+/// The tracker calibration that prepare_calibration makes of `choice` (empty stations for none and
+/// perfect). Throws as prepare_calibration.
+TrackerCalibration tracker_calibration_of(const Model& nominal, const CalibrationChoice& choice, std::uint64_t seed);
 
 /// Whether the calibration `name` is a tracker's (stations:N[,SEED] or plan: each platform identified
 /// from simulated tracker points, its errors small enough to report in um), as prepare_calibration reads it.
