@@ -131,17 +131,30 @@ CalibrationChoice choice_of(const std::string& calibration, const py::object& tr
                                                : "tolerance: a pose outside the nominal workspace");
 }
 
+// What every study call reads: the platform, the required poses, the options' sigmas, seed and threads.
+struct StudyInputs {
+  PlatformSource p;
+  std::vector<Pose> poses;
+  ToleranceOptions o;
+};
+
+StudyInputs study_inputs(const py::object& config, const py::object& poses_in, const py::dict& required,
+                         const py::dict& sigmas, std::uint64_t seed, int threads) {
+  StudyInputs in{platform_of(config), {}, {}};
+  in.poses = design_poses(in.p, poses_in, required);
+  in.o.sigmas = sigmas_of(sigmas);
+  in.o.seed = seed;
+  in.o.threads = threads;
+  return in;
+}
+
 // Platforms [first, first + count) of the study.
 py::dict chunk_py(const py::object& config, const py::object& poses_in, const py::dict& required,
                   const py::dict& sigmas, std::uint64_t seed, std::uint64_t first, std::size_t count,
                   const std::string& calibration, bool linear_worst, int threads, const py::object& tracker) {
-  const PlatformSource p = platform_of(config);
-  const std::vector<Pose> poses = design_poses(p, poses_in, required);
-  ToleranceOptions o;
-  o.sigmas = sigmas_of(sigmas);
-  o.seed = seed;
-  o.linear_worst = linear_worst;
-  o.threads = threads;
+  StudyInputs in = study_inputs(config, poses_in, required, sigmas, seed, threads);
+  const auto& [p, poses, o] = in;
+  in.o.linear_worst = linear_worst;
   const CalibrationChoice choice = choice_of(calibration, tracker);
   ToleranceLinear linear;
   ToleranceChunk c;
@@ -149,7 +162,7 @@ py::dict chunk_py(const py::object& config, const py::object& poses_in, const py
   {
     py::gil_scoped_release release;
     // The calibration step and its linear model (prepare_calibration throws for a bad choice).
-    s = prepare_calibration(*p.model, poses, choice, o, linear);
+    s = prepare_calibration(*p.model, poses, choice, in.o, linear);
     if (s == Status::Ok) s = tolerance_chunk(*p.model, poses, o, first, count, c, linear_worst ? &linear : nullptr);
   }
   if (s != Status::Ok) raise_study_status(s);
@@ -168,19 +181,15 @@ py::dict quantiles_dict(const ErrorQuantiles& q) {
 py::dict linear_py(const py::object& config, const py::object& poses_in, const py::dict& required,
                    const py::dict& sigmas, int threads, const std::string& calibration, const py::object& tracker,
                    std::uint64_t seed) {
-  const PlatformSource p = platform_of(config);
-  const std::vector<Pose> poses = design_poses(p, poses_in, required);
-  ToleranceOptions o;
-  o.sigmas = sigmas_of(sigmas);
-  o.seed = seed;
-  o.threads = threads;
+  StudyInputs in = study_inputs(config, poses_in, required, sigmas, seed, threads);
+  const auto& [p, poses, o] = in;
   const CalibrationChoice choice = choice_of(calibration, tracker);
   ToleranceLinear linear;
   ToleranceSummary summary;
   Status st;
   {
     py::gil_scoped_release release;
-    st = prepare_calibration(*p.model, poses, choice, o, linear);
+    st = prepare_calibration(*p.model, poses, choice, in.o, linear);
     if (st == Status::Ok) linear_quantiles(linear, summary, threads);
   }
   if (st != Status::Ok) raise_study_status(st);
@@ -196,12 +205,8 @@ py::dict linear_py(const py::object& config, const py::object& poses_in, const p
 py::list layouts_py(const py::object& config, const py::object& poses_in, const py::dict& required,
                     const py::dict& sigmas, int threads, const std::string& calibration, const py::object& tracker,
                     std::uint64_t seed, int max_extra) {
-  const PlatformSource p = platform_of(config);
-  const std::vector<Pose> poses = design_poses(p, poses_in, required);
-  ToleranceOptions o;
-  o.sigmas = sigmas_of(sigmas);
-  o.seed = seed;
-  o.threads = threads;
+  const StudyInputs in = study_inputs(config, poses_in, required, sigmas, seed, threads);
+  const auto& [p, poses, o] = in;
   if (!is_tracker_calibration(calibration))
     raise_input(
         "target_layouts: calibration must be a tracker calibration (\"stations:N[,SEED]\" or \"plan\"), got \"" +
