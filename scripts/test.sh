@@ -32,7 +32,7 @@ cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_COMPILER=cl
   -DHEXATWIST_BUILD_BENCHMARKS=OFF -DHEXATWIST_BUILD_EXAMPLES=OFF -DHEXATWIST_ARCH=x86-64-v3 "${ccache_flags[@]}" >/dev/null
 env "${sanitizer_env[@]}" cmake --build build-asan -- -j2
 # Left to the Release stage, to keep CI within its time (this build runs ~25x slower):
-# - the README's printed digits, which are the Release build's (the same commands run here in their
+# - the printed digits of the README and the guide, which are the Release build's (the same commands run here in their
 #   own tests; this build, without AVX-512 and at -O1, differs in an identification's last digits);
 # - the JSON outputs against their schemas (the same writer in both builds);
 # - a closed standard output walked across every command (the same roll back as a failed write,
