@@ -1,6 +1,7 @@
 // hexatwist ik: leg lengths, twist, length error and both motor commands for one pose.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -18,6 +19,32 @@ struct IkOptions {
   std::string temperature_c;
   bool json = false;
 };
+
+// Why a calibrated configuration's conventional command is not the leg's length (theory §4): the
+// drives read motor-side lengths less each leg's zero offset, converted with the drives' own lead
+// from their reference. "" when the configuration has none of these.
+std::string drive_contract_note(const Model& model, const Vector6d& length, const Vector6d& command) {
+  double offset = 0.0, scale = 0.0, differ = 0.0;
+  bool homes = false;
+  for (int i = 0; i < kLegs; ++i) {
+    const LegSpec& leg = model.spec().legs[static_cast<std::size_t>(i)];
+    offset = std::max(offset, std::abs(leg.length_offset));
+    if (std::isfinite(leg.drive_lead)) scale = std::max(scale, std::abs(leg.lead / leg.drive_lead - 1.0));
+    homes = homes || std::isfinite(leg.home_command);
+    differ = std::max(differ, std::abs(command[i] - length[i]));
+  }
+  if (offset == 0.0 && scale == 0.0 && !homes) return {};
+  std::string why;
+  if (offset > 0.0) why += fmt::format("less its zero offset (length_offsets, up to {:.3f} mm)", 1e3 * offset);
+  if (scale > 0.0)
+    why += fmt::format("{}in the drives' lead, not the screw's (drive_lead; they differ by up to {:.0f} ppm)",
+                       why.empty() ? "" : ", ", 1e6 * scale);
+  if (homes) why += fmt::format("{}counted from the drives' reference (home_commands)", why.empty() ? "" : ", ");
+  return fmt::format(
+      "note: command_conv differs from length by up to {:.3f} mm: a calibrated configuration's commands are what each "
+      "drive reads (theory §4): the leg's length {}\n",
+      1e3 * differ, why);
+}
 
 int run_ik(const IkOptions& o) {
   const Config config = load_config_from(o.model);
@@ -98,6 +125,7 @@ int run_ik(const IkOptions& o) {
       out += fmt::format("{:>3}  {:9.6f}  {}  {}  {}  {}  {:14.3f}  {:18.3f}\n", i + 1, report->legs.length[i], tw, le,
                          cc, cp, rad2deg(bend_base[i]), rad2deg(bend_platform[i]));
     }
+    if (ok) out += drive_contract_note(model, report->legs.length, report->conventional);
     if (effects && ok) {
       out += "leg effects (real minus rigid length, compensated; each leg approached from home):\n";
       out += "leg  force[kN]  temperature[degC]  load[um]  thermal[um]  play[um]  total[um]\n";

@@ -80,6 +80,21 @@ TEST(Cli, AHeaderSaysWhichSectionsAreTheSeedsDefaults) {
   }
 }
 
+TEST(Cli, IkSaysWhyACalibratedConfigurationsCommandIsNotTheLength) {
+  // Zero offsets (as identify writes them): the conventional command is the length less the offset,
+  // and the report says so with the largest difference; the seed's own report has no such note.
+  const std::string calibrated = write_file(
+      "offsets.yaml", hexatwist::test::kSymmetricYaml + "length_offsets: [0.0021, -0.0005, 0, 0, 0, 0.0013]\n");
+  const Outcome r = run({"ik", "--pose=0,0,0.1,0,0,10", "--config", calibrated});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("note: command_conv differs from length by up to 2.100 mm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("zero offset (length_offsets, up to 2.100 mm)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("home_commands"), std::string::npos) << r.out;
+  const Outcome s = run({"ik", "--pose=0,0,0.1,0,0,10"});
+  ASSERT_EQ(s.code, 0) << s.err;
+  EXPECT_EQ(s.out.find("note:"), std::string::npos) << s.out;
+}
+
 TEST(Cli, NegativeNumbersWorkWithAndWithoutEquals) {
   const Outcome eq = run({"ik", "--pose=-0.1,0,0,0,0,-5", "--json"});
   const Outcome space = run({"ik", "--pose", "-0.1,0,0,0,0,-5", "--json"});
