@@ -96,6 +96,9 @@ double lead_sensitivity(const Model& model, const CommandReport& r) {
 
 using Params = std::array<double, 4>;  // turn of ja, turn of jd, tilt of ja, tilt of jd [rad]
 
+// With tilts, the global grid samples each tilt at this many levels over [-max_tilt, max_tilt].
+constexpr int kTiltLevels = 5;
+
 struct Group {
   std::vector<int> legs;
   std::vector<double> sign;  // the in-plane turns' sign per leg (mirror legs turn the other way)
@@ -284,8 +287,10 @@ class Search {
     return s;
   }
 
-  // Global grid of in-plane turns, then a local compass search from the best few (with tilts if
-  // asked), for group gi; keeps the best in params_.
+  // Global grid of in-plane turns (with tilts if asked: kTiltLevels of each over [-max_tilt,
+  // max_tilt]), then a local compass search from the best few, for group gi; keeps the best in
+  // params_. The largest twist is a maximum over poses, not smooth: a compass search stops at its
+  // kinks, so the tilts are sampled globally as the turns are, not only searched from zero.
   void optimise_group(std::size_t gi, std::size_t budget) {
     const int n = std::max(1, static_cast<int>(std::lround(kPi / o_.grid_step)));
     struct Candidate {
@@ -294,12 +299,19 @@ class Search {
     };
     std::vector<Candidate> grid;
     const Params current = params_[gi];
+    std::vector<double> tilts{current[2]};
+    if (o_.tilt && o_.max_tilt > 0.0) {
+      tilts.clear();
+      for (int k = 0; k < kTiltLevels; ++k) tilts.push_back(o_.max_tilt * (2.0 * k / (kTiltLevels - 1) - 1.0));
+    }
     for (int a = 0; a < n; ++a)
-      for (int b = 0; b < n; ++b) {
-        // Turns in [-90, 90) deg: an axis is a line, so this covers every direction in the plane.
-        const Params p{-kPi / 2 + kPi * a / n, -kPi / 2 + kPi * b / n, current[2], current[3]};
-        grid.push_back({score(gi, p, budget), p});
-      }
+      for (int b = 0; b < n; ++b)
+        for (const double ta : tilts)
+          for (const double td : o_.tilt&& o_.max_tilt > 0.0 ? tilts : std::vector<double>{current[3]}) {
+            // Turns in [-90, 90) deg: an axis is a line, so this covers every direction in the plane.
+            const Params p{-kPi / 2 + kPi * a / n, -kPi / 2 + kPi * b / n, ta, td};
+            grid.push_back({score(gi, p, budget), p});
+          }
     grid.push_back({score(gi, current, budget), current});
     std::sort(grid.begin(), grid.end(),
               [](const Candidate& x, const Candidate& y) { return better(x.score, y.score); });
