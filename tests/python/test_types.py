@@ -298,6 +298,7 @@ def calls():
         "workspace_map": hexatwist.workspace_map(model, spacing=0.1),
         "design_axes": hexatwist.design_axes(rig, w.poses, volume_samples=100, cell=0.1, grid_step=0.3),
         "tolerance": hexatwist.tolerance(rig, w.poses, platforms=4),
+        "target_layouts": hexatwist.target_layouts(rig, w.poses, max_extra=1, calibration="stations:14")[1],
         "map_batch": hexatwist.map_batch("commands", model, q),
         "map_simulations": hexatwist.map_simulations([dict(poses=q_sim)])[0],
     }
