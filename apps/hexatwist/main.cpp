@@ -25,6 +25,24 @@ void print_error(std::string_view prefix, std::string_view message) {
   std::fprintf(stderr, "%s\n", line.c_str());
 }
 
+// The option of the command being run that sets the library's parameter `name`: --name, else
+// --name-UNIT (tracker_noise is --tracker-noise-um, targets --targets-mm); --name when it has none.
+std::string option_for(const std::vector<hexatwist::cli::Command>& commands, std::string name) {
+  std::replace(name.begin(), name.end(), '_', '-');
+  const std::string flag = "--" + name;
+  for (const hexatwist::cli::Command& c : commands) {
+    if (!c.app->parsed()) continue;
+    std::string with_unit;
+    for (const CLI::Option* o : c.app->get_options())
+      for (const std::string& l : o->get_lnames()) {
+        if ("--" + l == flag) return flag;
+        if (with_unit.empty() && ("--" + l).starts_with(flag + "-")) with_unit = "--" + l;
+      }
+    if (!with_unit.empty()) return with_unit;
+  }
+  return flag;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -93,9 +111,7 @@ int main(int argc, char** argv) {
   } catch (const hexatwist::ParameterError& e) {
     signals::stop_on_request();
     // The library names the parameter at fault; the command line names it as its option.
-    std::string option = "--" + e.parameter();
-    std::replace(option.begin(), option.end(), '_', '-');
-    print_error("hexatwist: error: ", fmt::format("{} [{}]", e.what(), option));
+    print_error("hexatwist: error: ", fmt::format("{} [{}]", e.what(), option_for(commands, e.parameter())));
     return kExitBadInput;
   } catch (const hexatwist::Error& e) {
     signals::stop_on_request();

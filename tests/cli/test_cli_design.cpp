@@ -241,8 +241,10 @@ TEST(CliTolerance, TargetsAroundThePlatformCalibrateThePivotAndTheLayoutsSayWher
   expect_error(run({"tolerance", "--targets-mm", "100,0,0"}), 2, {"--targets-mm", "tracker calibration"});
   expect_error(run({"tolerance", "--target-layouts", "2"}), 2, {"--target-layouts", "tracker calibration"});
   expect_error(run({"tolerance", "--calibration", "stations:20", "--targets-mm", "100,0"}), 2, {"--targets-mm"});
+  // The library's parameter (targets) named as the option that sets it, its unit suffix included.
   expect_error(run({"tolerance", "--calibration", "stations:20", "--targets-mm", "1200,0,0.5"}), 2,
-               {"targets", "within 1 mm"});
+               {"within 1 mm", "[--targets-mm]"});
+
   expect_error(run({"tolerance", "--calibration", "stations:20", "--target-layouts", "9"}), 2, {"--target-layouts"});
 }
 
