@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <string>
 
+#include "signals.hpp"
+
 namespace hexatwist::cli {
 
 namespace {
@@ -52,6 +54,7 @@ void Progress::update(std::size_t done, std::string_view what) {
   std::fprintf(stderr, "\r%-*s", kLineWidth, line.c_str());
   std::fflush(stderr);
   shown_ = true;
+  signals::set_progress_line(true);
 }
 
 void Progress::finish() noexcept {
@@ -59,6 +62,7 @@ void Progress::finish() noexcept {
   std::fprintf(stderr, "\r%*s\r", kLineWidth, "");
   std::fflush(stderr);
   shown_ = false;
+  signals::set_progress_line(false);
 }
 
 }  // namespace hexatwist::cli

@@ -32,6 +32,7 @@ std::atomic<int> g_critical{0};       // live Critical sections, all threads
 std::atomic<bool> g_aborting{false};  // a thread is rolling back and exiting
 std::atomic<int> g_pending{0};        // the stop signal received, 0 if none
 std::atomic<bool> g_on_request{false};
+std::atomic<bool> g_progress_line{false};  // a progress line is drawn, not ended
 
 void say(const char* text) noexcept {
   std::size_t left = std::strlen(text);
@@ -95,6 +96,7 @@ void abort_run(int sig) noexcept {
       it->undo(it->context);
       undone = true;
     }
+  if (g_progress_line.load()) say("\n");
   say("hexatwist: stopped by ");
   say(name_of(sig));
   say(undone ? "; the run was rolled back: every file is as it was before it, nothing was written\n" : "\n");
@@ -131,6 +133,8 @@ void install() {
   pipe.sa_flags = SA_RESTART;
   ::sigaction(SIGPIPE, &pipe, nullptr);
 }
+
+void set_progress_line(bool shown) noexcept { g_progress_line.store(shown); }
 
 void stop_on_request() {
   g_on_request.store(true);

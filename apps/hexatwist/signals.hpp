@@ -48,6 +48,10 @@ void remove_undo(Undo undo, void* context) noexcept;
 void add_child(pid_t pid) noexcept;
 void remove_child(pid_t pid) noexcept;
 
+/// Whether a progress line (progress.hpp) is on the terminal without its newline: a signal's
+/// message then starts on a line of its own.
+void set_progress_line(bool shown) noexcept;
+
 /// Removes the files in `dir` and then `dir` (one level), with system calls only: for the undo of
 /// a scratch folder.
 void remove_flat_dir(const char* dir) noexcept;

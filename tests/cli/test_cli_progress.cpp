@@ -22,8 +22,9 @@ struct TerminalOutcome {
   std::string out;       // its stdout, a file
 };
 
-// Runs the tool with stderr on a pseudo-terminal (stdout to a file), bounded to 120 s.
-TerminalOutcome run_on_terminal(const std::vector<std::string>& args) {
+// Runs the tool with stderr on a pseudo-terminal (stdout to a file), bounded to 120 s; with
+// `interrupt` it gets SIGINT once the progress line has shown 5 % (then "%" and a line).
+TerminalOutcome run_on_terminal(const std::vector<std::string>& args, bool interrupt = false) {
   TerminalOutcome r;
   const std::string out_path = (temp_dir() / "terminal-stdout.txt").string();
   std::vector<std::string> argv_text{HEXATWIST_CLI};
@@ -53,6 +54,10 @@ TerminalOutcome run_on_terminal(const std::vector<std::string>& args) {
     const ssize_t n = read(master, buf, sizeof buf);
     if (n <= 0) break;  // EIO: the child closed the terminal
     r.terminal.append(buf, static_cast<std::size_t>(n));
+    if (interrupt && r.terminal.find("  5%") != std::string::npos) {
+      kill(pid, SIGINT);
+      interrupt = false;
+    }
   }
   close(master);
   int status = 0;
@@ -65,17 +70,19 @@ TerminalOutcome run_on_terminal(const std::vector<std::string>& args) {
 TEST(CliProgress, ToleranceDrawsItsProgressOnATerminalOnlyAndInPartsGetsTheSameResult) {
   const std::string on_tty = (temp_dir() / "progress-tty").string();
   const std::string piped = (temp_dir() / "progress-piped").string();
-  const std::vector<std::string> study{"tolerance",     "--platforms", "300",
-                                       "--calibration", "stations:14", "--no-figures"};
+  // 20 stations calibrate every platform (14 would leave them all not identifiable).
+  const std::vector<std::string> study{"tolerance",     "--platforms", "20",
+                                       "--calibration", "stations:20", "--no-figures"};
   std::vector<std::string> args = study;
   args.insert(args.end(), {"--out", on_tty});
   const TerminalOutcome t = run_on_terminal(args);
   ASSERT_EQ(t.code, 0) << t.terminal;
   // The bar, its share and the platforms done; the line erased at the end (its last write a '\r').
-  EXPECT_NE(t.terminal.find("] 100%  300 of 300 platforms"), std::string::npos) << t.terminal;
-  EXPECT_NE(t.terminal.find("%  3 of 300 platforms"), std::string::npos) << t.terminal;
+  EXPECT_NE(t.terminal.find("] 100%  20 of 20 platforms"), std::string::npos) << t.terminal;
+  EXPECT_NE(t.terminal.find("%  1 of 20 platforms"), std::string::npos) << t.terminal;
   EXPECT_EQ(t.terminal.back(), '\r');
-  EXPECT_NE(t.out.find("300 platforms (seed 1)"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("20 platforms (seed 1)"), std::string::npos) << t.out;
+  EXPECT_EQ(t.out.find("calibration failed"), std::string::npos) << t.out;
   // Piped: no line at all, and the Monte Carlo in one call gives every platform's errors bit for bit.
   args = study;
   args.insert(args.end(), {"--out", piped});
@@ -91,6 +98,19 @@ TEST(CliProgress, ToleranceDrawsItsProgressOnATerminalOnlyAndInPartsGetsTheSameR
   ASSERT_EQ(j.code, 0) << j.terminal;
   EXPECT_EQ(j.terminal, "");
   EXPECT_EQ(j.out.front(), '{');
+}
+
+TEST(CliProgress, AnInterruptedRunsMessageStartsOnALineOfItsOwn) {
+  // SIGINT while the line is drawn: the roll-back message after a newline, not appended to the bar.
+  const TerminalOutcome t = run_on_terminal({"tolerance", "--platforms", "400", "--calibration", "stations:20",
+                                             "--no-figures", "--out", (temp_dir() / "progress-stopped").string()},
+                                            true);
+  EXPECT_EQ(t.code, 6) << t.terminal;
+  const std::size_t at = t.terminal.find("hexatwist: stopped by SIGINT");
+  ASSERT_NE(at, std::string::npos) << t.terminal;
+  ASSERT_GT(at, 0u);
+  EXPECT_EQ(t.terminal[at - 1], '\n') << t.terminal.substr(at > 80 ? at - 80 : 0);
+  EXPECT_FALSE(std::filesystem::exists(temp_dir() / "progress-stopped"));
 }
 
 TEST(CliProgress, StudyDrawsItsTestsOnATerminal) {

@@ -94,7 +94,7 @@ def main() -> int:
         printed(["tolerance", *small, "--platforms", "5", "--no-figures", "--no-csv", "--out", "to", "--json"])
         file("to/summary.json")
         # After a tracker calibration with more targets, comparing layouts of them.
-        printed(["tolerance", *small, "--platforms", "3", "--calibration", "stations:14", "--points-per-station", "3",
+        printed(["tolerance", *small, "--platforms", "3", "--calibration", "stations:20", "--points-per-station", "3",
                  "--targets-mm", "-600,0,0", "--target-layouts", "1", "--no-figures", "--no-csv", "--out", "tt",
                  "--json"])
         printed(["workspace", "--heights", "0", "--spacing", "0.1", "--yaws", "0", "--map-spacing", "0.2", "--cell",
