@@ -86,6 +86,30 @@ void BM_CompensatedCommandWithLegEffectsPerCall(benchmark::State& state) {
 }
 BENCHMARK(BM_CompensatedCommandWithLegEffectsPerCall)->MinTime(2.0);
 
+// Each effect alone, to see where the time of the command above goes.
+const Model& one_effect_model(int which) {
+  static const std::array<Model, 3> models = {
+      load_model(std::string(seed_config_yaml()) + "\nleg_effects:\n  stiffness: 2.0e8\n", "load"),
+      load_model(std::string(seed_config_yaml()) +
+                     "\nleg_effects:\n  length_expansion: 11.5e-6\n  lead_expansion: 11.5e-6\n"
+                     "  reference_temperature: 20\n",
+                 "heat"),
+      load_model(std::string(seed_config_yaml()) + "\nleg_effects:\n  play: 50.0e-6\n  home_direction: 1\n", "play")};
+  return models[static_cast<std::size_t>(which)];
+}
+void BM_CompensatedCommandWithOneLegEffectPerCall(benchmark::State& state) {
+  const Model& em = one_effect_model(static_cast<int>(state.range(0)));
+  LegInputs inputs;
+  if (state.range(0) == 1) inputs.temperature = Vector6d::Constant(23.5);
+  PlayState play;
+  start_play(em, em.geometry().home_command, play);
+  time_each_command(state, [&](const Pose& p, Vector6d& cmd, LimitReport& lim) {
+    return motor_commands(em, p, Strategy::Compensated, inputs, &play, cmd, lim);
+  });
+  state.SetLabel(state.range(0) == 0 ? "load" : state.range(0) == 1 ? "heat" : "play");
+}
+BENCHMARK(BM_CompensatedCommandWithOneLegEffectPerCall)->DenseRange(0, 2)->MinTime(1.0);
+
 void BM_TwistAwareFkWarmPerCall(benchmark::State& state) {
   // From the pose 1 ms earlier on the motion, as a servo loop at 1 kHz does.
   const Motion& m = motion();

@@ -120,9 +120,6 @@ Pose parse_pose_m_deg(const std::string& text, const std::string& option);
 /// A rounding-level value (|v| < 1e-12) as 0, so that text output shows 0.0000, not -0.0000.
 inline double tidy(double v) { return std::abs(v) < 1e-12 ? 0.0 : v; }
 
-/// "leg 3: length 2.5012 m above the maximum 2.45 m": one line for a limit report.
-std::string describe_limit(const LimitReport& report);
-
 /// Writes a JSON object for a limit report (or null if none).
 class JsonWriter;
 void write_limit_json(JsonWriter& json, const LimitReport& report);

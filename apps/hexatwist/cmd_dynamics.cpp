@@ -244,7 +244,7 @@ int run_dynamics(const DynamicsOptions& o) {
   if (const Status status = size_motors(rig, traj, sizing); status != Status::Ok) {
     const std::string where = fmt::format("{}: t = {:.3f} s", printable(o.trajectory), sizing.failed_time);
     if (is_limit(status))
-      throw ExitError(kExitOutOfLimit, fmt::format("{}: {}; nothing was written", where, describe_limit(sizing.limit)));
+      throw ExitError(kExitOutOfLimit, fmt::format("{}: {}; nothing was written", where, describe(sizing.limit)));
     throw ExitError(kExitOutOfLimit,
                     fmt::format("{} (sample {}): inverse dynamics failed: {} ({}); nothing was written", where,
                                 sizing.failed_index, describe(status), to_string(status)));

@@ -87,7 +87,7 @@ int run_fk(const FkOptionsCli& o) {
     return kExitOutOfLimit;
   }
   if (final_status != Status::Ok) {
-    std::fprintf(stderr, "hexatwist: pose outside a limit: %s\n", describe_limit(limit).c_str());
+    std::fprintf(stderr, "hexatwist: pose outside a limit: %s\n", describe(limit).c_str());
     return kExitOutOfLimit;
   }
   return kExitOk;

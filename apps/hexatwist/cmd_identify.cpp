@@ -455,10 +455,7 @@ int run_identify(const IdentifyOptions& o) {
   const Model& model = config.rig.model();
   const PointLogFormat format = log_format(o.log);
   check_option(o.settle >= 0.0, "--settle", o.settle, "a time >= 0 [s]");
-  if (!std::isnan(o.tracker_noise_um))
-    check_option(o.tracker_noise_um > 0.0 && o.tracker_noise_um < 1e4, "--tracker-noise-um", o.tracker_noise_um,
-                 "a standard deviation > 0 and below 1e4 [um]");
-  check_option(o.folds == 0 || (o.folds >= 2 && o.folds <= 100), "--folds", o.folds, "0 (none) or 2 to 100");
+  check_identification_options(library_options(o));  // before the log is read: exit 2 naming the option
   const Run run = build_run(config, o.run);
   check_option(o.settle < run.test.trajectory.duration(), "--settle", o.settle,
                fmt::format("a time shorter than the run ({:g} s): no point can be still for longer [s]",

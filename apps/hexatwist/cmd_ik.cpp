@@ -134,12 +134,11 @@ int run_ik(const IkOptions& o) {
                            e.temperature[i], 1e6 * tidy(e.load[i]), 1e6 * tidy(e.thermal[i]), 1e6 * tidy(e.play[i]),
                            1e6 * tidy(e.total[i]));
     }
-    out +=
-        fmt::format("status: {}\n", ok ? "ok" : std::string(to_string(status)) + ": " + describe_limit(report->limit));
+    out += fmt::format("status: {}\n", ok ? "ok" : std::string(to_string(status)) + ": " + describe(report->limit));
     write_stdout(out);
   }
   if (!ok) {
-    std::fprintf(stderr, "hexatwist: pose outside a limit: %s\n", describe_limit(report->limit).c_str());
+    std::fprintf(stderr, "hexatwist: pose outside a limit: %s\n", describe(report->limit).c_str());
     return kExitOutOfLimit;
   }
   return kExitOk;

@@ -101,12 +101,12 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
   for (int k = 0; k < 6; ++k) {
     AxisRange range;
     if (const Status s = axis_range(model, k, strategy, range); s != Status::Ok)
-      throw ExitError(kExitOutOfLimit, fmt::format("home is outside a limit: {}", describe_limit(range.upper_limit)));
+      throw ExitError(kExitOutOfLimit, fmt::format("home is outside a limit: {}", describe(range.upper_limit)));
     const bool linear = k < 3;
     const double scale = linear ? unit : rad2deg(1.0);
     const double offset = k == 2 ? home_z * unit : 0.0;
     const auto end = [&](const LimitReport& r) {
-      return r.status == Status::Ok ? std::string("search bound") : describe_limit(r);
+      return r.status == Status::Ok ? std::string("search bound") : describe(r);
     };
     t += fmt::format(
         "[AXIS_{}]\n# Reach along {} alone from home: below, {}; above, {}.\nMIN_LIMIT = {}\nMAX_LIMIT = {}\n"

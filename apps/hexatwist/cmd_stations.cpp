@@ -51,24 +51,13 @@ StationPlanSpec plan_spec(const Model& model, const StationsOptions& o) {
   range_option(o.range, spec.run);
   spec.run.seed = o.seed;
   // How the run visits the planned stations (run_options' --both-sides-mm and --reference-every).
-  check_option(o.both_sides_mm >= 0.0 && o.both_sides_mm <= kMaxApproach * 1e3, "--both-sides-mm", o.both_sides_mm,
-               fmt::format("0 to {:g} mm", kMaxApproach * 1e3));
   spec.run.approach = o.both_sides_mm * 1e-3;
   spec.run.reference_every = o.reference_every;
-  const int fewest = min_planned_stations(model, spec);
-  check_option(
-      o.count >= fewest && o.count <= kMaxStations, "--count", o.count,
-      fmt::format("{} to {} stations (with home's rests, as many equations as the parameters)", fewest, kMaxStations));
   spec.run.count = o.count;
-  check_option(o.candidates >= o.count && o.candidates <= kMaxCandidates, "--candidates", o.candidates,
-               fmt::format("the stations ({}) to {} candidates", o.count, kMaxCandidates));
   spec.candidates = o.candidates;
-  check_option(o.noise_um > 0.0 && o.noise_um < 1e4, "--noise-um", o.noise_um,
-               "a standard deviation > 0 and below 1e4 [um]");
   spec.noise = o.noise_um / 1e6;  // correctly rounded: 10 um is 1e-5 m exactly as Python gives it
-  check_option(o.points_per_station >= 1 && o.points_per_station <= 1000000, "--points-per-station",
-               o.points_per_station, "1 to 1000000 points");
   spec.points_per_station = o.points_per_station;
+  check_station_plan_spec(model, spec);  // the library's ranges: exit 2 naming the option (main.cpp)
   return spec;
 }
 
@@ -192,17 +181,8 @@ int run_stations(const StationsOptions& o) {
   const StationPlanSpec spec = plan_spec(model, o);
   const std::size_t every = rows_every(config.rig, o.rate);
   StationPlan plan;
-  try {
-    if (plan_stations(model, strategy, spec, plan) != Status::Ok)
-      throw ExitError(kExitOutOfLimit, fmt::format("{}; nothing was written", plan.reason));
-  } catch (const ParameterError& e) {
-    // The options checked above keep the library's own checks from refusing; should one still
-    // refuse, it names its field, which is this option.
-    const std::string& p = e.parameter();
-    std::string option = p == "translation" || p == "rotation" ? "--range" : p == "noise" ? "--noise-um" : "--" + p;
-    std::replace(option.begin(), option.end(), '_', '-');
-    throw ExitError(kExitBadInput, fmt::format("{}: {}", option, e.what()));
-  }
+  if (plan_stations(model, strategy, spec, plan) != Status::Ok)
+    throw ExitError(kExitOutOfLimit, fmt::format("{}; nothing was written", plan.reason));
   Trajectory run;
   try {
     run = station_run(model, strategy, plan.planned.stations, spec.run, config.rig.control_period());

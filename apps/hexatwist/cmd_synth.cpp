@@ -309,7 +309,7 @@ int run_synth(const SynthOptions& o) {
   if (const Status s = check_trajectory(rig, run.test.trajectory, issue); s != Status::Ok)
     throw ExitError(kExitOutOfLimit,
                     fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
-                                is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+                                is_limit(s) ? describe(issue.limit) : std::string(describe(s))));
   SyntheticLog log;
   Status synthesized = Status::Ok;
   try {
@@ -323,7 +323,7 @@ int run_synth(const SynthOptions& o) {
   if (const Status s = synthesized; s != Status::Ok)
     throw ExitError(kExitOutOfLimit,
                     fmt::format("{}: t = {:.3f} s: {}; nothing was written", run.test.label, issue.time,
-                                is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+                                is_limit(s) ? describe(issue.limit) : std::string(describe(s))));
 
   files.add(out, log_csv(log, !so.extra_targets_P.empty()));
   files.add(truth, truth_json(config, o, run, so, log));

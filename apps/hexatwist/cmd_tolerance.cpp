@@ -53,20 +53,28 @@ struct ToleranceCommandOptions {
 };
 
 ToleranceSigmas sigmas_of(const ToleranceCommandOptions& o) {
-  const auto um = [](double v, const char* option) {
-    check_option(v >= 0.0 && v <= 1e5, option, v, "a standard deviation from 0 to 1e5 um");
-    return 1e-6 * v;
-  };
+  const bool base = !std::isnan(o.base_joint_um), platform = !std::isnan(o.platform_joint_um);
   ToleranceSigmas s;
-  s.base_joint = um(std::isnan(o.base_joint_um) ? o.joint_um : o.base_joint_um,
-                    std::isnan(o.base_joint_um) ? "--sigma-joint-um" : "--sigma-base-joint-um");
-  s.platform_joint = um(std::isnan(o.platform_joint_um) ? o.joint_um : o.platform_joint_um,
-                        std::isnan(o.platform_joint_um) ? "--sigma-joint-um" : "--sigma-platform-joint-um");
-  check_option(o.axis_deg >= 0.0 && o.axis_deg <= 10.0, "--sigma-axis-deg", o.axis_deg, "0 to 10 deg");
+  s.base_joint = 1e-6 * (base ? o.base_joint_um : o.joint_um);
+  s.platform_joint = 1e-6 * (platform ? o.platform_joint_um : o.joint_um);
   s.base_axis = s.platform_axis = deg2rad(o.axis_deg);
-  check_option(o.lead_ppm >= 0.0 && o.lead_ppm <= 1e5, "--sigma-lead-ppm", o.lead_ppm, "0 to 1e5 ppm");
   s.lead = 1e-6 * o.lead_ppm;
-  s.offset = um(o.offset_um, "--sigma-offset-um");
+  s.offset = 1e-6 * o.offset_um;
+  // The library's ranges (check_tolerance_sigmas), each field named as the option that set it.
+  try {
+    check_tolerance_sigmas(s);
+  } catch (const ParameterError& e) {
+    const std::string& f = e.parameter();
+    const auto [option, typed] =
+        f == "base_joint"
+            ? std::pair{base ? "--sigma-base-joint-um" : "--sigma-joint-um", base ? o.base_joint_um : o.joint_um}
+        : f == "platform_joint" ? std::pair{platform ? "--sigma-platform-joint-um" : "--sigma-joint-um",
+                                            platform ? o.platform_joint_um : o.joint_um}
+        : f == "lead"   ? std::pair{"--sigma-lead-ppm", o.lead_ppm}
+        : f == "offset" ? std::pair{"--sigma-offset-um", o.offset_um}
+                        : std::pair{"--sigma-axis-deg", o.axis_deg};
+    throw ExitError(kExitBadInput, fmt::format("{} {:g}: {}", option, typed, e.what()));
+  }
   return s;
 }
 
@@ -82,12 +90,8 @@ void sigmas_json(JsonWriter& j, const ToleranceSigmas& s) {
 CalibrationChoice calibration_of(const ToleranceCommandOptions& o) {
   CalibrationChoice c;
   c.name = o.calibration;
-  check_option(o.tracker_noise_um > 0.0 && o.tracker_noise_um <= 1e4, "--tracker-noise-um", o.tracker_noise_um,
-               "a standard deviation above 0 and up to 1e4 um");
   c.tracker_noise = o.tracker_noise_um / 1e6;  // correctly rounded: 20 um is 20e-6 m
-  check_option(o.points_per_station >= 1 && o.points_per_station <= kMaxPointsPerStation, "--points-per-station",
-               o.points_per_station, fmt::format("1 to {} points", kMaxPointsPerStation));
-  c.points = o.points_per_station;
+  c.points = o.points_per_station;             // both checked by the library (check_tracker_calibration)
   c.frames = o.calibration_frames == "joints" ? CalibratedFrames::Joints : CalibratedFrames::Tracker;
   c.extra_targets_P = targets_option(o.targets_mm);
   if (!o.station_plan.empty()) {

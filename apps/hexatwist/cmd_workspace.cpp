@@ -499,12 +499,11 @@ std::string text_report(const Model& model, const WorkspaceCommandOptions& o, co
     }
     if (std::isinf(lo)) {
       out += fmt::format("  yaw {:+g} deg: out of reach at zero tilt ({})\n", rad2deg(r.orientation.spec.torsions[t]),
-                         describe_limit(r.orientation.reach[t].front().limit));
+                         describe(r.orientation.reach[t].front().limit));
       continue;
     }
     out += fmt::format("  yaw {:+g} deg: {:.1f} to {:.1f} deg; least towards {:.0f} deg ({})\n",
-                       rad2deg(r.orientation.spec.torsions[t]), rad2deg(lo), rad2deg(hi), rad2deg(at),
-                       describe_limit(limit));
+                       rad2deg(r.orientation.spec.torsions[t]), rad2deg(lo), rad2deg(hi), rad2deg(at), describe(limit));
   }
   const MapSummary ms = summarize(r.map);
   if (ms.inside > 0) {

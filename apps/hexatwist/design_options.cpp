@@ -139,7 +139,7 @@ RequiredPoses required_poses(const Config& config, const RequiredOptions& o) {
                         fmt::format("{}:{}: t = {:g} s: {}; every pose of a required trajectory must be inside every "
                                     "limit",
                                     printable(path), k < rows.lines.size() ? rows.lines[k] : static_cast<int>(k + 2),
-                                    rows.t[k], describe_limit(report)));
+                                    rows.t[k], describe(report)));
       r.poses.push_back(rows.poses[k]);
     }
   }

@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "cli_common.hpp"
+#include "hexatwist/version.hpp"
 #include "signals.hpp"
 
 namespace {
@@ -27,7 +28,10 @@ void print_error(std::string_view prefix, std::string_view message) {
 
 // The option of the command being run that sets the library's parameter `name`: --name, else
 // --name-UNIT (tracker_noise is --tracker-noise-um, targets --targets-mm); --name when it has none.
+// The fields whose option has another name: the stations' ranges and approach.
 std::string option_for(const std::vector<hexatwist::cli::Command>& commands, std::string name) {
+  if (name == "translation" || name == "rotation") name = "range";
+  if (name == "approach") name = "both_sides";
   std::replace(name.begin(), name.end(), '_', '-');
   const std::string flag = "--" + name;
   for (const hexatwist::cli::Command& c : commands) {
@@ -56,7 +60,7 @@ int main(int argc, char** argv) {
       "the data do not determine the parameters, 6 stopped by SIGINT, SIGTERM or SIGHUP (rolled back: nothing "
       "written)."};
   app.require_subcommand(1);
-  app.set_version_flag("--version", std::string("hexatwist ") + "0.1.0");
+  app.set_version_flag("--version", std::string("hexatwist ") + std::string(hexatwist::kVersion));
   const std::vector<Command> commands = add_commands(app);
   // Help and version go to standard output like every result: a failed write is exit 4.
   const auto print_and_check = [&](const CLI::Error& e) {

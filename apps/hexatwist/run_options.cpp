@@ -24,14 +24,18 @@ Run build_run(const Config& config, const RunOptions& o) {
     StationsSpec spec;
     spec.count = o.stations;
     spec.seed = o.station_seed;
-    check_option(o.both_sides_mm >= 0.0 && o.both_sides_mm <= kMaxApproach * 1e3, "--both-sides-mm", o.both_sides_mm,
-                 fmt::format("0 to {:g} mm", kMaxApproach * 1e3));
     spec.approach = o.both_sides_mm * 1e-3;
     spec.reference_every = o.reference_every;
     try {
       run.test.trajectory = stations_trajectory(config.rig.model(), strategy_of(o), spec, dt);
     } catch (const ParameterError& e) {
-      throw ExitError(kExitBadInput, e.what());
+      // The library's check (check_stations_spec) names the field: here, the run option that set it.
+      const std::string& f = e.parameter();
+      const char* option = f == "count"             ? "--stations"
+                           : f == "approach"        ? "--both-sides-mm"
+                           : f == "reference_every" ? "--reference-every"
+                                                    : "--stations";
+      throw ExitError(kExitBadInput, fmt::format("{}: {}", option, e.what()));
     } catch (const Error& e) {
       throw ExitError(kExitOutOfLimit, fmt::format("--stations: {}", e.what()));
     }

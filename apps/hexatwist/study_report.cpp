@@ -337,7 +337,7 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const Vect
     SimulationIssue issue;
     if (const Status s = check_trajectory(rig, t.trajectory, issue); s != Status::Ok)
       throw ExitError(kExitOutOfLimit, fmt::format("{}: {}; nothing was simulated{}", where(t, issue),
-                                                   is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s)),
+                                                   is_limit(s) ? describe(issue.limit) : std::string(describe(s)),
                                                    amplitude_hint(t, s)));
   }
   std::size_t total = 0;
@@ -350,9 +350,8 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const Vect
                               [&](std::size_t done, std::size_t) { bar.update(before + done, t.name); });
     if (s != Status::Ok) {
       bar.finish();
-      throw ExitError(kExitOutOfLimit,
-                      fmt::format("{}: simulation stopped: {}; no report was written", where(t, issue),
-                                  is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+      throw ExitError(kExitOutOfLimit, fmt::format("{}: simulation stopped: {}; no report was written", where(t, issue),
+                                                   is_limit(s) ? describe(issue.limit) : std::string(describe(s))));
     }
     before += 3 * t.trajectory.poses.size();
   }
@@ -360,9 +359,8 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const Vect
   for (ReportedTest& t : tests) {
     SimulationIssue issue;
     if (const Status s = effect_costs(rig.model(), t.trajectory, temperature_rise, t.effects, issue); s != Status::Ok)
-      throw ExitError(kExitOutOfLimit,
-                      fmt::format("{}: the legs' effects: {}; no report was written", where(t, issue),
-                                  is_limit(s) ? describe_limit(issue.limit) : std::string(describe(s))));
+      throw ExitError(kExitOutOfLimit, fmt::format("{}: the legs' effects: {}; no report was written", where(t, issue),
+                                                   is_limit(s) ? describe(issue.limit) : std::string(describe(s))));
   }
 }
 

@@ -72,7 +72,7 @@ py::array_t<double> motor_command(const Model& model, const py::object& pose_in,
   LimitReport r;
   const Status s = motor_commands(model, pose, strategy, c, r);
   if (s == Status::NonFiniteInput) raise_input("pose: holds NaN or inf");
-  if (s != Status::Ok) raise_status(s, "pose outside a limit (" + limit_text(r) + ")");
+  if (s != Status::Ok) raise_status(s, "pose outside a limit: " + describe(r));  // the CLI's words
   py::array_t<double> out(6);
   std::copy(c.data(), c.data() + 6, out.mutable_data());
   return out;

@@ -134,8 +134,6 @@ constexpr int leg_number(int index) noexcept { return index + 1; }
 
 /// A limit report as a dict: status (name), leg (1 to 6; 0 for none), value, bound.
 py::dict limit_dict(const LimitReport& r);
-/// "leg 2, value 2.5, bound 2.45" (no leg for a limit of the whole platform), for messages.
-std::string limit_text(const LimitReport& r);
 
 /// A (6,) float64 vector argument (lists accepted); InputError naming it otherwise, or for NaN/inf.
 Vector6d vector6(const py::handle& obj, const char* name);

@@ -88,15 +88,10 @@ IdentificationOptions options_of(const std::string& calibration, const std::stri
     o.axes = AxisFit::All;
   else
     raise_input("axes: expected 'auto', 'none' or 'all', got '" + axes + "'");
-  if (!tracker_noise.is_none()) {
-    const double v = tracker_noise.cast<double>();
-    if (!(v > 0.0 && v < 1e-2)) raise_input("tracker_noise: expected a standard deviation > 0 and below 0.01 [m]");
-    o.tracker_noise = v;
-  }
-  if (!(folds == 0 || (folds >= 2 && folds <= 100))) raise_input("folds: expected 0 (none) or 2 to 100");
-  if (!(accuracy_poses >= 1 && accuracy_poses <= 100000)) raise_input("accuracy_poses: expected 1 to 100000");
+  if (!tracker_noise.is_none()) o.tracker_noise = tracker_noise.cast<double>();
   o.folds = folds;
   o.accuracy_poses = accuracy_poses;
+  check_identification_options(o);  // the library's ranges: InputError naming the keyword
   return o;
 }
 

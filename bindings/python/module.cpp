@@ -2,10 +2,12 @@
 // concept. The public API, its typed results and docstrings are in python/hexatwist/ (one module per
 // subsystem); python/hexatwist/_hexatwist.pyi types this module.
 #include "common.hpp"
+#include "hexatwist/version.hpp"
 
 PYBIND11_MODULE(_hexatwist, m) {
   using namespace hexatwist::python;
   m.doc() = "hexatwist: twist-aware kinematics of lead-screw Stewart platforms (compiled core)";
+  m.attr("version") = std::string(hexatwist::kVersion);
   expose_errors(m);
   expose_model(m);
   expose_kinematics(m);

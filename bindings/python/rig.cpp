@@ -101,11 +101,6 @@ py::dict limit_dict(const LimitReport& r) {
   return d;
 }
 
-std::string limit_text(const LimitReport& r) {
-  return (r.leg >= 0 ? "leg " + std::to_string(leg_number(r.leg)) + ", " : std::string()) + "value " +
-         std::to_string(r.value) + ", bound " + std::to_string(r.bound);
-}
-
 void expose_rig(py::module_& m) {
   py::class_<PyRig, std::shared_ptr<PyRig>> c(
       m, "Rig",

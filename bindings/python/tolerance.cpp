@@ -16,7 +16,6 @@ ToleranceSigmas sigmas_of(const py::dict& d) {
   const auto get = [&](const char* key, double& out) {
     if (!d.contains(key)) return;
     out = d[key].cast<double>();
-    if (!(out >= 0.0) || !std::isfinite(out)) raise_input(std::string("sigmas: ") + key + " must be finite and >= 0");
   };
   for (const auto& kv : d) {
     const std::string k = kv.first.cast<std::string>();
@@ -31,6 +30,7 @@ ToleranceSigmas sigmas_of(const py::dict& d) {
   get("platform_axis", s.platform_axis);
   get("lead", s.lead);
   get("offset", s.offset);
+  check_tolerance_sigmas(s);  // the library's ranges: InputError naming the key
   return s;
 }
 
@@ -118,7 +118,7 @@ CalibrationChoice choice_of(const std::string& calibration, const py::object& tr
   }
   if (t.contains("targets") && !t["targets"].is_none()) {  // the library checks them (check_tracker_calibration)
     const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(t["targets"]);
-    if (!a || !(a.ndim() == 2 && a.shape(1) == 3) && !(a.ndim() == 1 && a.shape(0) == 0))
+    if (!a || (!(a.ndim() == 2 && a.shape(1) == 3) && !(a.ndim() == 1 && a.shape(0) == 0)))
       raise_input("tracker: targets must be an (N, 3) array [m, platform]");
     for (py::ssize_t r = 0; a.ndim() == 2 && r < a.shape(0); ++r)
       c.extra_targets_P.push_back(Eigen::Map<const Vector3d>(a.data(r, 0)));

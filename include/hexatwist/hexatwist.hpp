@@ -4,6 +4,7 @@
 #include "hexatwist/error.hpp"
 #include "hexatwist/status.hpp"
 #include "hexatwist/types.hpp"
+#include "hexatwist/version.hpp"
 
 #include "hexatwist/kinematics/batch.hpp"
 #include "hexatwist/kinematics/compensation.hpp"

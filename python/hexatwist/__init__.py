@@ -43,6 +43,8 @@ __all__ += design.__all__
 __all__ += io.__all__
 __all__ += distributed.__all__
 
+__version__: str = _core.version  # the library's version (hexatwist/version.hpp), as `hexatwist --version`
+
 
 def _input_copies() -> int:
     """Debug counter: inputs the bindings had to copy (never a C-contiguous float64 array)."""

@@ -1,5 +1,7 @@
-// C API: status names and descriptions (the library's, as C strings).
+// C API: the version, status names and descriptions (the library's, as C strings).
 #include "c_api.hpp"
+
+#include "hexatwist/version.hpp"
 
 namespace {
 
@@ -25,6 +27,8 @@ const char* c_str(std::string_view s) noexcept { return s.data(); }
 }  // namespace
 
 extern "C" {
+
+const char* hexatwist_version(void) { return HEXATWIST_VERSION_STRING; }
 
 const char* hexatwist_status_name(hexatwist_status status) {
   if (status == HEXATWIST_INVALID_ARGUMENT) return "invalid_argument";

@@ -439,8 +439,39 @@ Status identify_choosing_effects(const Model& nominal, std::span<const Observati
 
 }  // namespace
 
+void check_identification_options(const IdentificationOptions& o) {
+  const auto refuse = [](std::string message, const char* field) {
+    throw ParameterError("identification: " + std::move(message), field);
+  };
+  const auto positive = [&](double v, const char* field, const char* what) {
+    if (!(v > 0.0 && std::isfinite(v))) refuse(fmt::format("expected a finite {} > 0, got {}", what, v), field);
+  };
+  if (!std::isnan(o.tracker_noise) && !(o.tracker_noise > 0.0 && o.tracker_noise < kMaxTrackerNoise))
+    refuse(fmt::format("expected the tracker's noise > 0 and below {:g} m (or unknown: its scatter), got {:g}",
+                       kMaxTrackerNoise, o.tracker_noise),
+           "tracker_noise");
+  if (!(o.tracker_noise_floor >= 0.0 && o.tracker_noise_floor < kMaxTrackerNoise))
+    refuse(fmt::format("expected a noise floor of 0 to {:g} m, got {}", kMaxTrackerNoise, o.tracker_noise_floor),
+           "tracker_noise_floor");
+  positive(o.fit_sigmas, "fit_sigmas", "number of normal deviates");
+  positive(o.effect_sigmas, "effect_sigmas", "number of normal deviates");
+  positive(o.sign_separation_min, "sign_separation_min", "separation");
+  positive(o.axis_sd_max, "axis_sd_max", "standard deviation [rad]");
+  positive(o.max_registration_misfit, "max_registration_misfit", "share");
+  if (!(o.folds == 0 || (o.folds >= 2 && o.folds <= kMaxFolds)))
+    refuse(fmt::format("expected 0 folds (no cross-validation) or 2 to {}, got {}", kMaxFolds, o.folds), "folds");
+  if (o.accuracy_poses < 0 || o.accuracy_poses > 100000)
+    refuse(fmt::format("expected 0 (none) to 100000 accuracy poses, got {}", o.accuracy_poses), "accuracy_poses");
+  if (o.max_iterations < 1)
+    refuse(fmt::format("expected max iterations >= 1, got {}", o.max_iterations), "max_iterations");
+  if (!(o.max_condition > 1.0 && std::isfinite(o.max_condition)))
+    refuse(fmt::format("expected a finite max condition > 1, got {}", o.max_condition), "max_condition");
+  if (const std::string_view why = check_fk_options(o.fk); !why.empty()) refuse(std::string(why), "fk");
+}
+
 Status identify(const Model& nominal, std::span<const Observation> observations, Identification& out,
                 const IdentificationOptions& options) {
+  check_identification_options(options);
   if (options.auto_effects) return identify_choosing_effects(nominal, observations, out, options);
   return identify_fixed(nominal, observations, out, options, true);
 }

@@ -264,13 +264,9 @@ int min_planned_stations(const Model& nominal, const StationPlanSpec& spec) {
 void check_station_plan_spec(const Model& nominal, const StationPlanSpec& spec) {
   // Each refusal names the field at fault (ParameterError: the CLI's option, Python's keyword).
   const StationsSpec& run = spec.run;
-  if (!(std::isfinite(run.translation) && run.translation >= 0.0))
-    throw ParameterError(
-        fmt::format("station plan: expected a finite translation range >= 0 m, got {}", run.translation),
-        "translation");
-  if (!(std::isfinite(run.rotation) && run.rotation >= 0.0))
-    throw ParameterError(fmt::format("station plan: expected a finite rotation range >= 0 rad, got {}", run.rotation),
-                         "rotation");
+  StationsSpec ranges = run;  // the count is checked below, against the parameters
+  ranges.count = 1;
+  check_stations_spec(ranges);
   if (spec.targets_P.size() + 1 > static_cast<std::size_t>(kMaxPlanTargets))
     throw ParameterError(fmt::format("station plan: {} targets with the observation point, at most {}",
                                      spec.targets_P.size() + 1, kMaxPlanTargets),
@@ -292,10 +288,13 @@ void check_station_plan_spec(const Model& nominal, const StationPlanSpec& spec) 
     throw ParameterError(fmt::format("station plan: expected {} (the stations) to {} candidates, got {}", run.count,
                                      kMaxCandidates, spec.candidates),
                          "candidates");
-  if (!(std::isfinite(spec.noise) && spec.noise > 0.0))
-    throw ParameterError(fmt::format("station plan: expected a tracker noise > 0 m, got {}", spec.noise), "noise");
-  if (spec.points_per_station < 1)
-    throw ParameterError(fmt::format("station plan: expected points per station >= 1, got {}", spec.points_per_station),
+  if (!(spec.noise > 0.0 && spec.noise < kMaxTrackerNoise))
+    throw ParameterError(fmt::format("station plan: expected a tracker noise > 0 and below {:g} m, got {:g}",
+                                     kMaxTrackerNoise, spec.noise),
+                         "noise");
+  if (spec.points_per_station < 1 || spec.points_per_station > kMaxPointsPerStation)
+    throw ParameterError(fmt::format("station plan: expected 1 to {} points per station, got {}", kMaxPointsPerStation,
+                                     spec.points_per_station),
                          "points_per_station");
   if (spec.accuracy_poses < 1)
     throw ParameterError(fmt::format("station plan: expected accuracy poses >= 1, got {}", spec.accuracy_poses),

@@ -42,14 +42,39 @@ bool reachable_from(const Model& model, Strategy strategy, const Vector6d& from,
   return true;
 }
 
+void check_stations_spec(const StationsSpec& spec) {
+  const auto refuse = [](std::string message, const char* field) {
+    throw ParameterError("stations: " + std::move(message), field);
+  };
+  if (spec.count < 1 || spec.count > kMaxStations)
+    refuse(fmt::format("expected 1 to {} stations, got {}", kMaxStations, spec.count), "count");
+  if (!(spec.translation >= 0.0 && spec.translation <= kMaxStationTranslation))
+    refuse(
+        fmt::format("expected a translation range of 0 to {:g} m, got {:g}", kMaxStationTranslation, spec.translation),
+        "translation");
+  if (!(spec.rotation >= 0.0 && spec.rotation <= kMaxStationRotation))
+    refuse(fmt::format("expected a rotation range of 0 to {:g} deg, got {:g} deg", rad2deg(kMaxStationRotation),
+                       rad2deg(spec.rotation)),
+           "rotation");
+  if (spec.translation == 0.0 && spec.rotation == 0.0)
+    refuse("expected a range > 0 in translation or rotation: the stations would all be at home", "translation");
+  if (!(spec.approach >= 0.0 && spec.approach <= kMaxApproach))
+    refuse(fmt::format("approach: expected 0 to {:g} m, got {:g}", kMaxApproach, spec.approach), "approach");
+  if (spec.reference_every < 0)
+    refuse(fmt::format("reference every: expected 0 (none) or a number of stations, got {}", spec.reference_every),
+           "reference_every");
+  if (!(spec.dwell > 0.0 && std::isfinite(spec.dwell)))
+    refuse(fmt::format("expected a finite dwell > 0 s, got {}", spec.dwell), "dwell");
+  const MotionLimits& l = spec.limits;
+  for (const double v : {l.velocity, l.acceleration, l.jerk})
+    if (!(v > 0.0 && std::isfinite(v)))
+      refuse(fmt::format("expected finite move limits > 0, got {}, {}, {}", l.velocity, l.acceleration, l.jerk),
+             "limits");
+}
+
 std::vector<Vector6d> random_stations(const Model& model, Strategy strategy, const StationsSpec& spec) {
   constexpr int kMaxDraws = 1000;
-  if (spec.count < 1 || spec.count > kMaxStations)
-    throw Error(fmt::format("stations: expected 1 to {} stations, got {}", kMaxStations, spec.count));
-  if (!(std::isfinite(spec.translation) && spec.translation >= 0.0 && std::isfinite(spec.rotation) &&
-        spec.rotation >= 0.0))
-    throw Error(
-        fmt::format("stations: expected finite ranges >= 0, got ±{} m and ±{} rad", spec.translation, spec.rotation));
+  check_stations_spec(spec);
   detail::Random rng(spec.seed);
   std::vector<Vector6d> stations;
   Vector6d last = Vector6d::Zero();
@@ -76,13 +101,7 @@ std::vector<Vector6d> random_stations(const Model& model, Strategy strategy, con
 
 std::vector<Vector6d> station_waypoints(const Model& model, Strategy strategy, std::span<const Vector6d> stations,
                                         const StationsSpec& spec) {
-  if (!(spec.approach >= 0.0 && spec.approach <= kMaxApproach))
-    throw ParameterError(fmt::format("stations: approach: expected 0 to {:g} m, got {:g}", kMaxApproach, spec.approach),
-                         "approach");
-  if (spec.reference_every < 0)
-    throw ParameterError(fmt::format("stations: reference every: expected 0 (none) or a number of stations, got {}",
-                                     spec.reference_every),
-                         "reference_every");
+  check_stations_spec(spec);
   std::vector<Vector6d> waypoints{Vector6d::Zero()};
   const auto visit = [&](const Vector6d& next, std::size_t i) {
     if (!reachable_from(model, strategy, waypoints.back(), next))

@@ -1,5 +1,7 @@
 #include "hexatwist/design/tolerance.hpp"
 
+#include <fmt/format.h>
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
@@ -204,8 +206,23 @@ double ErrorHistogram::cdf(double value) const noexcept {
 
 // ---------------------------------------------------------------------------------------------
 
+void check_tolerance_sigmas(const ToleranceSigmas& s) {
+  const auto check = [](double v, double most, const char* field, const char* unit) {
+    if (!(v >= 0.0 && v <= most))
+      throw ParameterError(fmt::format("tolerance: sigma of {}: expected 0 to {:g} {}, got {:g}", field, most, unit, v),
+                           field);
+  };
+  check(s.base_joint, kMaxSigmaLength, "base_joint", "m");
+  check(s.platform_joint, kMaxSigmaLength, "platform_joint", "m");
+  check(s.base_axis, kMaxSigmaAxis, "base_axis", "rad");
+  check(s.platform_axis, kMaxSigmaAxis, "platform_axis", "rad");
+  check(s.lead, kMaxSigmaLead, "lead", "(relative)");
+  check(s.offset, kMaxSigmaLength, "offset", "m");
+}
+
 Status tolerance_linear(const Model& nominal, const std::vector<Pose>& poses, const ToleranceSigmas& sigmas,
                         ToleranceLinear& out, int threads) {
+  check_tolerance_sigmas(sigmas);
   out = ToleranceLinear{};
   const PlatformErrors sd = error_sigmas(nominal, sigmas);
   // Central differences on real_platform: the same construction as the Monte Carlo's platforms.
@@ -385,6 +402,7 @@ void study_platform(const Model& nominal, const StudyPoses& sp, const ToleranceO
 
 Status tolerance_chunk(const Model& nominal, const std::vector<Pose>& poses, const ToleranceOptions& o,
                        std::uint64_t first, std::size_t count, ToleranceChunk& out, const ToleranceLinear* linear) {
+  check_tolerance_sigmas(o.sigmas);
   out = ToleranceChunk{};
   out.first = first;
   const std::size_t np = poses.size();

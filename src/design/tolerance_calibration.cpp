@@ -96,13 +96,15 @@ void check_tracker_calibration(const TrackerCalibration& c) {
   for (std::size_t s = 0; s < c.stations.size(); ++s)
     if (!c.stations[s].allFinite())
       throw ParameterError(fmt::format("calibration: station {} holds NaN or inf", s + 1), "station_plan");
-  if (!(std::isfinite(c.noise) && c.noise > 0.0))
-    throw ParameterError(fmt::format("calibration: the tracker's noise must be finite and > 0 m, got {}", c.noise),
+  if (!(c.noise > 0.0 && c.noise < kMaxTrackerNoise))
+    throw ParameterError(fmt::format("calibration: the tracker's noise must be > 0 and below {:g} m, got {:g}",
+                                     kMaxTrackerNoise, c.noise),
                          "tracker_noise");
   if (c.points < 1 || c.points > kMaxPointsPerStation)
     throw ParameterError(
         fmt::format("calibration: expected 1 to {} points per station, got {}", kMaxPointsPerStation, c.points),
         "points_per_station");
+  check_identification_options(c.identification);
   if (c.identification.model != CalibrationModel::Geometry)
     throw ParameterError("calibration: the identification must fit the geometry model (the joints the study moves)",
                          "identification");
@@ -405,6 +407,7 @@ std::function<void(std::uint64_t, Eigen::VectorXd&)> same_errors(const Model& no
 
 Status calibrated_linear(const Model& nominal, const std::vector<Pose>& poses, const ToleranceOptions& study,
                          const TrackerCalibration& c, ToleranceLinear& out, CalibratedLinear* detail_out) {
+  check_tolerance_sigmas(study.sigmas);
   check_tracker_calibration(c);
   out = ToleranceLinear{};
   CalibratedLinear lin;
@@ -543,6 +546,7 @@ std::vector<Vector3d> target_layout(const Model& nominal, int extra) {
 std::vector<TargetLayout> target_layouts(const Model& nominal, const std::vector<Pose>& poses,
                                          const ToleranceOptions& study, const TrackerCalibration& calibration,
                                          int max_extra) {
+  check_tolerance_sigmas(study.sigmas);
   if (max_extra < 0 || max_extra > kMaxLayoutTargets)
     throw ParameterError(
         fmt::format("target layouts: expected 0 to {} extra targets, got {}", kMaxLayoutTargets, max_extra),

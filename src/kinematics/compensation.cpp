@@ -195,7 +195,11 @@ Status motor_commands(const Model& model, const Pose& pose, Strategy strategy, c
       s != Status::Ok)
     return fail(report, s);
   detail::command_travel(model, u0, twist_term, force, temperature, play, travel, no_play, direction);
-  if (const Status s = check_stroke(model, travel, report); s != Status::Ok) return s;
+  // The stroke in registers; check_stroke names the leg where it fails.
+  detail::lane_m within = detail::all_set();
+  for (int k = 0; k < detail::kPackets; ++k) within &= detail::within_stroke(model, detail::load6(travel.data(), k));
+  if (!detail::all_lanes(within))
+    if (const Status s = check_stroke(model, travel, report); s != Status::Ok) return s;
   report = LimitReport{};
   command = model.motor_from_travel(travel);
   if (play != nullptr) advance_play(*play, no_play, direction);

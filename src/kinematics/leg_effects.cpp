@@ -23,52 +23,13 @@ Status static_leg_forces(const Model& model, const StaticLoadSpec& load, const L
   return detail::finish_leg_forces(model, load, legs.R_BP, loads, rows, force);
 }
 
-bool detail::needs_static_forces(const Model& model, const LegInputs& inputs) noexcept {
-  return model.has_stiffness() && inputs.force.array().isNaN().any();
-}
-
-namespace {
-
-/// The status for inputs check_leg_inputs refuses; Ok for the others.
-Status input_status(const LegInputs& inputs) noexcept {
-  Status s = Status::Ok;
-  for (int i = 0; i < kLegs; ++i) {
-    const double t = inputs.temperature[i];
-    if (std::isinf(inputs.force[i]) || std::isinf(t)) return Status::NonFiniteInput;
-    if (!(std::isnan(t) || (t >= kMinTemperature && t <= kMaxTemperature))) s = Status::InvalidArgument;
-  }
-  return s;
-}
-
-}  // namespace
-
 std::string_view check_leg_inputs(const LegInputs& inputs) noexcept {
-  for (int i = 0; i < kLegs; ++i) {
-    const double t = inputs.temperature[i];
+  // The commands' decision (detail::input_status), worded: an infinite temperature is out of range.
+  if (detail::input_status(inputs) == Status::Ok) return {};
+  for (const double t : inputs.temperature)
     if (!(std::isnan(t) || (t >= kMinTemperature && t <= kMaxTemperature)))
       return "inputs.temperature must be from -60 to 200 degC, or NaN for the reference temperature";
-    if (std::isinf(inputs.force[i])) return "inputs.force must be finite [N], or NaN for the static force";
-  }
-  return {};
-}
-
-Status detail::resolve_inputs(const Model& model, const LegInputs& inputs, Status static_status,
-                              const Vector6d& static_force, Vector6d& force, Vector6d& temperature) noexcept {
-  if (const Status s = input_status(inputs); s != Status::Ok) return s;
-  temperature = inputs.temperature;
-  for (int i = 0; i < kLegs; ++i)
-    if (std::isnan(temperature[i])) temperature[i] = model.reference_temperature();
-  force = inputs.force;
-  if (!model.has_stiffness()) {
-    force = force.unaryExpr([](double f) { return std::isnan(f) ? 0.0 : f; });
-    return Status::Ok;
-  }
-  if (needs_static_forces(model, inputs)) {
-    if (static_status != Status::Ok) return static_status;
-    for (int i = 0; i < kLegs; ++i)
-      if (std::isnan(force[i])) force[i] = static_force[i];
-  }
-  return Status::Ok;
+  return "inputs.force must be finite [N], or NaN for the static force";
 }
 
 Status resolve_inputs(const Model& model, const LegState& legs, const LegInputs& inputs, Vector6d& force,
@@ -90,7 +51,11 @@ Vector6d play_direction(const Model& model, const PlayState& play, const Vector6
   const Vector6d& last = play.started ? play.last : model.geometry().home_command;
   const Vector6d& kept = play.started ? play.direction : model.geometry().home_direction;
   Vector6d d;
-  for (int i = 0; i < kLegs; ++i) d[i] = travel[i] > last[i] ? 1.0 : travel[i] < last[i] ? -1.0 : kept[i];
+  for (int k = 0; k < detail::kPackets; ++k)
+    detail::store6(d.data(),
+                   detail::direction_of(detail::load6(travel.data(), k), detail::load6(last.data(), k),
+                                        detail::load6(kept.data(), k)),
+                   k);
   return d;
 }
 
@@ -133,26 +98,7 @@ void fixed_parts(const Model& model, const Vector6d& force, const Vector6d& temp
   e.temperature = temperature;
   e.direction = direction;
   e.load = g.compliance.cwiseProduct(force - model.reference_force());
-  e.play = -g.half_play.cwiseProduct(direction - g.home_direction);
-}
-
-// u + E(u) = u0 with E linear in w = u - h + k dtheta (leg_effects.hpp): with the home direction
-// (no play term), w = (u0 - h + k dtheta - E_fixed) / (1 + a_P dT) and u = u0 - E; the play's
-// term p then moves u by -p / (1 + a_P dT). `scale` gets 1 + a_P dT.
-void travel_without_play(const Model& model, const Vector6d& u0, const Vector6d& twist_term, const Vector6d& force,
-                         const Vector6d& temperature, Vector6d& travel, Vector6d& scale) noexcept {
-  const LegGeometry& g = model.geometry();
-  const Vector6d dT = temperature.array() - model.reference_temperature();
-  const Vector6d fixed = g.compliance.cwiseProduct(force - model.reference_force()) + dT.cwiseProduct(g.thermal_length);
-  const Vector6d aP_dT = g.lead_expansion.cwiseProduct(dT);
-  scale = Vector6d::Ones() + aP_dT;
-  const Vector6d w = (u0 - g.home_command + twist_term - fixed).cwiseQuotient(scale);
-  travel = u0 - fixed - aP_dT.cwiseProduct(w);
-}
-
-Vector6d play_term(const Model& model, const Vector6d& direction) noexcept {
-  const LegGeometry& g = model.geometry();
-  return -g.half_play.cwiseProduct(direction - g.home_direction);
+  e.play = detail::play_term(model, direction);
 }
 
 }  // namespace
@@ -160,19 +106,9 @@ Vector6d play_term(const Model& model, const Vector6d& direction) noexcept {
 void travel_under_effects(const Model& model, const Vector6d& u0, const Vector6d& twist_term, const Vector6d& force,
                           const Vector6d& temperature, const Vector6d& direction, Vector6d& travel,
                           LegEffects* effects) noexcept {
-  Vector6d no_play, scale;
-  travel_without_play(model, u0, twist_term, force, temperature, no_play, scale);
-  travel = no_play - play_term(model, direction).cwiseQuotient(scale);
+  Vector6d d = direction;
+  detail::travel_in_lanes(model, u0, twist_term, force, temperature, nullptr, nullptr, d, travel, nullptr);
   if (effects != nullptr) effect_lengths(model, travel, twist_term, force, temperature, direction, *effects);
-}
-
-void detail::command_travel(const Model& model, const Vector6d& u0, const Vector6d& twist_term, const Vector6d& force,
-                            const Vector6d& temperature, const PlayState* play, Vector6d& travel, Vector6d& no_play,
-                            Vector6d& direction) noexcept {
-  Vector6d scale;
-  travel_without_play(model, u0, twist_term, force, temperature, no_play, scale);
-  direction = play_direction(model, play != nullptr ? *play : PlayState{}, no_play);
-  travel = no_play - play_term(model, direction).cwiseQuotient(scale);
 }
 
 void effect_lengths(const Model& model, const Vector6d& travel, const Vector6d& twist_term, const Vector6d& force,

@@ -30,6 +30,16 @@ inline void add_leg_loads(const StaticLoadSpec& load, const lanes3& s, const lan
   out.moment = {out.moment.x + m.x, out.moment.y + m.y, out.moment.z + m.z};
 }
 
+/// Solves A^T F = G for the padded rows of A by the pivoted elimination; false where A is singular.
+/// Out of line: the rare case, which would crowd the real-time command's registers.
+[[gnu::noinline, gnu::cold]] inline bool solve_transposed(const PaddedRows& rows_of_A, const Vector6d& G,
+                                                          Vector6d& force) noexcept {
+  Columns transposed;  // A^T's columns are A's rows
+  for (int i = 0; i < 6; ++i)
+    for (int q = 0; q < kPackets; ++q) transposed.c[i][q] = rows_of_A[i][q];
+  return gj_solve_system(transposed, G, force) > 0.0;
+}
+
 /// F = J^-T G once every packet is added, from the padded rows of A = J diag(1, 1, 1, w, w, w)
 /// (w = 1 / model.condition_length(), as the limits form it): A^T F = diag(1, 1, 1, w, w, w) G.
 /// G adds the load's weight at its centre of mass (pose rotation R_BP) to the legs' share.
@@ -51,56 +61,138 @@ inline void add_leg_loads(const StaticLoadSpec& load, const lanes3& s, const lan
   // A^T F = G' by blocks (legs 0, 2, 4 and 1, 3, 5: three legs spread around the platform, whose
   // axes are far from coplanar on any hexapod): cofactor inverses, short chains, no pivot search.
   // Where a block is nearly singular, the pivoted elimination.
-  alignas(64) double a[6][8];
-  std::memcpy(a, rows_of_A, sizeof a);
+  constexpr int kW = sizeof(lane_v) / sizeof(double);
+  const auto a = [&](int row, int column) { return rows_of_A[row][column / kW][column % kW]; };
   Matrix3d P, Q, R, T;  // A^T = [P Q; R T]: columns of P and R from legs 0, 2, 4
   for (int j = 0; j < 3; ++j)
     for (int c = 0; c < 3; ++c) {
-      P(c, j) = a[2 * j][c];
-      R(c, j) = a[2 * j][c + 3];
-      Q(c, j) = a[2 * j + 1][c];
-      T(c, j) = a[2 * j + 1][c + 3];
+      P(c, j) = a(2 * j, c);
+      R(c, j) = a(2 * j, c + 3);
+      Q(c, j) = a(2 * j + 1, c);
+      T(c, j) = a(2 * j + 1, c + 3);
     }
-  const auto cofactor_inverse = [](const Matrix3d& M, Matrix3d& inverse) {
+  // The adjugate and determinant of M; true when M is well away from singular: |det| above a
+  // tenth of the product of the columns' norms (a test that does not change with M's scale).
+  const auto adjugate = [](const Matrix3d& M, Matrix3d& adj, double& det) {
     const Vector3d c0 = M.col(1).cross(M.col(2)), c1 = M.col(2).cross(M.col(0)), c2 = M.col(0).cross(M.col(1));
-    const double det = M.col(0).dot(c0);
-    const double inv_det = 1.0 / det;
-    inverse.row(0) = inv_det * c0.transpose();
-    inverse.row(1) = inv_det * c1.transpose();
-    inverse.row(2) = inv_det * c2.transpose();
-    // Well away from singular: |det| above a tenth of the product of the columns' norms.
+    det = M.col(0).dot(c0);
+    adj.row(0) = c0.transpose();
+    adj.row(1) = c1.transpose();
+    adj.row(2) = c2.transpose();
     return det * det > 0.01 * (M.col(0).squaredNorm() * M.col(1).squaredNorm() * M.col(2).squaredNorm());
   };
-  Matrix3d P_inv, S_inv;
-  bool blocks = cofactor_inverse(P, P_inv);
-  const Matrix3d X = P_inv * Q;
-  const Vector3d y = P_inv * G.head<3>();
-  blocks = blocks && cofactor_inverse(T - R * X, S_inv);
+  // The Schur complement scaled by det P, S' = det P (T - R P^-1 Q) = det P T - R adj(P) Q, keeps
+  // the division by det P off the critical path: F2 = S'^-1 (det P G2 - R adj(P) G1) and
+  // F1 = (adj(P) G1 - adj(P) Q F2) / det P.
+  Matrix3d P_adj, S_adj;
+  double det_P = 0.0, det_S = 0.0;
+  bool blocks = adjugate(P, P_adj, det_P);
+  const Matrix3d X = P_adj * Q;
+  const Vector3d y = P_adj * G.head<3>();
+  blocks = blocks && adjugate(det_P * T - R * X, S_adj, det_S);
   if (blocks) {
-    const Vector3d F2 = S_inv * (G.tail<3>() - R * y);
-    const Vector3d F1 = y - X * F2;
+    const Vector3d F2 = S_adj * (det_P * G.tail<3>() - R * y) * (1.0 / det_S);
+    const Vector3d F1 = (y - X * F2) * (1.0 / det_P);
     force << F1[0], F2[0], F1[1], F2[1], F1[2], F2[2];
-  } else {
-    Columns transposed;  // A^T's columns are A's rows
-    for (int i = 0; i < 6; ++i)
-      for (int q = 0; q < kPackets; ++q) transposed.c[i][q] = rows_of_A[i][q];
-    if (!(gj_solve_system(transposed, G, force) > 0.0)) return Status::SingularJacobian;
+  } else if (!solve_transposed(rows_of_A, G, force)) {
+    return Status::SingularJacobian;
   }
   return force.allFinite() ? Status::Ok : Status::NonFiniteInput;
 }
 
 /// True where resolve_inputs needs the static forces: a leg has a stiffness and an input force is NaN.
-[[nodiscard]] bool needs_static_forces(const Model& model, const LegInputs& inputs) noexcept;
+[[nodiscard]] inline bool needs_static_forces(const Model& model, const LegInputs& inputs) noexcept {
+  return model.has_stiffness() && inputs.force.array().isNaN().any();
+}
+
+/// The status for inputs check_leg_inputs refuses (NonFiniteInput for an infinite force or
+/// temperature, InvalidArgument for a temperature out of range); Ok for the others.
+[[nodiscard]] [[gnu::always_inline]] inline Status input_status(const LegInputs& inputs) noexcept {
+  lane_m infinite = {}, out_of_range = {};
+  for (int k = 0; k < kPackets; ++k) {
+    const lane_v t = load6(inputs.temperature.data(), k), f = load6(inputs.force.data(), k);
+    infinite |= (vabs(t) == INFINITY) | (vabs(f) == INFINITY);
+    out_of_range |= (t < kMinTemperature) | (t > kMaxTemperature);  // NaN (the reference) passes
+  }
+  if (!all_lanes(~infinite)) return Status::NonFiniteInput;
+  return all_lanes(~out_of_range) ? Status::Ok : Status::InvalidArgument;
+}
+
 /// resolve_inputs with the static forces `static_force` and their status `static_status`
 /// (read only where needs_static_forces).
-[[nodiscard]] Status resolve_inputs(const Model& model, const LegInputs& inputs, Status static_status,
-                                    const Vector6d& static_force, Vector6d& force, Vector6d& temperature) noexcept;
+[[nodiscard]] [[gnu::always_inline]] inline Status resolve_inputs(const Model& model, const LegInputs& inputs,
+                                                                  Status static_status, const Vector6d& static_force,
+                                                                  Vector6d& force, Vector6d& temperature) noexcept {
+  if (const Status s = input_status(inputs); s != Status::Ok) return s;
+  const bool static_forces = needs_static_forces(model, inputs);
+  if (static_forces && static_status != Status::Ok) return static_status;
+  // A NaN force: the static force where a leg has a stiffness, else 0 (it changes nothing).
+  const lane_v reference = splat<lane_v>(model.reference_temperature());
+  for (int k = 0; k < kPackets; ++k) {
+    const lane_v t = load6(inputs.temperature.data(), k), f = load6(inputs.force.data(), k);
+    store6(temperature.data(), blend(t == t, t, reference), k);
+    store6(force.data(), blend(f == f, f, static_forces ? load6(static_force.data(), k) : splat<lane_v>(0.0)), k);
+  }
+  return Status::Ok;
+}
+
+/// play_direction's rule in lanes: +1 where `travel` passed `last` upwards, -1 downwards, `kept`
+/// where it did not move.
+[[gnu::always_inline]] inline lane_v direction_of(lane_v travel, lane_v last, lane_v kept) noexcept {
+  return blend(travel > last, splat<lane_v>(1.0), blend(travel < last, splat<lane_v>(-1.0), kept));
+}
+
+/// The travel u [m] of travel_under_effects, leg by leg in lanes. u + E(u) = u0 with E linear in
+/// w = u - h + k dtheta (leg_effects.hpp): with the home direction (no play term),
+/// w = (u0 - h + k dtheta - E_fixed) / (1 + a_P dT) and u = u0 - E; the play's term
+/// p = -(b / 2)(d - d_home) then moves u by -p / (1 + a_P dT). With `last` and `kept` (the play
+/// state), each leg's direction is decided on the travel without its play term, which goes to
+/// `no_play` (may be null), and written to `direction`; without them, `direction` is read.
+[[gnu::always_inline]] inline void travel_in_lanes(const Model& model, const Vector6d& u0, const Vector6d& twist_term,
+                                                   const Vector6d& force, const Vector6d& temperature,
+                                                   const Vector6d* last, const Vector6d* kept, Vector6d& direction,
+                                                   Vector6d& travel, Vector6d* no_play) noexcept {
+  const LegGeometry& g = model.geometry();
+  const lane_v reference = splat<lane_v>(model.reference_temperature());
+  for (int k = 0; k < kPackets; ++k) {
+    const lane_v dT = load6(temperature.data(), k) - reference;
+    const lane_v fixed =
+        load6(g.compliance.data(), k) * (load6(force.data(), k) - load6(model.reference_force().data(), k)) +
+        dT * load6(g.thermal_length.data(), k);
+    const lane_v aP_dT = load6(g.lead_expansion.data(), k) * dT;
+    const lane_v inverse_scale = 1.0 / (1.0 + aP_dT);
+    const lane_v u = load6(u0.data(), k);
+    const lane_v w = (u - load6(g.home_command.data(), k) + load6(twist_term.data(), k)) - fixed;
+    const lane_v without_play = u - fixed - aP_dT * w * inverse_scale;
+    lane_v d;
+    if (last != nullptr) {
+      d = direction_of(without_play, load6(last->data(), k), load6(kept->data(), k));
+      store6(direction.data(), d, k);
+    } else {
+      d = load6(direction.data(), k);
+    }
+    if (no_play != nullptr) store6(no_play->data(), without_play, k);
+    const lane_v play = -load6(g.half_play.data(), k) * (d - load6(g.home_direction.data(), k));
+    store6(travel.data(), without_play - play * inverse_scale, k);
+  }
+}
 
 /// The travel [m] a command gives the nut under the effects for the twist-compensated travel u0
 /// [m] (travel_under_effects), each leg's play direction decided on the travel without its play
 /// term, `no_play` (what the play state moves on to; play may be null: from home).
-void command_travel(const Model& model, const Vector6d& u0, const Vector6d& twist_term, const Vector6d& force,
-                    const Vector6d& temperature, const PlayState* play, Vector6d& travel, Vector6d& no_play,
-                    Vector6d& direction) noexcept;
+[[gnu::always_inline]] inline void command_travel(const Model& model, const Vector6d& u0, const Vector6d& twist_term,
+                                                  const Vector6d& force, const Vector6d& temperature,
+                                                  const PlayState* play, Vector6d& travel, Vector6d& no_play,
+                                                  Vector6d& direction) noexcept {
+  const bool started = play != nullptr && play->started;
+  travel_in_lanes(model, u0, twist_term, force, temperature, started ? &play->last : &model.geometry().home_command,
+                  started ? &play->direction : &model.geometry().home_direction, direction, travel, &no_play);
+}
+
+/// The play's term of the effects, -(b / 2)(d - d_home) [m].
+inline Vector6d play_term(const Model& model, const Vector6d& direction) noexcept {
+  const LegGeometry& g = model.geometry();
+  return -g.half_play.cwiseProduct(direction - g.home_direction);
+}
 
 }  // namespace hexatwist::detail

@@ -1,6 +1,9 @@
 #include "hexatwist/kinematics/limits.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
+#include <utility>
 
 #include "kinematics/geometry.hpp"
 #include "kinematics/lanes.hpp"
@@ -173,6 +176,63 @@ Status check_stroke(const Model& model, const Vector6d& command, LimitReport& r)
       return report_violation(r, Status::StrokeAboveMax, i, command[i], lim.length_max);
   }
   return Status::Ok;
+}
+
+namespace {
+
+// A value and its bound with as many decimals as it takes to tell them apart (at least `least`):
+// "1.4000003 m is below the minimum 1.4000000 m", never "1.400000 below 1.400000".
+std::pair<std::string, std::string> apart(double value, double bound, int least) {
+  for (int d = least; d <= 16; ++d) {
+    std::string a = fmt::format("{:.{}f}", value, d), b = fmt::format("{:.{}f}", bound, d);
+    if (a != b) return {a, b};
+  }
+  return {fmt::format("{}", value), fmt::format("{}", bound)};
+}
+
+}  // namespace
+
+std::string describe(const LimitReport& r) {
+  if (r.status == Status::Ok) return "ok";
+  const std::string leg = r.leg >= 0 ? fmt::format("leg {}: ", r.leg + 1) : std::string();
+  switch (r.status) {
+    case Status::StrokeBelowMin:
+    case Status::StrokeAboveMax: {
+      const bool below = r.status == Status::StrokeBelowMin;
+      const char* which = below ? "minimum" : "maximum";
+      const char* field = below ? "limits.length_min" : "limits.length_max";
+      // Within 10 nm (a boundary found by bisection): at the limit, in digits every CPU prints alike.
+      if (std::abs(r.value - r.bound) < 1e-8)
+        return fmt::format("{}length at the {} {:.6f} m ({})", leg, which, r.bound, field);
+      const auto [v, b] = apart(r.value, r.bound, 6);
+      return fmt::format("{}length {} m is {} the {} {} m ({})", leg, v, below ? "below" : "above", which, b, field);
+    }
+    case Status::BendBase:
+    case Status::BendPlatform: {
+      const auto [v, b] = apart(rad2deg(r.value), rad2deg(r.bound), 3);
+      return fmt::format("{}{} U-joint bends {} deg, above the limit {} deg (limits.bend_max_deg)", leg,
+                         r.status == Status::BendBase ? "base" : "platform", v, b);
+    }
+    case Status::SingularBase:
+    case Status::SingularPlatform:
+      return fmt::format(
+          "{}leg is {:.3f} deg from the {} U-joint's fixed axis, inside the singularity margin {:.3f} deg "
+          "(limits.singularity_margin_deg)",
+          leg, rad2deg(r.value), r.status == Status::SingularBase ? "base" : "platform", rad2deg(r.bound));
+    case Status::MotorSpeedAboveMax:
+      return fmt::format("{}motor speed {:.0f} rpm is above the limit {:.0f} rpm (servo.max_speed_rpm)", leg,
+                         r.value * 60.0 / (2.0 * kPi), r.bound * 60.0 / (2.0 * kPi));
+    case Status::TorqueAboveMax:
+      return fmt::format("{}holding the load takes {:.2f} N m, above the motor's limit {:.2f} N m (servo.torque_limit)",
+                         leg, r.value, r.bound);
+    case Status::PlatformSingularity:
+      return fmt::format(
+          "the platform is near a singularity: the Jacobian's condition number {:.4g} is above the limit "
+          "{:.4g} (limits.jacobian_condition_max)",
+          r.value, r.bound);
+    default:
+      return leg + std::string(describe(r.status));
+  }
 }
 
 }  // namespace hexatwist

@@ -179,6 +179,8 @@ static void test_limits(const hexatwist_model* m) {
   CHECK(
       hexatwist_forward_kinematics(m, command, (hexatwist_length_kind)5, NULL, NULL, &fk) == HEXATWIST_INVALID_ARGUMENT,
       "length kind");
+  CHECK(strcmp(hexatwist_version(), HEXATWIST_PROJECT_VERSION) == 0, "version %s, CMake's %s", hexatwist_version(),
+        HEXATWIST_PROJECT_VERSION);
   CHECK(strcmp(hexatwist_status_name(HEXATWIST_OK), "ok") == 0, "name");
   CHECK(strcmp(hexatwist_status_name(HEXATWIST_PLATFORM_SINGULARITY), "platform_singularity") == 0, "name");
   CHECK(strcmp(hexatwist_status_name(HEXATWIST_INVALID_ARGUMENT), "invalid_argument") == 0, "name");

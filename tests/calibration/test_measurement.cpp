@@ -500,18 +500,22 @@ TEST(Measurement, StationsRefuseBadSpecsInOneLine) {
   spec.count = 3;
   spec.translation = std::nan("");
   test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
-                          "stations:", {"finite"});
-  // Far outside the workspace: within +-30 m, a draw inside the seed's +-0.5 m has odds of 1e-5.
-  spec.translation = 30.0;
-  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
-                          "station 1:", {"1000 tries", "smaller ranges"});
-  // Finite but astronomically large: the lines to check would have 1e300 points (a count that
-  // overflowed an int before it was checked); refused the same way, and quickly.
-  spec.translation = 1e300;
-  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
-                          "station 1:", {"1000 tries", "smaller ranges"});
+                          "stations:", {"0 to 10 m", "got nan"});
+  // Beyond the widest range (check_stations_spec), as large as 1e300 (a count of points along the
+  // lines that would overflow an int): refused by the range's check, before a draw.
+  for (const double t : {10.5, 1e300}) {
+    spec.translation = t;
+    test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
+                            "stations:", {"translation range of 0 to 10 m"});
+  }
   spec.translation = 0.0;
-  spec.rotation = 1e300;  // any rotation is some pose: the checks along the line refuse it
+  spec.rotation = 1e300;
+  test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
+                          "stations:", {"rotation range of 0 to 90 deg"});
+  // Inside the ranges but far outside the workspace: within +-9 m, a draw inside the seed's
+  // +-0.5 m has odds of 1e-4.
+  spec.translation = 9.0;
+  spec.rotation = 0.0;
   test::expect_error_line([&] { (void)stations_trajectory(model, Strategy::Compensated, spec, 1e-3); },
                           "station 1:", {"1000 tries", "smaller ranges"});
 }

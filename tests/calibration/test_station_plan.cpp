@@ -279,8 +279,8 @@ TEST(StationPlan, BadSpecsAreRefusedNamingTheField) {
   // One line naming the field (ParameterError's parameter: the CLI's option, Python's keyword).
   const auto refused = [](StationPlanSpec spec, std::string_view field, std::initializer_list<std::string_view> parts) {
     StationPlan plan;
-    expect_error_line([&] { (void)plan_stations(seed_model(), Strategy::Compensated, spec, plan); },
-                      "station plan: ", parts);
+    // "station plan: ", or "stations: " for the run's own fields (check_stations_spec).
+    expect_error_line([&] { (void)plan_stations(seed_model(), Strategy::Compensated, spec, plan); }, "station", parts);
     try {
       (void)plan_stations(seed_model(), Strategy::Compensated, spec, plan);
       ADD_FAILURE() << field << ": not refused";
@@ -295,19 +295,30 @@ TEST(StationPlan, BadSpecsAreRefusedNamingTheField) {
   refused(s, "count", {"got 10001"});
   s = {};
   s.run.translation = std::nan("");
-  refused(s, "translation", {"finite translation range"});
+  refused(s, "translation", {"translation range of 0 to 10 m"});
+  s.run.translation = 10.5;
+  refused(s, "translation", {"translation range of 0 to 10 m", "got 10.5"});
   s = {};
   s.run.rotation = -0.1;
-  refused(s, "rotation", {"finite rotation range"});
+  refused(s, "rotation", {"rotation range of 0 to 90 deg"});
+  s.run.rotation = kMaxStationRotation + 1e-9;
+  refused(s, "rotation", {"rotation range of 0 to 90 deg"});
+  s = {};
+  s.run.translation = s.run.rotation = 0.0;
+  refused(s, "translation", {"a range > 0 in translation or rotation"});
   s = {};
   s.candidates = 39;
   refused(s, "candidates", {"40 (the stations) to 100000 candidates", "got 39"});
   s = {};
   s.noise = 0.0;
-  refused(s, "noise", {"noise > 0"});
+  refused(s, "noise", {"noise > 0 and below 0.01 m"});
+  s.noise = kMaxTrackerNoise;
+  refused(s, "noise", {"noise > 0 and below 0.01 m"});
   s = {};
   s.points_per_station = 0;
-  refused(s, "points_per_station", {"points per station >= 1"});
+  refused(s, "points_per_station", {"1 to 100000 points per station"});
+  s.points_per_station = kMaxPointsPerStation + 1;
+  refused(s, "points_per_station", {"got 100001"});
   s = {};
   s.accuracy_poses = 0;
   refused(s, "accuracy_poses", {"accuracy poses >= 1"});

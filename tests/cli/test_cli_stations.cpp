@@ -108,15 +108,19 @@ TEST(CliStations, BadOptionsExitTwoNamingTheOptionAndWriteNothing) {
     expect_error(run(args), 2, parts);
     EXPECT_FALSE(fs::exists(out));
   };
-  bad({"--count", "12"}, {"--count 12", "13 to 10000 stations"});
-  bad({"--count", "0"}, {"--count 0"});
+  // The library's checks (check_station_plan_spec, check_stations_spec) name the option.
+  bad({"--count", "12"}, {"[--count]", "13 to 10000 stations", "got 12"});
+  bad({"--count", "0"}, {"[--count]", "got 0"});
   bad({"--count", "20", "--range", "0.25"}, {"--range"});
   bad({"--count", "20", "--range", "-0.1,15"}, {"--range -0.1", "0 to 10 m"});
-  bad({"--count", "20", "--range", "0.25,95"}, {"--range 95", "0 to 90 deg"});
+  bad({"--count", "20", "--range", "0.25,95"}, {"--range 0.25,95", "0 to 90 deg"});
   bad({"--count", "20", "--range", "0,0"}, {"--range 0,0", "all be at home"});
-  bad({"--count", "20", "--candidates", "19"}, {"--candidates 19", "the stations (20)"});
-  bad({"--count", "20", "--noise-um", "0"}, {"--noise-um 0"});
-  bad({"--count", "20", "--points-per-station", "0"}, {"--points-per-station 0"});
+  bad({"--count", "20", "--candidates", "19"}, {"[--candidates]", "20 (the stations)", "got 19"});
+  bad({"--count", "20", "--noise-um", "0"}, {"[--noise-um]", "below 0.01 m", "got 0"});
+  bad({"--count", "20", "--noise-um", "1e4"}, {"[--noise-um]", "got 0.01"});
+  bad({"--count", "20", "--points-per-station", "0"}, {"[--points-per-station]", "got 0"});
+  bad({"--count", "20", "--points-per-station", "100001"}, {"[--points-per-station]", "got 100001"});
+  bad({"--count", "20", "--range", "10.5,15"}, {"--range 10.5,15", "0 to 10 m"});
   bad({"--count", "20", "--rate", "300"}, {"--rate 300", "divides the control rate 1000 Hz"});
   bad({"--count", "20", "--strategy", "both"}, {"--strategy"});
   bad({"--count", "20", "--config", (temp_dir() / "missing.yaml").string()}, {"--config", "missing.yaml"});

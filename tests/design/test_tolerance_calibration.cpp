@@ -211,7 +211,9 @@ TEST(ToleranceCalibration, TargetsAroundThePlatformCalibrateThePivotAndTheOrient
   EXPECT_EQ(layouts[0].position.p95, a.position_linear.p95);
   for (std::size_t k = 0; k < layouts.size(); ++k) {
     EXPECT_EQ(layouts[k].status, Status::Ok);
-    if (k > 0) EXPECT_LT(layouts[k].orientation.p95, layouts[k - 1].orientation.p95) << k;
+    if (k > 0) {
+      EXPECT_LT(layouts[k].orientation.p95, layouts[k - 1].orientation.p95) << k;
+    }
   }
 }
 

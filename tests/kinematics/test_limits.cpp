@@ -1,6 +1,8 @@
 // Limits: stroke, bend, U-joint and platform singularity, each reported with the right leg and value.
+#include <fmt/format.h>
 #include <Eigen/LU>
 #include <Eigen/SVD>
+
 #include <iomanip>
 
 #include "support.hpp"
@@ -46,6 +48,29 @@ TEST(Limits, StrokeViolationsNameLegAndValue) {
   LegState st;
   ASSERT_EQ(inverse_kinematics(seed_model(), side, st), Status::Ok);
   EXPECT_NEAR(r.value, st.length[r.leg], 1e-15);
+}
+
+TEST(Limits, ADescriptionNamesTheLegFromOneTheKeyAndDigitsThatTellValueFromBound) {
+  LimitReport r;
+  Pose up;
+  up.position.z() = 0.8;
+  ASSERT_EQ(check(seed_model(), up, r), Status::StrokeAboveMax);
+  const std::string text = describe(r);
+  EXPECT_EQ(text.rfind(fmt::format("leg {}: length ", r.leg + 1), 0), 0U) << text;
+  EXPECT_NE(text.find("above the maximum 2.450000 m (limits.length_max)"), std::string::npos) << text;
+  // A value a hair past its bound gets the digits that show it: never "2.450000 above 2.450000".
+  r.value = r.bound + 3e-8;
+  EXPECT_NE(describe(r).find("2.45000003 m is above the maximum 2.45000000 m"), std::string::npos) << describe(r);
+  r.value = r.bound + 1e-12;  // within 10 nm: at the limit
+  EXPECT_NE(describe(r).find("at the maximum 2.450000 m"), std::string::npos) << describe(r);
+  // The whole platform's limit has no leg; Ok is "ok".
+  LimitReport condition;
+  condition.status = Status::PlatformSingularity;
+  condition.value = 61.0;
+  condition.bound = 50.0;
+  EXPECT_EQ(describe(condition).rfind("the platform is near a singularity", 0), 0U) << describe(condition);
+  EXPECT_NE(describe(condition).find("(limits.jacobian_condition_max)"), std::string::npos);
+  EXPECT_EQ(describe(LimitReport{}), "ok");
 }
 
 TEST(Limits, BendViolationMatchesBendAngles) {

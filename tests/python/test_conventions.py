@@ -63,7 +63,8 @@ def test_a_leg_is_the_same_number_in_messages_and_the_command_line(stiff, refuse
         q = refused[i]
         with pytest.raises(hexatwist.StatusError) as e:
             hexatwist.motor_command(stiff, q)
-        assert (f"leg {leg}," in str(e.value)) == (leg > 0) and ("leg" in str(e.value)) == (leg > 0), str(e.value)
+        message = str(e.value)
+        assert (f"leg {leg}:" in message) == (leg > 0) and ("leg " in message) == (leg > 0), message
         # The command line reads the pose in degrees: the same doubles from short decimal text.
         text = ",".join(repr(float(v)) for v in (*q[:3], *np.rad2deg(q[3:])))
         pose = np.array([*q[:3], *np.deg2rad(np.array([float(t) for t in text.split(",")[3:]]))])
@@ -73,6 +74,8 @@ def test_a_leg_is_the_same_number_in_messages_and_the_command_line(stiff, refuse
         j = json.loads(out.stdout)
         assert j["status"] == hexatwist.STATUS_NAMES[again.status], text
         assert j["limit"].get("leg", 0) == again.limit_leg, text
+        # One wording of a limit (describe(LimitReport) in the library), Python's and the CLI's.
+        assert j["limit"]["message"] in message, (message, j["limit"]["message"])
     assert seen == set(range(7))
 
 
@@ -164,3 +167,10 @@ def test_from_arrays_takes_one_hand_or_six_and_model_gives_them_back(model):
     with pytest.raises(TypeError):  # the limits are keyword-only: no silent shift of a positional argument
         hexatwist.Model.from_arrays(model.base, model.platform, model.base_axes, model.platform_axes, 1.5, 0.01,
                                     "right", "base", 0.0, 1.4, 2.45, 0.7, 0.08)
+
+
+def test_the_version_is_the_clis():
+    cli = tool("HEXATWIST_CLI")
+    out = subprocess.run([cli, "--version"], capture_output=True, text=True, timeout=30, check=True)
+    assert out.stdout == f"hexatwist {hexatwist.__version__}\n"
+    assert all(part.isdigit() for part in hexatwist.__version__.split(".")) and hexatwist.__version__.count(".") == 2

@@ -245,6 +245,9 @@ void hexatwist_fk_tracker_reset(hexatwist_fk_tracker* tracker);
 hexatwist_status hexatwist_fk_tracker_set(const hexatwist_model* model, hexatwist_fk_tracker* tracker,
                                           const double pose[6], hexatwist_length_kind kind);
 
+/** The library's version, "major.minor.patch" (hexatwist/version.hpp). */
+const char* hexatwist_version(void);
+
 /** Stable snake_case name of a status ("stroke_above_max"); "unknown" for other values. */
 const char* hexatwist_status_name(hexatwist_status status);
 

@@ -61,7 +61,7 @@ struct IdentificationOptions {
   /// chi-square of one degree of freedom: 25 = 5 sigma).
   double sign_separation_min = 25.0;
   int folds = 5;                    ///< cross-validation folds over the stations (0 = none; needs >= 2)
-  int accuracy_poses = 1000;        ///< poses of the predicted accuracy over the calibrated range
+  int accuracy_poses = 1000;        ///< poses of the predicted accuracy over the calibrated range (0: none)
   std::uint64_t accuracy_seed = 1;  ///< their seed
   int max_iterations = 100;         ///< solver iterations per sign
   /// Largest accepted condition number of the column-scaled Jacobian; above it some parameter
@@ -198,6 +198,17 @@ struct Identification {
   Identification() { axis_sd.fill(std::numeric_limits<double>::quiet_NaN()); }
 };
 
+/// Most cross-validation folds.
+inline constexpr int kMaxFolds = 100;
+
+/// The one check of IdentificationOptions (identify runs it; the CLI and Python reach it through
+/// identify): throws hexatwist::ParameterError naming the field out of its range. tracker_noise NaN
+/// or in (0, kMaxTrackerNoise); tracker_noise_floor in [0, kMaxTrackerNoise); fit_sigmas,
+/// effect_sigmas, sign_separation_min, axis_sd_max and max_registration_misfit finite and > 0;
+/// folds 0 (none) or 2 to kMaxFolds; accuracy_poses 0 (none) to 100000; max_iterations >= 1;
+/// max_condition finite and > 1; fk as check_fk_options.
+void check_identification_options(const IdentificationOptions& options);
+
 /// Identifies the platform from the observations (theory §13): the nominal model and a Kabsch
 /// start, both thread senses by Levenberg-Marquardt (Ceres), the sense of lower cost; with
 /// AxisFit::Auto the axes the data determine; then the decisions. Returns Ok, or: NonFiniteInput;
@@ -205,7 +216,8 @@ struct Identification {
 /// rank-deficient Jacobian naming the parameters, a leg without U-joint axes, an unknown tracker
 /// noise); SignUndecided (both senses fit alike); ModelMismatch (the fit leaves more than the
 /// tracker's noise: the worst stations and a hint are given); SolverNoConvergence; or a forward
-/// kinematics status. `out.reason` says why in one line; `out.hint` what to do.
+/// kinematics status. `out.reason` says why in one line; `out.hint` what to do. Throws as
+/// check_identification_options for options out of their ranges.
 [[nodiscard]] Status identify(const Model& nominal, std::span<const Observation> observations, Identification& out,
                               const IdentificationOptions& options = {});
 

@@ -15,6 +15,11 @@
 
 namespace hexatwist {
 
+/// The largest tracker noise (a standard deviation per coordinate) a calibration takes: 10 mm [m].
+inline constexpr double kMaxTrackerNoise = 0.01;
+/// Most tracker points per station (and target) a plan or a simulated calibration takes.
+inline constexpr int kMaxPointsPerStation = 100000;
+
 /// One tracker measurement: where a target on the platform was seen while the legs stood at the
 /// motor-side lengths they were commanded to.
 struct Observation {

@@ -58,12 +58,22 @@ inline constexpr double kMaxApproach = 0.05;
 
 /// Most stations a run may have.
 inline constexpr int kMaxStations = 10000;
+/// The widest ranges stations are drawn in: +-10 m in x, y, z and +-90 deg in roll, pitch, yaw
+/// (beyond, the pose's angles stop meaning what a person reads in them) [m, rad].
+inline constexpr double kMaxStationTranslation = 10.0, kMaxStationRotation = 1.5707963267948966;
+
+/// The one check of a StationsSpec, which random_stations, station_waypoints, the station plan,
+/// the CLI and Python all go through: throws hexatwist::ParameterError naming the field out of its
+/// range (count 1 to kMaxStations; translation 0 to kMaxStationTranslation and rotation 0 to
+/// kMaxStationRotation, not both 0; approach 0 to kMaxApproach; reference_every >= 0; dwell and
+/// the move limits finite and > 0).
+void check_stations_spec(const StationsSpec& spec);
 
 /// `spec.count` random stations, each drawn again (up to 1000 times) while it, or a pose every 5 mm
 /// (or 5 mrad) along the straight move to it from the one before (home before the first), is
 /// outside a limit of `model` for the commands of `strategy`; the last must also reach home. Poses
-/// [m, rad] from home. Throws hexatwist::Error for a count below 1 or above kMaxStations, a range
-/// that is not finite and >= 0, and no reachable station in 1000 draws.
+/// [m, rad] from home. Throws as check_stations_spec, and hexatwist::Error for no reachable
+/// station in 1000 draws.
 std::vector<Vector6d> random_stations(const Model& model, Strategy strategy, const StationsSpec& spec);
 
 /// True if `to` and the poses every 5 mm (5 mrad) on the straight line from `from` to it are inside
@@ -72,8 +82,7 @@ bool reachable_from(const Model& model, Strategy strategy, const Vector6d& from,
 
 /// The poses a run visits, in order: home, the stations (each from both sides with spec.approach,
 /// home again every spec.reference_every), home [m, rad]. Throws hexatwist::Error naming the
-/// station if a move to it leaves a limit (reachable_from), or for an approach outside [0,
-/// kMaxApproach] or a negative reference_every.
+/// station if a move to it leaves a limit (reachable_from), and as check_stations_spec.
 std::vector<Vector6d> station_waypoints(const Model& model, Strategy strategy, std::span<const Vector6d> stations,
                                         const StationsSpec& spec);
 

@@ -24,6 +24,16 @@ struct ToleranceSigmas {
   double offset = 0.1e-3;               ///< zero offset of the leg (length at the drive's reference) [m]
 };
 
+/// The widest sigmas a study takes: 0.1 m for a joint's centre and the zero offset (1e5 um),
+/// 10 deg for an axis, 0.1 (1e5 ppm) for the lead (beyond, the errors are not small and the
+/// linear model and the sampled platforms stop meaning a manufacturing tolerance).
+inline constexpr double kMaxSigmaLength = 0.1, kMaxSigmaAxis = 0.17453292519943295, kMaxSigmaLead = 0.1;
+
+/// The one check of ToleranceSigmas (the study's functions run it; the CLI and Python reach it
+/// through them or call it first): throws hexatwist::ParameterError naming the field (base_joint,
+/// platform_joint, base_axis, platform_axis, lead, offset) that is not from 0 to its maximum.
+void check_tolerance_sigmas(const ToleranceSigmas& sigmas);
+
 /// Errors per leg, in this order: base joint x, y, z [m, B]; platform joint x, y, z [m, P]; base
 /// axis turned about e1, e2 [rad]; platform axis alike [rad]; relative lead error [-]; zero
 /// offset [m]. e1 = unit(axis x z) (unit(axis x x) for a vertical axis), e2 = axis x e1.

@@ -49,11 +49,8 @@ struct TrackerCalibration {
   CalibratedFrames frames = CalibratedFrames::Tracker;  ///< where the errors are measured
 };
 
-/// Most points per station a TrackerCalibration takes.
-inline constexpr int kMaxPointsPerStation = 100000;
-
 /// Throws hexatwist::ParameterError naming the field when `calibration` is unusable: no station, a station
-/// that is not finite, a noise that is not finite and > 0, points outside 1..kMaxPointsPerStation,
+/// that is not finite, a noise outside (0, kMaxTrackerNoise), points outside 1..kMaxPointsPerStation,
 /// a single point per station without identification.tracker_noise (the scatter needs two), an
 /// identification of another model than Geometry (the study's errors move the joints), more than
 /// kMaxTargets targets with the observation point, or one that is not finite, farther than 10 m from

@@ -2,6 +2,8 @@
 // singularity.
 #pragma once
 
+#include <string>
+
 #include "hexatwist/kinematics/kinematics.hpp"
 
 namespace hexatwist {
@@ -19,6 +21,11 @@ struct LimitReport {
   double value = 0.0;          ///< the offending quantity [m, rad, or - for a condition number]
   double bound = 0.0;          ///< the limit it crossed [m, rad, or -]
 };
+
+/// One line for a limit report, as the CLI and Python word it: "leg 3: length 2.450013 m is above
+/// the maximum 2.450000 m (limits.length_max)", with the configuration key of the limit and as
+/// many decimals as it takes to tell the value from its bound; "ok" for Ok.
+[[nodiscard]] std::string describe(const LimitReport& report);
 
 /// U-joint bend angles: base, angle between s_i and its home direction; platform, the same seen
 /// from the platform frame [rad].
