@@ -3,6 +3,8 @@
 // LegState: one computation, the same forces from either.
 #pragma once
 
+#include <array>
+
 #include "hexatwist/kinematics/leg_effects.hpp"
 #include "kinematics/gauss_jordan.hpp"
 #include "kinematics/lanes.hpp"
@@ -61,38 +63,64 @@ inline void add_leg_loads(const StaticLoadSpec& load, const lanes3& s, const lan
   // A^T F = G' by blocks (legs 0, 2, 4 and 1, 3, 5: three legs spread around the platform, whose
   // axes are far from coplanar on any hexapod): cofactor inverses, short chains, no pivot search.
   // Where a block is nearly singular, the pivoted elimination.
-  constexpr int kW = sizeof(lane_v) / sizeof(double);
-  const auto a = [&](int row, int column) { return rows_of_A[row][column / kW][column % kW]; };
-  Matrix3d P, Q, R, T;  // A^T = [P Q; R T]: columns of P and R from legs 0, 2, 4
-  for (int j = 0; j < 3; ++j)
-    for (int c = 0; c < 3; ++c) {
-      P(c, j) = a(2 * j, c);
-      R(c, j) = a(2 * j, c + 3);
-      Q(c, j) = a(2 * j + 1, c);
-      T(c, j) = a(2 * j + 1, c + 3);
+  // A^T = [P Q; R T] by columns: column j of P and R is row 2j of A (legs 0, 2, 4: its first and
+  // last three entries), of Q and T row 2j + 1; each column a 4-lane vector (x, y, z, 0), the
+  // whole solve in a dozen vector operations per step (Eigen's 3x3 blocks went through the stack).
+  using M3 = std::array<v4d, 3>;  // columns
+  // Entries first .. first + 2 of a row of A as (x, y, z, 0): two shuffles of the row's register
+  // with eight lanes, else element by element.
+  const auto half = [&](int row, int first) {
+    constexpr int kW = sizeof(lane_v) / sizeof(double);
+    if constexpr (kW == 8) {
+      const lane_v r = rows_of_A[row][0], zero = {};
+      return first == 0 ? __builtin_shufflevector(r, zero, 0, 1, 2, 8) : __builtin_shufflevector(r, zero, 3, 4, 5, 8);
+    } else {
+      const auto at = [&](int c) { return rows_of_A[row][c / kW][c % kW]; };
+      return v4d{at(first), at(first + 1), at(first + 2), 0.0};
     }
-  // The adjugate and determinant of M; true when M is well away from singular: |det| above a
-  // tenth of the product of the columns' norms (a test that does not change with M's scale).
-  const auto adjugate = [](const Matrix3d& M, Matrix3d& adj, double& det) {
-    const Vector3d c0 = M.col(1).cross(M.col(2)), c1 = M.col(2).cross(M.col(0)), c2 = M.col(0).cross(M.col(1));
-    det = M.col(0).dot(c0);
-    adj.row(0) = c0.transpose();
-    adj.row(1) = c1.transpose();
-    adj.row(2) = c2.transpose();
-    return det * det > 0.01 * (M.col(0).squaredNorm() * M.col(1).squaredNorm() * M.col(2).squaredNorm());
+  };
+  M3 P, Q, R, T;
+  for (int j = 0; j < 3; ++j) {
+    P[j] = half(2 * j, 0);
+    R[j] = half(2 * j, 3);
+    Q[j] = half(2 * j + 1, 0);
+    T[j] = half(2 * j + 1, 3);
+  }
+  const auto cross = [](v4d u, v4d v) {
+    return __builtin_shufflevector(u, u, 1, 2, 0, 3) * __builtin_shufflevector(v, v, 2, 0, 1, 3) -
+           __builtin_shufflevector(u, u, 2, 0, 1, 3) * __builtin_shufflevector(v, v, 1, 2, 0, 3);
+  };
+  const auto dot = [](v4d u, v4d v) {
+    const v4d p = u * v;
+    return p[0] + p[1] + p[2];
+  };
+  const auto splat4 = [](double s) { return v4d{s, s, s, s}; };
+  // M v for M by columns.
+  const auto times = [&](const M3& M, v4d v) {
+    return M[0] * splat4(v[0]) + M[1] * splat4(v[1]) + M[2] * splat4(v[2]);
+  };
+  // The adjugate of M by columns (its rows are the cross products of M's columns) and the
+  // determinant; true when M is well away from singular: |det| above a tenth of the product of
+  // the columns' norms (a test that does not change with M's scale).
+  const auto adjugate = [&](const M3& M, M3& adj, double& det) {
+    const v4d r0 = cross(M[1], M[2]), r1 = cross(M[2], M[0]), r2 = cross(M[0], M[1]);
+    det = dot(M[0], r0);
+    adj = {v4d{r0[0], r1[0], r2[0], 0.0}, v4d{r0[1], r1[1], r2[1], 0.0}, v4d{r0[2], r1[2], r2[2], 0.0}};
+    return det * det > 0.01 * (dot(M[0], M[0]) * dot(M[1], M[1]) * dot(M[2], M[2]));
   };
   // The Schur complement scaled by det P, S' = det P (T - R P^-1 Q) = det P T - R adj(P) Q, keeps
   // the division by det P off the critical path: F2 = S'^-1 (det P G2 - R adj(P) G1) and
   // F1 = (adj(P) G1 - adj(P) Q F2) / det P.
-  Matrix3d P_adj, S_adj;
+  M3 P_adj, S_adj, X, S;
   double det_P = 0.0, det_S = 0.0;
   bool blocks = adjugate(P, P_adj, det_P);
-  const Matrix3d X = P_adj * Q;
-  const Vector3d y = P_adj * G.head<3>();
-  blocks = blocks && adjugate(det_P * T - R * X, S_adj, det_S);
+  for (int j = 0; j < 3; ++j) X[j] = times(P_adj, Q[j]);
+  const v4d y = times(P_adj, v4d{G[0], G[1], G[2], 0.0});
+  for (int j = 0; j < 3; ++j) S[j] = splat4(det_P) * T[j] - times(R, X[j]);
+  blocks = adjugate(S, S_adj, det_S) && blocks;
   if (blocks) {
-    const Vector3d F2 = S_adj * (det_P * G.tail<3>() - R * y) * (1.0 / det_S);
-    const Vector3d F1 = (y - X * F2) * (1.0 / det_P);
+    const v4d F2 = times(S_adj, splat4(det_P) * v4d{G[3], G[4], G[5], 0.0} - times(R, y)) * splat4(1.0 / det_S);
+    const v4d F1 = (y - times(X, F2)) * splat4(1.0 / det_P);
     force << F1[0], F2[0], F1[1], F2[1], F1[2], F2[2];
   } else if (!solve_transposed(rows_of_A, G, force)) {
     return Status::SingularJacobian;
