@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Speed of the calibration (issue 21: "the geometric identification of 40 stations in <= 2 s"):
 // identify on the points at rest of a synthetic 40-station run, the geometric model (40
 // parameters, both thread senses, 5-fold cross-validation, 1000 poses of predicted accuracy) and

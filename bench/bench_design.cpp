@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Speed of the design subsystem (docs/theory/design.md §16-18): one membership test of the
 // workspace searches, a column search, the seed's workspace volume, a map point, the design of the
 // seed's U-joint axes, one (platform, pose) of the tolerance study and the norm of a 3-D normal

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Speed of the mechanism's dynamics, side by side in one run: inverse dynamics per call (six
 // legs), the mass matrix, the forward dynamics, the closed-loop simulation on the full model in
 // simulated seconds per wall second, and (with HEXATWIST_MUJOCO) MuJoCo stepping the exported model

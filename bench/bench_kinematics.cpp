@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Real-time path timings: compensated commands, warm and cold twist-aware forward kinematics; and
 // batches of 10^6 poses across the lanes (batch.hpp) beside the same poses one call at a time.
 // Run in Release: build/bench/bench_kinematics. Each benchmark repeats 15 times and reports the

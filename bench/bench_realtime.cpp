@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Worst-case timing of the real-time path: every call timed on its own, reported as percentiles
 // (p50, p99, p99.9, max, in ns) for the compensated command, the warm twist-aware FK and the
 // stream's per-line processing (parse, check, rate-limit, format); and a loopback UDP round trip

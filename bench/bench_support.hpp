@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Shared by the benchmarks: the seed platform, poses inside its limits, a realistic 1 kHz motion,
 // repetition statistics, and a per-call timer for latency percentiles.
 #pragma once

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Debian packages of hexatwist, one per install component (`cpack -G DEB` in the build folder;
 # tests/packaging/check_debs.cmake builds and checks them):
 #   hexatwist            the command-line tool, the seed configuration, the licence

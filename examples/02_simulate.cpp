@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The servo simulation from C++: a yaw sweep of +-10 deg on the seed platform, closed loop, with
 // the conventional and the compensated commands, and the error of point A.
 #include <hexatwist/hexatwist.hpp>

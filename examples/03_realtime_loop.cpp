@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A fixed-rate servo loop (1 kHz) that calls the real-time API: every period it takes the pose the
 // motion cue asks for, gets six checked, rate-limited motor commands from hexatwist, hands them
 // to the drives, and checks its deadline. Nothing inside the loop allocates, locks or prints.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Twist over a workspace slice (x-y plane 0.1 m above home, yaw 10 deg): 200 x 200 poses, each with
 // the twist of its legs (Eq. 7-9), the length error it causes (Eq. 10) and its compensated commands
 // checked against every limit; the largest twist and length error over the poses inside the limits.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // One test of the paper's study (§4, Table 1): the rotation about z through +-30 deg, simulated
 // twist-free, with the conventional and with the compensated commands, and the observation error
 // split into what the twist and what the servos do. The twin of examples/python/05_study.py, which

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Motor sizing along the fast motion-simulator cue examples/motion_simulator.csv, as `hexatwist
 // dynamics` does: the inverse dynamics of the whole mechanism at every control tick, each motor's
 // peaks and largest torque parts, and where the cue leaves the seed motor's envelope. The twin of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Designing the seed's fixed U-joint axes (docs/theory/design.md §16-18): the constant-orientation
 // workspace's volume with its stated error, the required workspace (the study's tests and 2000
 // random combined poses), and the symmetric turns of the axes that minimise the largest twist over

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Fuzz target: a YAML configuration (hexatwist::load_config). Bad text must end in
 // hexatwist::Error with a one-line message that starts with the source name; any other exception,
 // a crash or a sanitizer finding is a bug. A configuration that loads must give a model whose

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Fuzz target: pose lines through the real-time stream on the seed platform
 // (hexatwist::parse_pose_line, stream_line, format_stream_output). The first byte chooses the
 // stream settings (strategy, reject policy, angle unit, rate limits, start at home, output

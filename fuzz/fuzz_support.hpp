@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Shared by the fuzz targets: the input as text, and invariant checks that stop the program (a
 // crash for libFuzzer, a failed test for the replay under ctest).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Fuzz target: trajectory CSV text (hexatwist::parse_trajectory_csv), then its resampling. Bad text
 // must end in hexatwist::Error with a one-line message that starts with the source name; any other
 // exception, a crash or a sanitizer finding is a bug. What parses must hold what the header

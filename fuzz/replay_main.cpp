@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Replays fuzz inputs without libFuzzer: every argument is a file or a directory of files, and
 // every file is passed once to the target's LLVMFuzzerTestOneInput. ctest runs it over
 // fuzz/corpus/<target>/ and fuzz/regressions/<target>/ in the normal and the sanitizer builds.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs missing packages, then configures and builds hexatwist (Release) in build/.
 #   bash scripts/build.sh              every target: the library, the CLI, tests, benchmarks, examples,
 #                                      the Python package and the LinuxCNC module (scripts/test.sh)

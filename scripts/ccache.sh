@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Sourced by scripts/build.sh, test.sh and fuzz.sh: compile through ccache (installed by setup.sh),
 # so that a rebuild after a small change, a second build folder or a fresh clone of the same
 # sources (CI) compiles only what changed. Paths are hashed relative to the clone, so clones in

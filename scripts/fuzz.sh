@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Builds the libFuzzer targets (clang, with ASan and UBSan) in build-fuzz/ and runs each for
 # SECONDS (default 60). Each run reads the seed corpus fuzz/corpus/<target>/ and the saved
 # regressions, writes the inputs it finds into a scratch corpus build-fuzz/corpus/<target>/

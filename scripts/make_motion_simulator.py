@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Writes examples/motion_simulator.csv: a fast motion-simulator cue for `hexatwist dynamics`.
 
 At rest at home, then a heave bump with a surge swing under it, a yaw swing and a roll swing,

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The main job: set up, build, and run hexatwist. Arguments go to hexatwist; the default is
 # `study`: the paper's four tests on the seed platform, written to ./study-out/ in the folder you
 # run this from. Example: bash scripts/run.sh ik --pose=0,0,0.1,0,0,30

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Drafts a JSON schema (draft 2020-12) from example documents of one kind, for docs/schemas/.
 
     python3 scripts/schema_draft.py NAME/VERSION "TITLE" EXAMPLE.json... > docs/schemas/NAME.schema.json

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs the Debian packages hexatwist needs to build and test, if any is missing.
 # Non-interactive; runs apt-get as root (or through sudo). Safe to run again: it installs nothing
 # when everything is present.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Set up, build, and run every test: the Release suite through ctest (unit, property, CLI, install,
 # examples, fuzz-input replays, stream stress test, benchmark smoke run); the same suite built with
 # AddressSanitizer + UndefinedBehaviorSanitizer in build-asan/; a bounded run of each libFuzzer

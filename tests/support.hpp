@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Test support: seeded random platforms and poses, an independent joint-chain twist, pose errors,
 // stress counts and measured-residual reports.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Test support for configuration files: the seed platform as YAML text with one key per line
 // (tests break it one line at a time and check the reported line), and line editing helpers.
 #pragma once

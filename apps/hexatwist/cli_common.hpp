@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Shared pieces of the hexatwist command-line tool: exit codes, input parsing, model loading.
 #pragma once
 

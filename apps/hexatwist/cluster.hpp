@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The command line's door to a Dask cluster (`--scheduler tcp://HOST:PORT`): a request runs through the
 // Python package (python3 -m hexatwist.cluster, which drives the workers), and the merged summaries
 // come back as arrays for the command to finish its report with the library.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist compare: what changed between two configurations' platforms, joint by joint, and where
 // the first one's commands put point A on the second (calibration/validation.hpp).
 #include <fmt/format.h>

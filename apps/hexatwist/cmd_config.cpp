@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist config: the resolved platform model, every leg's vectors.
 #include <fmt/format.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist design: the fixed U-joint axes that minimise the twist, the length error or the sensitivity
 // to the lead over a required workspace, every limit kept there and the volume kept
 // (design/axis_design.hpp); writes the designed configuration (io/platform_yaml.hpp).

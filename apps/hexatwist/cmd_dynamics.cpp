@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist dynamics: motor sizing along a trajectory from a CSV file (motor_sizing.hpp): the
 // per-sample CSV, summary.json, the torque-speed figure, and a table on the terminal.
 #include <fmt/format.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist fk: the pose for six leg lengths (geometric, or motor-side with the twist included).
 #include <fmt/format.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist identify: the platform identified from a tracker's point log (the library decides,
 // identification.hpp), printed, and written as a corrected configuration with the map of its
 // predicted accuracy (docs/theory/calibration.md §13).

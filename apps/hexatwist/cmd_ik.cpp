@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist ik: leg lengths, twist, length error and both motor commands for one pose.
 #include <fmt/format.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist linuxcnc: a LinuxCNC INI file for a platform driven by the hexatwistkins module, with
 // the numbers a LinuxCNC configuration needs from the kinematics ([TRAJ] HOME, each joint's HOME,
 // HOME_OFFSET and limits, each axis' reach).
@@ -34,8 +35,28 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
   const Strategy strategy = strategy_option(o.strategy);
   const LimitSpec& lim = model.spec().limits;
   const double home_z = model.spec().home_height;
-  // The drives' reference: the joints read these after homing (home_commands, theory §4).
+  // The drives' reference: the joints read these at the home switches (home_commands, theory §4),
+  // LinuxCNC's HOME_OFFSET. HOME is where each joint then goes: the commands of the nominal home
+  // pose, [TRAJ] HOME. On the configuration the drives were set up with the two are the same; on a
+  // calibrated one the switches leave the platform a little off home, and the move to HOME after
+  // homing takes it to the pose the user expects.
   const Vector6d home_motor = model.home_command();
+  Vector6d home_pose_motor;
+  LimitReport home_limit;
+  if (const Status s = motor_commands(model, Pose{}, strategy, home_pose_motor, home_limit); s != Status::Ok)
+    throw ExitError(kExitOutOfLimit, fmt::format("home is outside a limit: {}", describe(home_limit)));
+  std::string homed_note;
+  if ((home_pose_motor - home_motor).cwiseAbs().maxCoeff() > 1e-9) {
+    FkResult at_switches;
+    if (forward_kinematics(model, home_motor, LengthKind::Motor, Placement{}, at_switches) == Status::Ok) {
+      const Pose& q = at_switches.pose;
+      homed_note = fmt::format(
+          "# At the home switches (HOME_OFFSET) this calibrated platform stands at X Y Z A B C =\n"
+          "# {} {} {} {} {} {}; after homing each joint moves on to its HOME, the commands of this HOME.\n",
+          fixed(q.position.x() * unit), fixed(q.position.y() * unit), fixed((home_z + q.position.z()) * unit),
+          fixed(rad2deg(q.rpy.x())), fixed(rad2deg(q.rpy.y())), fixed(rad2deg(q.rpy.z())));
+    }
+  }
 
   std::string kins = "hexatwistkins";
   if (!o.model.config.empty()) kins += " config=" + std::filesystem::absolute(o.model.config).string();
@@ -69,16 +90,17 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
       o.display);
   t += fmt::format(
       "[TRAJ]\nCOORDINATES = X Y Z A B C\nLINEAR_UNITS = {}\nANGULAR_UNITS = degree\n"
-      "# Home: the platform frame at home_height above the base, no rotation.\n"
+      "# Home: the platform frame at home_height above the base, no rotation.\n{}"
       "HOME = 0 0 {} 0 0 0\n"
       "# Speeds of the configuration's study motion (study.linear, study.angular_deg).\n"
       "DEFAULT_LINEAR_VELOCITY = {}\nMAX_LINEAR_VELOCITY = {}\nDEFAULT_LINEAR_ACCELERATION = {}\n"
       "MAX_LINEAR_ACCELERATION = {}\nDEFAULT_ANGULAR_VELOCITY = {}\nMAX_ANGULAR_VELOCITY = {}\n"
       "DEFAULT_ANGULAR_ACCELERATION = {}\nMAX_ANGULAR_ACCELERATION = {}\n\n",
-      o.units, fixed(home_z * unit), fixed(study.linear.velocity * unit), fixed(study.linear.velocity * unit),
-      fixed(study.linear.acceleration * unit), fixed(study.linear.acceleration * unit),
-      fixed(rad2deg(study.angular.velocity)), fixed(rad2deg(study.angular.velocity)),
-      fixed(rad2deg(study.angular.acceleration)), fixed(rad2deg(study.angular.acceleration)));
+      o.units, homed_note, fixed(home_z * unit), fixed(study.linear.velocity * unit),
+      fixed(study.linear.velocity * unit), fixed(study.linear.acceleration * unit),
+      fixed(study.linear.acceleration * unit), fixed(rad2deg(study.angular.velocity)),
+      fixed(rad2deg(study.angular.velocity)), fixed(rad2deg(study.angular.acceleration)),
+      fixed(rad2deg(study.angular.acceleration)));
   t += fmt::format("[KINS]\nKINEMATICS = {}\nJOINTS = 6\n", kins);
   if (model.has_thermal())
     t += fmt::format(
@@ -89,14 +111,18 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
   t += "\n";
 
   for (int i = 0; i < kLegs; ++i) {
+    const std::string at_home =
+        homed_note.empty()
+            ? fmt::format("At home {} {}", fixed(home_motor[i] * unit), o.units)
+            : fmt::format("At the home switch {} {} (HOME_OFFSET), at home {} {} (HOME)", fixed(home_motor[i] * unit),
+                          o.units, fixed(home_pose_motor[i] * unit), o.units);
     t += fmt::format(
-        "[JOINT_{}]\n# Leg {}: motor-side length. At home {} {}; the stroke limits.length_min .. length_max.\n"
+        "[JOINT_{}]\n# Leg {}: motor-side length. {}; the stroke limits.length_min .. length_max.\n"
         "TYPE = LINEAR\nHOME = {}\nHOME_OFFSET = {}\nHOME_SEQUENCE = 0\nMIN_LIMIT = {}\nMAX_LIMIT = {}\n"
         "# Motor speed limit (servo.max_speed_rpm, lead, gear_ratio); full speed in 0.1 s (not in the config).\n"
         "MAX_VELOCITY = {}\nMAX_ACCELERATION = {}\n\n",
-        i, i + 1, fixed(home_motor[i] * unit), o.units, fixed(home_motor[i] * unit), fixed(home_motor[i] * unit),
-        fixed(lim.length_min * unit), fixed(lim.length_max * unit), fixed(joint_velocity * unit),
-        fixed(10.0 * joint_velocity * unit));
+        i, i + 1, at_home, fixed(home_pose_motor[i] * unit), fixed(home_motor[i] * unit), fixed(lim.length_min * unit),
+        fixed(lim.length_max * unit), fixed(joint_velocity * unit), fixed(10.0 * joint_velocity * unit));
   }
   for (int k = 0; k < 6; ++k) {
     AxisRange range;

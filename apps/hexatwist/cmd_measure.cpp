@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist measure: a point log (real or synthetic) registered, evaluated and reported beside the
 // simulation of the same run, as the paper's experiment (§5, Table 1; docs/theory.md §12).
 #include <fmt/format.h>

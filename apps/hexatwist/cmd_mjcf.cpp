@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist mjcf: the platform as a MuJoCo model (MJCF XML, mjcf.hpp, docs/theory.md §15).
 #include <fmt/format.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist stations: where to measure. The library plans the stations of a calibration run
 // (station_plan.hpp: the Ds-optimal choice among candidates inside every limit, ordered into a run
 // of reachable moves) and compares them with random stations; this command prints the plan and

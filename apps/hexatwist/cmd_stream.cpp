@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist stream: one pose per line (stdin) or datagram (UDP) in, one answer per input out,
 // in order: six checked motor commands and a status (include/hexatwist/kinematics/stream.hpp does the work;
 // this file only moves bytes).

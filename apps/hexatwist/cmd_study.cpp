@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist study / simulate: the closed-loop servo simulation of the paper's four tests, or of a
 // trajectory from a CSV file, with both strategies; writes the report (study_report.hpp).
 #include <fmt/format.h>

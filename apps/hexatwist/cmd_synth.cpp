@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist synth: a tracker-like point log made from the simulation of a platform with known parameter
 // errors, with the truth beside it (docs/theory.md §12).
 #include <fmt/format.h>

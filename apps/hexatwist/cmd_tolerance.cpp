@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist tolerance: how accurate a platform built with manufacturing errors is, before it is built
 // (design/tolerance.hpp): the Monte Carlo over sampled platforms driven by the nominal compensated
 // commands, beside the linearised (covariance) answer; on this machine or a Dask cluster.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist workspace: the constant-orientation workspace (its volume, its boundary in slices with the
 // limit of every boundary point), the orientation workspace at a position, and maps over a slice
 // (design/workspace_*.hpp); summary.json, CSVs and figures, on this machine or a Dask cluster.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Every subcommand of the tool, registered in the order `--help` lists them.
 #include <charconv>
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Options the design commands share (workspace, design, tolerance): the required workspace
 // (--workspace SPEC or --trajectory FILE...) and the Dask scheduler (--scheduler tcp://HOST:PORT).
 #pragma once

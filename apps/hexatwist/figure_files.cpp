@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Writing figures: gnuplot found and run on the script (figure_script.hpp) in a private scratch
 // directory, its first error named by figure, and each drawn file moved to its place whole.
 #include "figures.hpp"

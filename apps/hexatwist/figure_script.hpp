@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The gnuplot script of a set of figures (figures.cpp), run by write_figures (figure_files.cpp).
 // Internal to the CLI.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Line-plot figures for reports, drawn by gnuplot (PNG and SVG); the only plotting code of the project.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A minimal JSON writer for the CLI's --json output (numbers round-trip exactly; NaN/inf become
 // null, which the CLI never emits for a valid result).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist: twist-aware kinematics of lead-screw Stewart platforms, from the command line.
 // This directory is the only code of the project that reads files and writes to the terminal.
 #include <fmt/format.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The one writer of the tool's files: every command that writes files puts them in place through an
 // OutputFiles transaction, so that an output never replaces an input or another output, a report
 // folder holds one run's files, and a failed run leaves every file that existed before it byte for

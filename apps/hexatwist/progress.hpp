@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A progress line on stderr for the long runs (study, simulate, tolerance): the share done, what is
 // running and an estimate of the time left. Drawn only when stderr is a terminal and the command
 // prints a text report (never when piped, redirected or with --json), and erased when the run ends.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What synth, measure and identify share: the run the platform made (a study test after the
 // calibration moves, a trajectory file or a stations run) and how to read a tracker's point log.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The name and version of each JSON document the tool writes, its first field ("schema"). Each is a
 // file in docs/schemas/ (NAME.schema.json, with the version in its $id), and the tests validate the
 // tool's outputs against them (tests/docs/check_schemas.py). A change that breaks a reader (a field

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // How every command ends on a signal. SIGINT, SIGTERM and SIGHUP end a run as a failure does:
 // what the run was writing is rolled back (the OutputFiles transaction, a figure's scratch folder),
 // its children (gnuplot, a Dask client) are stopped, one line says so on stderr, and the exit code

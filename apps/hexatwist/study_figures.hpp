@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The figures of a study, simulate or measure report (drawn by figures.hpp), and the names and
 // axes they share with the report's tables.
 #pragma once

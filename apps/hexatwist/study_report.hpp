@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What `hexatwist study` and `hexatwist simulate` write: the terminal table, summary.json,
 // summary.md, one CSV per test and strategy, and the figures.
 #pragma once

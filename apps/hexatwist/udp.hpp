@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // UDP endpoints of `hexatwist stream` (POSIX sockets): addresses written udp://HOST:PORT, a
 // socket that receives one datagram per pose, and one that sends one datagram per answer.
 #pragma once

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Benchmarks of the Python package: median (and worst) of repetitions.
 
     PYTHONPATH=build/python /usr/bin/python3 bench/python/bench_python.py [--reps 15] [--baseline DIR]

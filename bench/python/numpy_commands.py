@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The compensated motor commands of hexatwist.commands written in plain numpy, for the benchmark.
 
 The same computation as the library's motor_commands (docs/theory/kinematics.md §2-§6): inverse

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The required workspace and the design of the fixed U-joint axes (design/required_workspace.hpp,
 // design/axis_design.hpp), with the designed configuration's YAML (io/platform_yaml.hpp).
 #include <pybind11/stl.h>

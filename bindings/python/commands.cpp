@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Motor-side commands (Eq. 11-12) over (N, 6) poses with a per-pose status and limit report, and
 // the one-pose real-time call.
 #include "common.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Shared helpers of the Python bindings: checked views of numpy arrays (no copy of a contiguous
 // float64 input), output arrays, the status names, and the std::thread chunking of batch work.
 #pragma once

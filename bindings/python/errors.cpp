@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Errors: hexatwist.Error and its subclasses, the translation of the library's hexatwist::Error,
 // the status names, and the checked array views shared by the batch functions.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Batch forward kinematics from (N, 6) leg lengths, motor-side (twist included) or geometric:
 // warm-started along the batch (in fixed blocks, so the result does not depend on the threads) or
 // from given guesses, with per-pose status, iterations and residual.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Identification (identification.hpp): the twist-aware calibration from observations at rest, with
 // the library's decisions (the same status and estimate as `hexatwist identify`), and the corrected
 // configuration written into the user's YAML.

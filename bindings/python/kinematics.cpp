@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Batch inverse kinematics and twist over (N, 6) poses: leg lengths, unit axes, U-joint bends,
 // twist relative to home and the length error it causes (Eq. 1-10); where a platform point is.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Measurement: a tracker point log (one or more targets), the commanded runs (a measured test, a
 // stations run), and the observations at rest an identification uses (identification.cpp).
 #include <pybind11/stl.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Dynamics of the whole mechanism (mechanism.hpp): inverse dynamics over (N, 6) poses with their
 // rates and accelerations (per-pose status, GIL released), and for one pose the mass matrix, the
 // bias force, forward dynamics, the energies, the motor angles and their Jacobian.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The platform as a MuJoCo model (mjcf.hpp): MJCF XML text of a Rig.
 #include "hexatwist/io/mjcf.hpp"
 #include "common.hpp"

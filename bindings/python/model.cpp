@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist.Model: the immutable platform model, from the embedded seed, YAML text or a file, or
 // numpy arrays; its numbers as arrays, its YAML back out, and pickling (exact: the numbers travel).
 #include <pybind11/stl.h>

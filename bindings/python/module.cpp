@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The hexatwist Python extension module (_hexatwist): one layer over the library, one file per
 // concept. The public API, its typed results and docstrings are in python/hexatwist/ (one module per
 // subsystem); python/hexatwist/_hexatwist.pyi types this module.

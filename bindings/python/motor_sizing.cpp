@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Motor sizing along a trajectory (motor_sizing.hpp): per-sample torque, speed, power and the
 // torque's six parts as (T, 6) arrays, the per-motor summary and envelope verdict as dicts, and
 // the torque-speed figure's data. The trajectory: a CSV file or text (resampled at the control

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Rigid registration of corresponding point sets (registration.hpp, Kabsch/Umeyama): X_BT from
 // points measured in the tracker frame T and the same points in the base frame B.
 #include "common.hpp"

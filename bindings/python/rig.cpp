@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist.Rig: a whole validated configuration (platform, servo, load, mechanism, simulation
 // rates, study) built once from YAML, for the functions that need more than the Model: dynamics,
 // motor sizing, simulation. Every `config` argument takes a Rig, YAML text, a path or None (seed).

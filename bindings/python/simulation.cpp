@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Closed-loop simulation and the paper's study: time series as (T,) and (T, 6) arrays, the
 // summary as a dict. Configurations as YAML text or a path (None: the embedded seed); they travel
 // to worker processes as text.

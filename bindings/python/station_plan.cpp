@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Where to measure (station_plan.hpp, theory §13): the library's plan of a calibration run's
 // stations (the same stations, criterion and predicted accuracy as `hexatwist stations --json`)
 // beside random stations of the same count, and the planned run.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist.Stream: the real-time command stream for one pose at a time (stream.hpp), with its
 // reject policy and rate limits.
 #include <memory>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tolerance analysis (design/tolerance.hpp): a range of sampled platforms (locally, or one chunk of
 // a Dask study), the covariance answer's quantiles, and the summary of the whole study.
 #include <pybind11/stl.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Pose trajectories (motion/trajectory.hpp): the paper's sweep along one coordinate, straight moves
 // through waypoints, CSV trajectories read and resampled onto a fixed period. Times (T,) [s] and
 // poses (T, 6) [m, rad] as arrays; the library's hexatwist::Error becomes ConfigError (a bad file)

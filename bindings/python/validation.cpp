@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Checking a calibration (validation.hpp, theory §13c): two platforms compared leg by leg and the
 // first one's commands on the second, the numbers `hexatwist compare --json` prints.
 #include <pybind11/stl.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Reach of the platform along each pose coordinate alone (workspace.hpp, axis_range).
 #include "common.hpp"
 

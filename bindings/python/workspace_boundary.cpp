@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Slices of the constant-orientation workspace with the limit of each boundary point, and the
 // orientation workspace at a position (design/workspace_boundary.hpp).
 #include <pybind11/stl.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Maps over a slice of the constant-orientation workspace (design/workspace_map.hpp): the grid
 // around a slice, and rows of the map (the whole map here, or its rows on Dask workers).
 #include "common.hpp"

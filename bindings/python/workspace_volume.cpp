@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The constant-orientation workspace's volume (design/workspace_volume.hpp): the whole computation,
 // and its grid and cells apart for Dask (hexatwist.distributed: cells on the workers, the sum here).
 #include "common.hpp"

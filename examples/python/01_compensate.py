@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Quick start: compensated motor commands for a pose, and the pose they really produce (the twin of
 examples/01_compensate.cpp: the same calls of the library, the same lines printed).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The servo simulation from Python: a yaw sweep of +-10 deg on the seed rig, closed loop, with the
 conventional and the compensated commands, and the error of point A (the twin of
 examples/02_simulate.cpp: the same lines printed).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The real-time command stream from Python: a 1 kHz loop that takes the pose a motion cue asks for,
 gets six checked, rate-limited motor commands from hexatwist.Stream, and counts what it did (the twin of
 examples/03_realtime_loop.cpp: the same cue and settings, so the same commands).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Twist and length-error maps of a workspace slice (x-y plane 0.1 m above home, yaw 10 deg): 200 x 200
 poses in one batch call per quantity; for leg 1 the twist [deg] and the length error it causes [mm], and
 the largest |length error| over the six legs; poses outside a limit are blank. The twin of

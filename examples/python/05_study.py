@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The paper's Rz test (rotation about z, +-30 deg) from hexatwist.study: the observation error with the
 conventional and the compensated commands, what the twist and the servos each leave, and the twist of
 leg 1. The twin of examples/05_study.cpp: the same numbers, the same lines printed.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Identification from tracker logs (theory §13). examples/tracker_Rz.csv, the Rz test after the
 calibration moves, cannot separate the observation point's height from the tracker's: identify answers
 not_identifiable and names the combination (a status, not an exception). A run of 40 random stations,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Designing the seed's fixed U-joint axes from Python (docs/theory/design.md §16-18): the workspace's
 volume with its stated error, the symmetric turns of the axes that minimise the largest twist over the
 required workspace (the study's tests and 2000 random combined poses), and the largest |twist| over the

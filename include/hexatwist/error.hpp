@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The one exception type: thrown only while building a Model or parsing input, never on the
 // real-time path.
 #pragma once

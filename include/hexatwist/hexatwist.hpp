@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Umbrella header: the whole hexatwist library, in the order its subsystems depend on each other.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Outcome codes of the numerical functions (the real-time path never throws).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Fixed-size types shared by every hexatwist header: six legs, 3-D vectors.
 #pragma once
 

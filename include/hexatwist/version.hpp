@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The library's version: the one place it is written. CMake reads these three numbers for
 // project(VERSION) (the packages, the CMake package), the CLI prints them with --version, the C API
 // returns them from hexatwist_version() and Python has them as hexatwist.__version__.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /* hexatwistkins: LinuxCNC kinematics of a lead-screw Stewart platform with the legs' twist
  * compensated, over the hexatwist C API (include/hexatwist/c/hexatwist.h).
  *

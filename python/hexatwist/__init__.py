@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """hexatwist: twist-aware kinematics, dynamics, simulation, calibration and design of lead-screw
 (U-P-U) Stewart platforms, from numpy.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Types of the compiled core hexatwist._hexatwist (bindings/python/*.cpp, pybind11). The public API is the
 Python package over it (hexatwist.kinematics, ...), which types its results; the private functions here
 return the library's numbers as dicts that the package turns into those results. Units: [m], [rad], [s]."""

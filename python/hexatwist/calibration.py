@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Calibration (the library's calibration subsystem): a laser tracker's point log, the commanded runs
 of a measurement (a measured test, a run of stations), the observations at rest, the twist-aware
 identification (theory §13) with the library's decisions, and rigid registration (Kabsch). The

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The command line's door to a Dask cluster (``hexatwist tolerance --scheduler``, ``hexatwist workspace
 --scheduler``): ``python3 -m hexatwist.cluster`` reads one request (JSON) on standard input, runs it on the
 cluster through :mod:`hexatwist.distributed` and writes the merged summaries on standard output, one array a

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """What every subsystem of hexatwist shares (the library's core: types, status, error): the exception
 types, the status codes, the threads of the batch functions, the array types, and :class:`Result`,
 the base of every typed result.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Design (the library's design subsystem, docs/theory/design.md §16-19): the constant-orientation
 workspace (volume, slices, maps) and the orientation workspace of a :class:`~hexatwist.Model`; the
 required workspace, the design of the fixed U-joint axes and the tolerance study, which take a Model

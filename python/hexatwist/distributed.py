@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Batch evaluations, simulation sweeps and design studies over a dask.distributed cluster, or local threads.
 
 Batches (:func:`map_batch`) are cut into chunks of a fixed number of rows, a multiple of ``hexatwist.BLOCK``,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Dynamics (the library's dynamics subsystem: rig, mechanism, motor sizing): the :class:`Rig` (the
 platform with its drives, load, leg bodies and rates), the inverse and forward dynamics of the whole
 mechanism, its mass matrix and energies, and motor sizing along a trajectory. Every function takes

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Files and formats (the library's io subsystem): models and configurations from YAML (the embedded
 seed, text or a file), a configuration with its platform replaced, and the MuJoCo model. Reading a
 bad file raises :class:`~hexatwist.ConfigError` with the library's one line "source:line:column:

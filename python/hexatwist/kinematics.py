@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Kinematics (the library's kinematics subsystem): inverse kinematics, twist and the length error it
 causes, motor-side commands with their limits, forward kinematics (one batch, or along a motion),
 the real-time command stream, and the reach along each coordinate. Every function takes the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Motion (the library's motion subsystem, trajectory.hpp): pose trajectories made of jerk-limited
 moves (the paper's sweep along one coordinate, straight moves through waypoints) and trajectories
 read from CSV and resampled onto a fixed period. A :class:`Trajectory` at the control period is what

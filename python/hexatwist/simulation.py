@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Simulation (the library's simulation subsystem: servo, simulation, study): the closed loop of the
 six servo drives and the platform, and the paper's study (the same test with twist-free,
 conventional and compensated commands). Every function takes the :class:`~hexatwist.Rig` first (YAML

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: what the C API's files share: the opaque model, conversions between C arrays and the
 // library's types, and the guard that keeps C++ exceptions from crossing into C.
 #pragma once

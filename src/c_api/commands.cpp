@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // C API: motor commands (paper Eq. 1-12), the full command report and the twist; real-time.
 #include "c_api.hpp"
 #include "hexatwist/kinematics/compensation.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // C API: forward kinematics from a guess and along a motion (the tracker); real-time.
 #include "hexatwist/kinematics/forward.hpp"
 #include "c_api.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // C API: building, freeing and reading the opaque model. The only calls of the C API that
 // allocate; every exception stops here and becomes a NULL model and a one-line message.
 #include <cstring>

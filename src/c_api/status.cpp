@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // C API: the version, status names and descriptions (the library's, as C strings).
 #include "c_api.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The accuracy an identification predicts for the corrected platform (theory §13): at a pose, the
 // covariance of the target point that compensated commands reach, from the parameters' covariance.
 #include <fmt/format.h>

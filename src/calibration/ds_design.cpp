@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "calibration/ds_design.hpp"
 
 #include <fmt/format.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: Ds-optimal exact designs by exchange (docs/theory/calibration.md §13, "Where to
 // measure"). Candidate k contributes the block J_k (r rows, p columns) to the information
 // M = F + sum_{k in design} J_k^T J_k; the last n columns are nuisance parameters, and the criterion

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the measurement model of an identification (docs/theory/calibration.md §13): the pose
 // each station's commands put the candidate platform in, the residuals of the groups' mean points,
 // and their exact Jacobian by the implicit function theorem through twist-aware forward kinematics,

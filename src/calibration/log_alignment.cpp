@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "calibration/log_alignment.hpp"
 
 #include <fmt/format.h>

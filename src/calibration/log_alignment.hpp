@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: how a point log's points sit in the commanded run's time, shared by the measurement
 // and the observations of an identification (docs/theory/calibration.md §12).
 #pragma once

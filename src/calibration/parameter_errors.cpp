@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "hexatwist/calibration/parameter_errors.hpp"
 
 #include <Eigen/Dense>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: seeded random numbers that are the same on every platform. The raw output of
 // std::mt19937_64 is fixed bit for bit by the standard; its distributions are left to each library,
 // so they would make the same seed give other numbers elsewhere.

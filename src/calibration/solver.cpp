@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "calibration/solver.hpp"
 
 #include <ceres/ceres.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the least-squares solve of an identification (Ceres' Levenberg-Marquardt on the
 // groups' residuals, the tracker rotation on SO(3)), and the column-scaled conditioning that
 // decides which parameters the data determine (docs/theory/calibration.md §13).

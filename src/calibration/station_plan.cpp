@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Where to measure (theory §13): the stations' sensitivities at the nominal model, the Ds-optimal
 // choice among seeded candidates (ds_design.hpp), the run's order, and the plan's quality beside
 // random stations'.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the design subsystem's batch work split over threads in fixed blocks, so that a result
 // never depends on the number of threads (each item is computed alone, into its own slot).
 #pragma once

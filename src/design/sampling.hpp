@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: seeded random numbers addressed by (seed, index), the same on every machine and in any
 // order of evaluation, so that sample k of a Monte Carlo study is the same platform whichever
 // thread, chunk or worker draws it (docs/theory/design.md §18).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the workspace searches' common step, a march along a one-parameter family of poses with
 // every change between accepted and refused bisected (docs/theory/design.md §16).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "hexatwist/design/tolerance_calibration.hpp"
 
 #include <fmt/format.h>

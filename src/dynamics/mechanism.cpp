@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Dynamics of the whole mechanism (docs/theory/dynamics.md §14): inverse and forward dynamics, the
 // mass matrix, the energies, and the drives' equation the closed-loop simulation integrates, from
 // the bodies' passes over the legs (mechanism_bodies.cpp) and the drives' losses

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The bodies of the mechanism (docs/theory/dynamics.md §14; the symbols below are the section's):
 // velocities and accelerations of every body from the platform's motion, Newton-Euler on each
 // body projected onto the platform's coordinates by virtual power, and the mass matrix from the

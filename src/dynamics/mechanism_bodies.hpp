@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the bodies of the mechanism as the dynamics' passes over the legs see them
 // (docs/theory/dynamics.md §14): each leg's velocity-level state, its accelerations, the
 // platform's frame, and the generalised forces of every part. mechanism.cpp and

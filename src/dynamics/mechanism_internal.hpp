@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The mechanism's dynamics in the motor angles, as the closed-loop simulation integrates them
 // (docs/theory.md §9, §14). Internal: not installed.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The drives' losses (docs/theory/dynamics.md §14, "Friction and efficiency"): viscous and dry
 // friction at the motor shaft, and the screw's efficiency loss in the thread, decided by the power
 // that passes through the thread, which slides at the real length rate.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the YAML reader of the configuration (src/io/config.cpp, config_sections.cpp): fields
 // with their place in the document, and messages "source:line:column: field 'x.y': what".
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The configuration's optional sections: servo, load, mechanism, simulation and study. Every key
 // has a default (rig.hpp, study.hpp); sign errors are caught here, where the units the file uses
 // (rpm, Hz, deg) are known, and the plausible ranges by the Rig and check_study.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // MJCF export of the rig (docs/theory.md §15).
 #include "hexatwist/io/mjcf.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Batches of poses across the SIMD lanes (docs/theory/kinematics.md §8, "Batches"): one pose per
 // lane, the six legs one after the other, where the real-time call (compensation.cpp) puts the
 // legs across the lanes. The arithmetic is the real-time call's, expression for expression (the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "hexatwist/kinematics/compensation.hpp"
 
 #include "kinematics/compensation_internal.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the second half of motor_commands, shared with the batch path (batch.cpp).
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: sin/cos and atan2 accurate to a few ulp, vectorised over the six legs.
 // libm's scalar calls (~25 ns each on the 2.1 GHz test machine) would dominate the real-time
 // budget, and Eigen 3.4's select() compiles to scalar branches, so these kernels use GCC/Clang

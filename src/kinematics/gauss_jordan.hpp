@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the inverse of a 6x6 matrix by Gauss-Jordan elimination with partial pivoting, on the
 // matrix's columns as lanes.hpp's packets (lane i of column c: entry (i, c)), which is how the
 // forward kinematics forms its Jacobian. Row operations on all rows at once are one multiply-add

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal geometric helpers shared by the model, the twist and the limit check.
 #pragma once
 

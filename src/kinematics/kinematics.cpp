@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "hexatwist/kinematics/kinematics.hpp"
 
 #include "kinematics/geometry.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the six legs side by side, one leg per lane, in the widest double vector the target
 // has: one packet of eight lanes with AVX-512, two of four with AVX, three of two with SSE2 or
 // NEON (lanes 6 and 7, where they exist, repeat leg 0, so they pass or fail every test with it

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the legs' static forces packet by packet (lanes.hpp), shared by static_leg_forces and
 // the real-time command (compensation.cpp), which gives them from its pass in registers without a
 // LegState: one computation, the same forces from either.

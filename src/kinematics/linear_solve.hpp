@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: LU factorisation of a 6x6 matrix with partial pivoting, unrolled at fixed size, and
 // the matching solve. Eigen's PartialPivLU goes through a dynamic-stride kernel that costs several
 // times as much at this size, which matters inside the real-time forward kinematics.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the twist kernels forward kinematics calls directly, and the cheap condition test.
 #pragma once
 

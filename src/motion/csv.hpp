@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Internal: the CSV reading shared by the trajectory and the point-log parsers (trajectory.cpp,
 // measurement.cpp): data lines, cells, numbers, and the one-line error
 // "source:line:column: column 'name': message".

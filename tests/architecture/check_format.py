@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Every C and C++ file of the project is formatted as .clang-format says (Debian's clang-format 14):
 runs `clang-format --dry-run --Werror` over them and fails naming each file that would change.
 

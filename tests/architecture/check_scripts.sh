@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Every shell script of the tree parses (bash -n): scripts/test.sh runs its stages in order, so a
 # quoting mistake in a late stage would otherwise surface only after the earlier ones have run.
 set -uo pipefail

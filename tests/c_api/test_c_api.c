@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /* The C API (include/hexatwist/c/hexatwist.h), compiled as C99: models, commands against the
  * report, forward kinematics round trips and tracking, limits, errors, and no allocation in the
  * real-time calls (malloc interposed: every heap allocation of the process is counted). */

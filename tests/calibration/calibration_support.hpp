@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Test support for the calibration tests: a real platform that differs from the nominal one by
 // known errors (joint centres and axes, leads, thread sense, zero offsets, targets, a tracker
 // frame), and what a laser tracker sees of it at stations where the nominal model's commands hold

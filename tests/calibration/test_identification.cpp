@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Identification (include/hexatwist/calibration/identification.hpp, theory §13) on synthetic tracker
 // data made here (calibration_support.hpp): a real platform whose joint centres, leads, thread
 // sense, zero offsets and observation point differ from the seed by known amounts, seen by a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The legs' effects in an identification (EffectFit, theory §13b): a real platform whose legs
 // deflect under the load, have play and warm over the run is refused without them and recovered
 // with them; their Jacobian columns against central differences; what they need, asked for.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The log's clock from the rests (log_clock.hpp): a log recorded on a clock of its own (another
 // start, another rate, noise at rest) is put back on the run's time within its reported
 // uncertainty; a log of another run, or one with too few rests, is refused with a reason.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Measured points (measurement.hpp): the point-log reader and its one-line errors, the calibration
 // moves, and the whole pipeline on synthetic logs whose truth is known: registration recovers the
 // tracker frame, a noise-free log of the model reproduces the simulation, a lead error shows up

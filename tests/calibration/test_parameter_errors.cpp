@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The real platform against the model (parameter_errors.hpp): each error changes what it should and
 // nothing else; the drives keep their lead and reference, so the nominal commands move the real nut
 // by the real lead about that reference; joint errors have no rigid part (the gauge of theory §13).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Rigid registration (Kabsch/Umeyama): exact recovery of seeded random transforms, the residual
 // and the estimate error under Gaussian noise against their expected values (theory §11), the
 // reflection fix, degenerate inputs, frame-swap and change-of-frame invariance, and agreement

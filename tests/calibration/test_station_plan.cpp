@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Where to measure (include/hexatwist/calibration/station_plan.hpp, theory §13): planned stations
 // against random ones on the predicted worst error; every station inside every limit and every
 // move of the run reachable; the same plan for a seed; the Ds criterion's rank-r and rank-2r

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The runs a calibration records (stations.hpp): random stations inside the limits, and how a run
 // visits them: each from both sides (every leg's command coming down to the station from above
 // and up from below, for identify's play), home again as a repeated reference (identify's heat),

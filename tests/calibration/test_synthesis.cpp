@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Synthetic tracker logs (synthesis.hpp): the points are where the real platform puts the
 // observation point, in the drawn tracker frame, at the tracker's rate, with the noise asked for;
 // the same seed gives the same log.

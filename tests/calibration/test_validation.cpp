@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Checking a calibration (validation.hpp): the differences leg by leg against what was changed, and
 // the accuracy of one platform's commands on another against cases with a known answer: the same
 // platform (nothing), a base moved as a whole (every point off by the move in the gauge frames,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What the CLI's end-to-end tests share: a scratch folder, running the real binary (stdout, stderr,
 // exit code), the one-line error check, and the inputs several commands' tests use.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Every command of the tool, run on small inputs: the arguments that make each one run in a moment,
 // and the runs in a folder of their own. The tests that walk a class of input or event across the
 // commands (the option table, links, signals, locks) share it, so that a new command is walked by

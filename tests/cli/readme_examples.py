@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Runs every `$ hexatwist ...` example of README.md and of the user guide (docs/guide/*.md) and
 compares its output, digit for digit.
 

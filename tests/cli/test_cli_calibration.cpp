@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist synth, measure and identify: the experiment and the identification, end to end.
 #include <fmt/format.h>
 
@@ -299,7 +300,8 @@ TEST(CliIdentify, SynthThenIdentifyRecoversTheTruthAndWritesAConfigThatExplainsT
   EXPECT_GT(j["accuracy"]["median"].as<double>(), 0.0);
   EXPECT_LT(j["accuracy"]["aligned_median"].as<double>(), 15e-6);
   // The corrected configuration loads with exactly the estimate, and the drives' reference is the
-  // nominal one: the controller's HOME values do not change (hexatwist linuxcnc writes the same).
+  // nominal one: the controller's HOME_OFFSET values do not change (hexatwist linuxcnc writes the
+  // same); its joints' HOME are the corrected commands of the nominal home, [TRAJ] HOME the same.
   const Outcome c = run({"config", "--config", yaml, "--json"});
   ASSERT_EQ(c.code, 0) << c.err;
   const YAML::Node legs = json(c)["legs"];
@@ -311,16 +313,23 @@ TEST(CliIdentify, SynthThenIdentifyRecoversTheTruthAndWritesAConfigThatExplainsT
   EXPECT_NE(text.find("(identified from "), std::string::npos);
   EXPECT_NE(text.find("home_commands:"), std::string::npos);
   EXPECT_NE(text.find("drive_lead: 0.01"), std::string::npos);
-  const auto homes = [&](const std::vector<std::string>& config) {
+  const auto homes = [&](const std::vector<std::string>& config, std::string_view key) {
     std::vector<std::string> args{"linuxcnc", "--out", (temp_dir() / "machine.ini").string()};
     args.insert(args.end(), config.begin(), config.end());
     EXPECT_EQ(run(args).code, 0);
-    std::string found;
+    std::vector<std::string> found;
     for (const std::string& line : lines_of(read_file((temp_dir() / "machine.ini").string())))
-      if (line.starts_with("HOME = ") || line.starts_with("HOME_OFFSET = ")) found += line + "\n";
+      if (line.starts_with(std::string(key) + " = ")) found.push_back(line);
     return found;
   };
-  EXPECT_EQ(homes({"--config", yaml}), homes({}));
+  EXPECT_EQ(homes({"--config", yaml}, "HOME_OFFSET"), homes({}, "HOME_OFFSET"));
+  const std::vector<std::string> corrected = homes({"--config", yaml}, "HOME"), nominal = homes({}, "HOME");
+  ASSERT_EQ(corrected.size(), 7U);
+  EXPECT_EQ(corrected[0], nominal[0]);  // [TRAJ] HOME
+  const Outcome at_home = run({"ik", "--config", yaml, "--json", "--pose=0,0,0,0,0,0"});
+  for (int i = 0; i < 6; ++i)
+    EXPECT_EQ(corrected[i + 1],
+              fmt::format("HOME = {:.9f}", 1e3 * json(at_home)["legs"][i]["command_compensated"].as<double>()));
 }
 
 TEST(CliIdentify, DataThatCannotDetermineTheParametersExitFiveInOneLine) {

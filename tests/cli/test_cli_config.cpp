@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist config and --config: the resolved model, and configuration errors named by file, line and field.
 #include "cli_support.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The design commands end to end (hexatwist workspace, design, tolerance): the real binary, its
 // JSON, its files; boundary points checked with `hexatwist ik` as a user would; bad inputs one line
 // with their exit codes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist dynamics: motor sizing along a trajectory.
 #include "cli_support.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist fk: the pose of six leg lengths.
 #include "cli_support.hpp"
 

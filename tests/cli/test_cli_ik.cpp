@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist ik: the commands of one pose, and the pose errors every command shares.
 #include <fmt/format.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist linuxcnc: the INI file of the platform for LinuxCNC.
 #include "cli_support.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The tool as a whole: subcommands, help and version.
 #include "cli_support.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist mjcf: the MuJoCo model of the platform.
 #include "cli_support.hpp"
 

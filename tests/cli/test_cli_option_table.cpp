@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Every option of every command, walked from the CLI's own definitions (add_commands), given the
 // values a new user tries: NaN, +-inf, 0, -1, 1e300, an empty string and a folder. Each run ends
 // as the same command without that value ends (exit 0 for every command but identify, whose small

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Options: refused out of their range, without effect in the mode, or absurd.
 #include "cli_support.hpp"
 

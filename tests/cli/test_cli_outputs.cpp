@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The one writer of every command's files (output_files.hpp): standard output checked, sets of
 // files all or none, outputs compared with inputs as files, reused folders.
 #include <fcntl.h>

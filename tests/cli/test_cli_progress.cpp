@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The progress line of the long runs (apps/hexatwist/progress.hpp): drawn on a terminal only, with an
 // estimate of the time left, erased at the end; the tolerance study's parts give the one-call result.
 #include <fcntl.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A signal is a failure like any other (apps/hexatwist/signals.hpp), walked across every command of
 // the command table: SIGTERM, SIGINT or SIGHUP at moments spread over the run leave the folder byte
 // for byte as it was (exit 6, one line) or the run completes (its own exit code); never a half-written

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist study and simulate: the report of the closed-loop simulation.
 #include "cli_support.hpp"
 

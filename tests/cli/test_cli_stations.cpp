@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist stations end to end: the planned run is read back by synth and identify (which
 // determines a platform with joint errors from it, to the standard deviations the plan predicts);
 // the run rests at the planned stations; the text and the JSON report one plan, the same for a

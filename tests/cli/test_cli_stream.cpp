@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // hexatwist stream: answers on standard output and over UDP.
 #include <fcntl.h>
 #include <signal.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The figure writer of the command-line tool (apps/hexatwist/figures.cpp): real gnuplot runs that
 // write PNG and SVG files, its failures as exit code 4 with one line, and the thinning of long series.
 // gnuplot is required (scripts/setup.sh installs gnuplot-nox): without it these tests fail.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What the design subsystem's tests share: a required workspace of the seed platform.
 #pragma once
 

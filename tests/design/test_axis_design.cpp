@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Design of the fixed U-joint axes (axis_design.hpp, docs/theory/design.md §17): the issue's
 // acceptance on the seed with an independent twist (the joint chain of tests/support.hpp), every
 // required pose kept, the volume kept, the turned axes, and a design never worse than the model.

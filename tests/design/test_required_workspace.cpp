@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The required workspace (required_workspace.hpp, docs/theory/design.md §17): the tests' poses,
 // the random combined poses and which of them the platform reaches.
 #include "hexatwist/design/required_workspace.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tolerance analysis (tolerance.hpp, docs/theory/design.md §18): the linearised answer against the
 // Monte Carlo (the 10 %), the linear model against FK of one platform, chunks and threads
 // bit for bit, a perfect calibration, the norm of a Gaussian against closed forms and sampling, the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Slices of the constant-orientation workspace and the orientation workspace
 // (workspace_boundary.hpp, docs/theory/design.md §16): every boundary point accepted just inside
 // and refused just outside by the limit it names, the slice's area against a Monte Carlo estimate,

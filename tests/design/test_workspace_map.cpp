@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Maps over a slice (workspace_map.hpp, docs/theory/design.md §16): each node's numbers against the
 // library's functions called directly, NaN and the limit outside, and the rows' independence.
 #include "hexatwist/design/workspace_map.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The constant-orientation workspace's volume (workspace_volume.hpp, docs/theory/design.md §16):
 // against an independent Monte Carlo estimate, its stated error, the search's crossings, the
 // independence from threads and chunks, and the platform's symmetry.

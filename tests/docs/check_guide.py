@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Checks the user guide in docs/guide/ against the repository and the built command-line tool.
 
     check_guide.py <repo root> <path to hexatwist binary>

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Validates every kind of JSON document the tool writes against its schema in docs/schemas/.
 
     check_schemas.py <repo root> <path to hexatwist binary> [--examples DIR]

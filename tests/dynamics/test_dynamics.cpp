@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Leg-space load: checked against energy computed without any Jacobian (finite differences of the
 // pose that forward kinematics gives for perturbed leg lengths).
 #include <gtest/gtest.h>

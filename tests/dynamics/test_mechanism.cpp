@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Dynamics of the whole mechanism, checked without its own derivation: the mass matrix against the
 // kinetic energy (a quadratic form in the velocity), the inverse dynamics against Lagrange's
 // equations by finite differences of the energies, the reduced model against the leg-space load,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Motor sizing along a trajectory: the differences and the statistics against a hand computation
 // on a heave sinusoid with exact derivatives, the terms adding up to the torque, the envelope's
 // first violation, a pose limit reported with its sample, and the figure's envelope.

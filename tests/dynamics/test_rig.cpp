@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Rig validation: every bad number is refused with the field named; derived numbers are right.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /* Uses the installed C API from C: compensated commands for a pose, then twist-aware forward
  * kinematics must return that pose. Exit code 0 only if it does. */
 #include <hexatwist/c/hexatwist.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Uses the installed library: compensated commands for a pose, then twist-aware forward
 // kinematics must return that pose. Exit code 0 only if it does.
 #include <hexatwist/hexatwist.hpp>

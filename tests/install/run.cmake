@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs the build tree into a scratch prefix, then configures, builds and runs an outside
 # project that uses find_package(hexatwist). Run by ctest (tests/CMakeLists.txt).
 file(REMOVE_RECURSE "${WORK_DIR}")

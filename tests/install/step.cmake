@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # step(COMMAND...): runs a command of a test script (cmake -P), stopping the script with its output
 # if it fails; its standard output is in `step_output` afterwards. Included by tests/install/run.cmake
 # and tests/packaging/check_debs.cmake.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // MuJoCo harness of the MJCF export's tests and benchmark: load the XML of mjcf_model, pose the
 // platform, and solve the legs' joints so that every equality holds (Newton on efc_pos).
 #pragma once

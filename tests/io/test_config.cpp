@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Config: YAML text to Model. The seed file gives the default model, the `legs` form of the seed
 // gives the same kinematics, per-leg screw settings override the screw block, and every bad
 // input is one line naming "file:line" and the field path.

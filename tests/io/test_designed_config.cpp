@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Writing a designed configuration (platform_yaml.hpp): the axes put in, every other key kept, a
 // symmetric block turned into the same platform's legs, and designs that change more refused.
 #include "hexatwist/io/platform_yaml.hpp"

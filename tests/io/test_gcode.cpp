@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The LinuxCNC program of a run of straight moves (gcode.hpp): read back by a small G-code reader
 // here, its targets are the waypoints (LinuxCNC units converted back to SI), its times those of
 // waypoint_trajectory, the same run the CSV holds; its comments are comments LinuxCNC reads.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The MJCF export (mjcf.hpp) loaded in MuJoCo: structure, assembly at home, the twist and the
 // screw in the joints at any pose, statics against twist-aware forward kinematics, and the
 // motor torques of MuJoCo's inverse dynamics (docs/theory.md §15).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // platform_config_yaml: a platform written into a configuration's YAML in the legs form loads back
 // to exactly that platform (every double round trips), keeps every other section, writes a leg's
 // own screw keys only where they differ, records the drives' reference, and refuses bad text.

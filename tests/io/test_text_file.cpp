@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The one reader of configuration and data files (text_file.hpp): the whole file, a bound on its
 // size checked while reading (an endless device stops there), and one line naming the path.
 #include <fcntl.h>

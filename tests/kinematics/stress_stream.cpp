@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Seeded random stress test of the real-time command stream (stream.hpp): random requests through
 // stream_pose and stream_line, with random stream settings, on the seed platform and on random
 // platforms whose U-joint axes lie close to their legs (so that the singularity limit is reached).

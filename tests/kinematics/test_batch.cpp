@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Batches of poses across the lanes (batch.hpp): every pose's status, report and commands are the
 // single-pose motor_commands' bit for bit, and the lengths inverse_kinematics', on the seed and on
 // random asymmetric platforms, inside, far outside and on every limit (poses within a few ulp of

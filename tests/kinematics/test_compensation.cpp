@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Compensation (Eq. 10-12): exact through twist-aware forward kinematics, signs of the twist
 // term, and commands never emitted outside a limit.
 #include "support.hpp"

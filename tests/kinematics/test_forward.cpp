@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Forward kinematics: round trips with IK (geometric and twist-aware), the residual Jacobian
 // against finite differences, warm starts, and failures that are reported rather than silent.
 #include <map>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The internal kernels of the real-time path: vectorised sin/cos and atan2 (src/kinematics/fast_math.hpp)
 // against libm, the fixed-size 6x6 LU and condition proof (src/kinematics/linear_solve.hpp) and the
 // Gauss-Jordan inverse on lane columns (src/kinematics/gauss_jordan.hpp) against Eigen.

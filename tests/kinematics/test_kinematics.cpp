@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Inverse kinematics (Eq. 1-4): the seed geometry as read in the notes, symmetry, Jacobian, pivot.
 #include "support.hpp"
 

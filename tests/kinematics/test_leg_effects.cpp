@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The legs' effects (leg_effects.hpp, theory §4b): the static forces against the whole
 // mechanism's inverse dynamics, each effect's share of the command against its formula, the
 // reference state, exact compensation through forward kinematics with the effects, the play's

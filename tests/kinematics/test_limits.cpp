@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Limits: stroke, bend, U-joint and platform singularity, each reported with the right leg and value.
 #include <fmt/format.h>
 #include <Eigen/LU>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Model: validation of a ModelSpec (one broken thing at a time, each error a single line naming
 // the leg or field), the twist gain's sign, the plain-Stewart case and the symmetric layout.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Pose conventions: Eq. (3) rotation order, roll-pitch-yaw round trip, exp map.
 #include "support.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The real-time functions never allocate (a counting global operator new) and are noexcept.
 #include <atomic>
 #include <cstdlib>

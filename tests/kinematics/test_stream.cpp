@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The real-time command stream (include/hexatwist/kinematics/stream.hpp): pose lines, reject policies, rate
 // limits, answer lines.
 #include <yaml-cpp/yaml.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Twist (passive rotation): signed, matches an independent joint-chain computation, correct
 // symmetries, analytic Jacobian, continuity.
 #include "support.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Reach along each pose coordinate alone (workspace.hpp): every value inside the interval is
 // accepted, the values just past its ends are refused by the limit it names, and the search
 // agrees with itself at another step size.

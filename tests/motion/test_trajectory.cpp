@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Trajectories: the jerk-limited move keeps its limits, starts and ends at rest, is time-optimal
 // and self-consistent (finite differences); the sweep test motion; CSV poses with units and
 // located errors; Hermite resampling exact on lines, parabolas and the input samples.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Builds the Debian packages of the build tree (cmake/packaging.cmake) with cpack and checks them as
 # a user installing them would: each package's name, section and dependencies, then its files
 # unpacked into a scratch root and used from there: the tool runs `ik` on the packaged seed

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Shared fixtures of the Python tests: the seed model, seeded random poses, the tools of the build."""
 import os
 

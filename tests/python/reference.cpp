@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The library called directly, pose by pose, for the Python tests to compare with bit for bit:
 // reads N poses (raw float64, N x 6) from argv[1] and writes to argv[2], per pose, the IK lengths,
 // the twist, the compensated and conventional commands (NaN unless ok) and the three statuses, as

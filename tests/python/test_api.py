@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Model construction, YAML and pickling; errors; no copies; the GIL released."""
 import os
 import pickle

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Every batch function and option of the package given what a new user tries (#22): NaN, +-inf, 0, -1
 and 1e300. Each call either returns a meaningful result (rows with a non-ok status where the input
 is bad, never an ok row with NaN) or raises one hexatwist.Error with a one-line message naming the

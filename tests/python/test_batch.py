@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Batch functions against the library called directly (bit for bit) and the CLI, FK round trips."""
 import json
 import subprocess

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The command line and Python accept the same values (#30): each option that the library checks
 (check_stations_spec, check_station_plan_spec, check_tolerance_sigmas, check_tracker_calibration,
 check_identification_options) given values inside, at and beyond its range's ends. For every value

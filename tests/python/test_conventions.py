@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The package's conventions (issue 24): a leg is the same number (1 to 6, 0 for none) in every result,
 every message and the command line, and it is the column ``leg - 1`` of the per-leg arrays; a Rig is
 built once and gives what its YAML gives; Model.from_arrays takes what Model has."""

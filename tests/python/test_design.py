@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The design functions from Python (docs/theory/design.md §16-19): the workspace's volume, slices, maps
 and orientation workspace against the batch functions, the designed configuration through its YAML,
 and the tolerance study's independence from threads."""

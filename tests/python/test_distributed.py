@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The Dask helper on a real (local) cluster: a scheduler and two workers on 127.0.0.1, started as
 processes and always stopped; results identical, bit for bit, to the local run."""
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Dynamics and motor sizing through the bindings: the library called directly (bit for bit), and
 properties that break if an argument were swapped (forward dynamics inverts inverse dynamics, the
 energies, the torque's parts)."""

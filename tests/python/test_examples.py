@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The numbered examples come in pairs (Ruckig's habit): examples/NN_topic.cpp and
 examples/python/NN_topic.py call the same functions of the library on the same data and print the same
 lines (the Python one may add its figure's path, or the truth it compares with, after them); the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Registration, forward kinematics along a motion with a tracker, the axis ranges, and the YAML
 round trip of angles in degrees: the library called directly (bit for bit) and properties."""
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Identification from Python reaches the CLI's decisions on the same data, bit for bit (issues 21, 24):
 a log made by ``hexatwist synth`` with joint-centre errors, identified by ``hexatwist identify --json``
 and by the Python pipeline (read_point_log, stations_run, observations_at_rest, identify with its

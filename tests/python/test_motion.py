@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Trajectories from Python (hexatwist.motion, trajectory.hpp): the paper's sweeps are the study's tests
 bit for bit, moves through waypoints stay on their lines within their limits, CSV files read in SI, and
 their resampling is what motor sizing sizes."""

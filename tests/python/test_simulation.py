@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Simulation, the study, the stream and identification through the bindings."""
 import os
 

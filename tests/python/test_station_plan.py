@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Where to measure from Python (plan_stations, theory §13) is the CLI's plan (issue 21): the same
 stations, criterion and predicted accuracy as ``hexatwist stations --json`` to the last bit, the run
 ``stations_run`` makes of them the rows of the CLI's --out file, planned stations better determined

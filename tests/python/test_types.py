@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The package's types against what it does (issue 24): the stub of the compiled core (_hexatwist.pyi)
 names every function, class, method, property and constant the module has, and nothing else, with the
 same parameters (mypy's stubtest, and the signatures pybind11 states); every public function of every

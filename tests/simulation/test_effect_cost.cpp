@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What the legs' effects cost at point A (effect_cost.hpp): one row per effect in order, exact
 // compensation of each (the compensated commands on the plant with the effect leave the forward
 // kinematics' tolerance), the load's cost against geometric forward kinematics of the deflected

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // One drive under its PID: integrator against the exact solution, step response, torque limit,
 // anti-windup and encoder quantisation. The six legs get a diagonal load here, so each behaves
 // as a single axis.

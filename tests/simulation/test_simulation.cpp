@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The closed loop on short trajectories: a settled start, the plant's length law (Eq. 10), the
 // limit check before anything runs, and what each option changes.
 #include <gtest/gtest.h>

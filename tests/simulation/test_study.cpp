@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The study's claims on the seed platform's default tests: exact compensation, the compensated
 // loop adds nothing to the servo's own error, and the twist error grows away from home.
 #include <gtest/gtest.h>

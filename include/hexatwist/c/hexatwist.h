@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /* hexatwist C API: twist-aware kinematics of lead-screw Stewart platforms, for C and for any
  * language's foreign-function interface (C99).
  *

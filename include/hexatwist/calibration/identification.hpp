@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Twist-aware calibration from a laser tracker's points (issues 5, 21): the U-joint centres, the
 // screw leads, the sign of the twist term, each leg's zero offset, the targets on the platform and
 // the tracker frame, by nonlinear least squares with standard deviations; and the decisions on

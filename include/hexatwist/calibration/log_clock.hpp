@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The tracker's clock against the run's: a tracker log starts whenever the operator pressed record,
 // on a clock of its own. The rests of the run (the commanded pose unchanged) and the rests in the
 // log (the target still) are the same events; matched in order, their middles give the offset and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Measured observation points, as in the paper's experiment (§5): a point log aligned in time with
 // the commanded trajectory, the registration of the tracker frame T to the base frame B, and the
 // observation-point errors that the study computes for the simulation, so that both can sit side by

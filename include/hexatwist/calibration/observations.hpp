@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What an identification measures: tracker points of the platform's targets taken while the legs
 // stood at known motor-side lengths, grouped by station (one commanded pose held) and target, and
 // the tracker's own noise from their scatter at rest. Theory: docs/theory/calibration.md §13.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What a real platform may have that its nominal model does not, in the parameters a laser tracker
 // can reveal: the U-joint centres and fixed axes, the screw leads, the sign of the twist term, each
 // leg's zero-length offset and the observation point. `hexatwist synth` builds a platform with known

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The parameters an identification estimates, their order, names and gauge: screw leads, zero
 // offsets, the twelve U-joint centres (in the gauge that keeps B and P the least-squares frames of
 // their joints), the U-joint axes where the data determine them, the targets on the platform and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A laser tracker's point log: the points of one or more targets on the platform with their time
 // stamps, as tracker software exports them (CSV), and their alignment with a commanded run's time.
 // Reading files is the caller's job. Theory: docs/theory/calibration.md §12.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Rigid registration of corresponding point sets (Kabsch 1976, Umeyama 1991): the rotation and
 // translation that best map points measured in one frame (a laser tracker's, T) onto the same
 // points known in another (the base frame B), with the fit residual and a degeneracy check.

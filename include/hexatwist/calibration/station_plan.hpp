@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Where to measure (issue 21): the stations of a calibration run chosen from a seeded set of
 // candidate poses inside every limit so that the geometric model is best determined (the
 // Ds-optimal criterion, by an exchange algorithm), ordered into a run of short moves that stay

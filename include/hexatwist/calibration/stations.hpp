@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The runs a calibration records: the calibration moves a measured test starts with (the paper's
 // registration stations), and runs that stop at stations spread over the workspace for an
 // identification (random ones here; planned ones in station_plan.hpp). Theory:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tracker-like point logs made from the closed-loop simulation of a platform whose real parameters
 // differ from its model by known errors, with the truth beside them: test data for `measure`
 // and for an identification, since no real measurement ships with hexatwist (docs/theory.md §12).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Checking a calibration before trusting it (docs/theory/calibration.md §13c): what changed, joint
 // by joint, between two platforms (a corrected configuration and the nominal one, a later
 // calibration, or the real platform of a rehearsal), and where one's commands put point A on the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Design of the fixed U-joint axes (docs/theory/design.md §17): the directions of ja (base) and jd
 // (platform) that minimise the twist, the length error or the sensitivity to the lead over a
 // required workspace, with every limit kept there and the workspace volume kept within a stated

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The poses a platform must reach, for its design and its tolerance analysis (docs/theory/design.md
 // §17): the study's four tests at their amplitudes and random combined poses within a box of
 // translations and rotations, kept where the platform reaches them.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Tolerance analysis (docs/theory/design.md §18): how accurate a platform built with manufacturing
 // errors is, before it is built. Monte Carlo over sampled platforms driven by the nominal
 // compensated commands, and the linearised (covariance) answer, checked against each other; a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The calibration a tolerance study simulates (docs/theory/design.md §18): what a laser tracker
 // records of each sampled platform at the stations of a plan, the twist-aware identification of
 // those points (calibration/identification.hpp) and the configuration its controller runs

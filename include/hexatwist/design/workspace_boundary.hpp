@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The workspace's boundary: slices of the constant-orientation workspace with the limit that
 // bounds each boundary point, and the orientation workspace at a position, the largest tilt in
 // every direction at several torsions (docs/theory/design.md §16).

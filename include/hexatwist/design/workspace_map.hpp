@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Maps over a slice of the constant-orientation workspace (docs/theory/design.md §16): at each grid
 // point inside, the largest |twist| and |length error| and the leg that has them, the Jacobian's
 // condition number (dexterity) and the share left to the nearest limit.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The constant-orientation workspace and its volume (docs/theory/design.md §16): the positions the
 // platform reaches at one orientation inside every limit, found along lines and integrated by
 // columns over a grid refined at the boundary of its shadow.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Rigid-body load of the platform seen from the legs: the platform's mass matrix and gravity
 // wrench, and both mapped to leg space through the (motor-side) length Jacobian (docs/theory.md §9).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Dynamics of the whole mechanism (docs/theory.md §14): the platform with its payload, the two
 // bodies of each leg (housing with the motor on the base U-joint, rod with the nut on the platform
 // U-joint), the rotor and screw spinning about the leg, screw efficiency and friction. The rods

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Motor sizing along a trajectory: the inverse dynamics of the whole mechanism (mechanism.hpp) at
 // every sample, each motor's torque, speed and power, what its torque is made of, and the check
 // against the motor's torque-speed envelope and continuous rating.

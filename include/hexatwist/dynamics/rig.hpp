@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The platform with its six drives and the load they carry: everything the closed-loop servo
 // simulation needs besides the trajectory (docs/theory.md §9). Immutable and validated, like Model.
 #pragma once

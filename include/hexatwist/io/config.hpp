@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Platform configuration in YAML: parse text into a Model. Reading files is the caller's job.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A run of straight moves between poses, written as a LinuxCNC G-code program for the kinematics
 // module hexatwistkins (integrations/linuxcnc): the program a technician runs on the controller to
 // drive a calibration plan (`hexatwist stations --gcode`). Units are LinuxCNC's at its boundary:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The platform as a MuJoCo model (MJCF XML, docs/theory.md §15): base, six legs of housing, rotor,
 // screw, rod and rod end, and the platform with its payload, closed by weld equalities at the
 // platform U-joints; the screw-nut pair and the motor's gear as joint equalities.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // A platform written into a configuration's YAML: the legs form of a ModelSpec (every joint, axis,
 // screw and offset explicit) in place of the user's platform keys, every other key of the user's
 // text kept. What an identification (a corrected configuration) and a design write.

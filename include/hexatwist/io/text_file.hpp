@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Text files read whole, with a bound on their size: the one reader of configuration and data files
 // for the CLI, the C API and Python, so that they refuse the same files with the same words.
 #pragma once

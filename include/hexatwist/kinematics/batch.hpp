@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Batches of poses for atlases, design searches and Monte Carlo: the poses side by side in the
 // SIMD lanes (eight to a register with AVX-512), where the real-time call puts the six legs of one
 // pose. Motor-side commands with every limit checked, as motor_commands decides them, and the

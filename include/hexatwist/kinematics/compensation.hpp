@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Length error from the twist (Eq. 10) and the motor commands with and without compensation
 // (Eq. 11-12): what the servo must reach on the motor side.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Forward kinematics: the pose for given leg lengths, by Newton's method on R^3 x SO(3), either
 // from geometric lengths or from motor-side lengths with the twist included.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Inverse kinematics, paper Eq. (1)-(4): leg vectors, lengths and unit axes for a pose.
 #pragma once
 

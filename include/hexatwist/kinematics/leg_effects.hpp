@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What a real leg adds to its geometry (docs/theory/kinematics.md §4b): it shortens under its
 // axial load (stiffness), grows with its temperature (thermal expansion of the length between the
 // joints and of the screw's lead), and its nut lags the motor by half its play in the direction of

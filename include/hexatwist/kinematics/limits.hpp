@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Limit check of a pose: leg stroke, U-joint bend, U-joint singularity and platform (Jacobian)
 // singularity.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The immutable, validated description of a six-leg U-P-U lead-screw Stewart platform.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Platform pose relative to home: position and roll-pitch-yaw (paper Eq. 2-3), and the
 // rotation-matrix placement that forward kinematics iterates on.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The real-time command stream: one pose in, one checked set of six motor commands out, with a
 // policy for rejected poses and optional per-leg rate limits; and the text protocol of
 // `hexatwist stream` (a pose line in, a CSV or JSON line out).

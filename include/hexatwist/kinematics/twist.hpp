@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Passive rotation ("twist") of each leg: the signed angle of the rod relative to the housing
 // about the leg axis, minus its home value (paper Eq. 7-8; Eq. 9 corrected, docs/theory.md).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Reach of the platform along each pose coordinate alone: how far it can move from home in x, y,
 // z, roll, pitch or yaw with every limit respected (what a controller's axis limits should be).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Pose trajectories: jerk-limited rest-to-rest moves, the seed paper's sweep test motion, poses
 // read from CSV text and their resampling onto a fixed period. Reading files is the caller's job.
 #pragma once

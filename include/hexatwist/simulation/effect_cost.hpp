@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // What the legs' effects (heat, load and play: kinematics/leg_effects.hpp, theory §4b) cost at the
 // observation point along a trajectory, as the paper's Table 1 gives the twist's: with commands
 // that ignore them, with commands that compensate the twist alone (Eq. 12), and with commands that

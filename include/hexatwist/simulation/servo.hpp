@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // One position loop per leg on the motor encoder (the paper's Fig. 4): PID with anti-windup and
 // feed-forward, and the drives' dynamics integrated with fixed-step RK4 (docs/theory.md §9).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Closed-loop simulation of the platform under its six servo loops (the paper's §3-4, Fig. 4):
 // the commands of a trajectory, the drives, the load, and the real pose with the twist included.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The paper's study (§4, Table 1, Figs. 6-9): four sweeps from home, each simulated with the
 // conventional and the compensated command, and the observation error split into what the twist
 // does, what the servo does, and what the closed loop does.

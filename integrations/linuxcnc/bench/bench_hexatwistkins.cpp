@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The LinuxCNC module's kinematics functions called directly, as LinuxCNC's motion calls them:
 // kinematicsInverse for a world pose (mm, deg), and kinematicsForward warm from the previous
 // solution along a 1 kHz motion, and cold (after a failure motion passes the home pose). Beside

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 /* The few HAL and RTAPI calls hexatwistkins.c makes at load time, standing in for LinuxCNC's so
  * that the benchmark can call the module's kinematics functions directly in one process: pins
  * get storage, messages go to stderr. Nothing here runs in the timed loops. */

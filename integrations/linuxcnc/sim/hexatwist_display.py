@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: BSD-3-Clause
 """LinuxCNC user interface for the tests (and the sample configuration's demo): no window.
 
 LinuxCNC starts it as `[DISPLAY] DISPLAY` with `-ini FILE`. It reads a plan (JSON) from the file

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Runs the sample configuration seed.ini: LinuxCNC with hexatwistkins on the seed platform, the
 # joints simulated, and hexatwist_display.py as the user interface (no window: it homes, makes a
 # few moves and prints what LinuxCNC reports). Install the module first:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Starts a real LinuxCNC headless, runs a plan through sim/hexatwist_display.py, and always stops it.
 
 Only one LinuxCNC runs on a machine (a lock file and fixed shared-memory keys): the tests that use

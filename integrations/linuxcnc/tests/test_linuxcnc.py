@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """hexatwistkins in a real, headless LinuxCNC (and genhexkins beside it for comparison).
 
 Run by ctest (integrations/linuxcnc/tests/CMakeLists.txt) with
@@ -348,9 +349,12 @@ def ini_values(ini, key):
 def test_a_calibrated_configuration_keeps_the_machines_home_and_runs_unchanged():
     """The calibration contract (README "Identification"): a platform identified from a tracker
     log of a synthetic platform with every error (joint centres off by up to 1 mm, lead +2 %,
-    zero offsets, the observation point) gives a configuration whose INI keeps every HOME value and
-    joint speed of the one the log was recorded with; LinuxCNC runs it unchanged, and its joints
-    are `hexatwist ik`'s compensated commands of the corrected configuration."""
+    zero offsets, the observation point) gives a configuration whose INI keeps every joint's
+    HOME_OFFSET (the drives' reference at the home switches) and speed of the one the log was
+    recorded with; each joint's HOME is the corrected commands of the nominal home, so that after
+    homing LinuxCNC moves the platform to the [TRAJ] HOME the user expects (the INI says where the
+    switches alone leave it); LinuxCNC runs it, and its joints are `hexatwist ik`'s compensated
+    commands of the corrected configuration."""
     work = os.path.join(OUT, "calibrated")
     os.makedirs(work, exist_ok=True)
     log = os.path.join(work, "stations.csv")
@@ -359,8 +363,15 @@ def test_a_calibrated_configuration_keeps_the_machines_home_and_runs_unchanged()
         "--offsets-mm", "0.5", "--point-offset-mm", "1,-1,2", "--seed", "4", "--out", log)
     cli("identify", "--points", log, "--stations", "30", "--station-seed", "5", "--no-figures", "--out", corrected)
     nominal_ini, ini = cli("linuxcnc").stdout, ini_for(corrected)
-    for key in ("HOME", "HOME_OFFSET", "MAX_VELOCITY"):
+    for key in ("HOME_OFFSET", "MAX_VELOCITY"):
         assert ini_values(harness.faster(nominal_ini), key) == ini_values(ini, key), key
+    home_world = [0.0, 0.0, 1000 * model_json(corrected)["home_height"], 0.0, 0.0, 0.0]
+    home_commands = [1000.0 * leg["command_compensated"] for leg in ik(home_world, corrected)["legs"]]
+    joint_homes = [float(v) for v in ini_values(ini, "HOME")[1:]]  # the first is [TRAJ] HOME
+    assert ini_values(ini, "HOME")[0] == ini_values(nominal_ini, "HOME")[0]
+    assert_close(joint_homes, home_commands, 1e-8, "the joints' HOME")
+    assert max(abs(a - float(b)) for a, b in zip(joint_homes, ini_values(ini, "HOME_OFFSET"))) > 0.05
+    assert "At the home switches (HOME_OFFSET) this calibrated platform stands at" in ini
     # The corrected platform differs from the nominal one: its commands do (by the joints' errors).
     limits = axis_limits(ini)
     poses = random_inside(random.Random(3), limits, 0.5, corrected, count=6)
@@ -371,6 +382,10 @@ def test_a_calibrated_configuration_keeps_the_machines_home_and_runs_unchanged()
     run = harness.run(ini, {"steps": steps, "pins": PINS}, timeout=120, keep_dir=os.path.join(work, "run"))
     assert run.results and len(run.results) == len(steps), run.log[-3000:]
     assert all(r["done"] and not r["errors"] for r in run.results), run.results
+    # Homed, the platform stands at the nominal home, its joints at their HOME (the switches alone
+    # left it 1.2 mm away; the joints' move to HOME ends within 18 nm of it, the pose within 9 nm).
+    assert_close(run.results[0]["actual_position"], home_world, 2e-4, "the pose after homing")
+    assert_close(run.results[0]["joint_actual_position"], home_commands, 2e-4, "the joints after homing")
     worst_joint, worst_pose = check_pose_steps(run, corrected)
     print("calibrated configuration: worst joint difference %.3g mm, worst FK pose difference %.3g" %
           (worst_joint, worst_pose))
