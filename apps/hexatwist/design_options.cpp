@@ -34,12 +34,15 @@ int limit_group(Status s) {
 }
 
 void add_required_options(CLI::App& app, RequiredOptions& o) {
+  const RequiredWorkspaceSpec d;  // the library's defaults
   auto* w = app.add_option(
       "--workspace", o.workspace,
-      "The required workspace, key=value separated by commas (every key optional): tests=on|off (the study's four "
-      "tests at their amplitudes), samples=41 (poses per test), random=2000 (combined poses drawn uniformly in "
-      "+-linear [m] and +-angular [deg] in every coordinate at once, kept where the platform reaches them), "
-      "linear=0.25, angular=15, seed=1");
+      fmt::format("The required workspace, key=value separated by commas (every key optional): tests=on|off (the "
+                  "study's four tests at their amplitudes), test_samples={} (poses per test, 2 to {}), random={} "
+                  "(combined poses drawn uniformly in +-linear [m] and +-angular [deg] in every coordinate at once, "
+                  "kept where the platform reaches them), linear={:g} (0 to {:g} m), angular={:g} (0 to 180 deg), "
+                  "seed={}",
+                  d.test_samples, kMaxTestSamples, d.random, d.linear, kMaxRequiredLinear, rad2deg(d.angular), d.seed));
   auto* t = app.add_option("--trajectory", o.trajectories,
                            "Instead: CSV files (simulate's format: t,x,y,z,roll,pitch,yaw in s, m, deg), every row a "
                            "required pose; each must be inside every limit")
@@ -61,16 +64,17 @@ RequiredWorkspaceSpec parse_workspace_spec(const std::string& text) {
     const auto fail = [&](const std::string& what) {
       throw ExitError(kExitBadInput, fmt::format("--workspace '{}': {}", printable(item), what));
     };
-    if (eq == std::string::npos) fail("expected key=value (tests, samples, random, linear, angular, seed)");
+    if (eq == std::string::npos) fail("expected key=value (tests, test_samples, random, linear, angular, seed)");
     const auto number = [&]() {
       char* stop = nullptr;
       const double v = std::strtod(value.c_str(), &stop);
       if (value.empty() || *stop != '\0' || !std::isfinite(v)) fail("expected a finite number");
       return v;
     };
-    const auto count = [&](double lo) {
+    // A whole number an int holds; its range is the library's (check_required_workspace_spec).
+    const auto count = [&]() {
       const double v = number();
-      if (v != std::floor(v) || v < lo || v > 1e9) fail(fmt::format("expected a whole number from {:g} to 1e9", lo));
+      if (v != std::floor(v) || v < 0.0 || v > 2147483647.0) fail("expected a whole number >= 0");
       return v;
     };
     if (key == "tests") {
@@ -81,25 +85,27 @@ RequiredWorkspaceSpec parse_workspace_spec(const std::string& text) {
       } else {
         fail("expected on or off");
       }
-    } else if (key == "samples") {
-      s.test_samples = static_cast<int>(count(2));
+    } else if (key == "test_samples" || key == "samples") {  // samples: the name before 0.1.0's vocabulary
+      s.test_samples = static_cast<int>(count());
     } else if (key == "random") {
-      s.random = static_cast<int>(count(0));
+      s.random = static_cast<int>(count());
     } else if (key == "linear") {
       s.linear = number();
-      if (s.linear < 0.0 || s.linear > 10.0) fail("expected 0 to 10 m");
     } else if (key == "angular") {
-      const double deg = number();
-      if (deg < 0.0 || deg > 180.0) fail("expected 0 to 180 deg");
-      s.angular = deg2rad(deg);
+      s.angular = deg2rad(number());
     } else if (key == "seed") {
-      s.seed = static_cast<std::uint64_t>(count(0));
+      s.seed = static_cast<std::uint64_t>(count());
     } else {
-      fail("unknown key; expected tests, samples, random, linear, angular, seed");
+      fail("unknown key; expected tests, test_samples, random, linear, angular, seed");
     }
     if (end == text.size()) break;
   }
-  if (!s.tests && s.random == 0) throw ExitError(kExitBadInput, "--workspace: no tests and no random poses: empty");
+  // The library's ranges, the field named as its key of --workspace.
+  try {
+    check_required_workspace_spec(s);
+  } catch (const ParameterError& e) {
+    throw ExitError(kExitBadInput, fmt::format("--workspace ({}): {}", e.parameter(), e.what()));
+  }
   return s;
 }
 
@@ -108,8 +114,9 @@ RequiredPoses required_poses(const Config& config, const RequiredOptions& o) {
   const Model& model = config.rig.model();
   if (o.trajectories.empty()) {
     r.spec = parse_workspace_spec(o.workspace);
-    if (required_workspace(model, config.study, r.spec, Strategy::Compensated, r.workspace) != Status::Ok)
-      throw ExitError(kExitBadInput, "--workspace: a setting out of range");
+    if (const Status s = required_workspace(model, config.study, r.spec, Strategy::Compensated, r.workspace);
+        s != Status::Ok)
+      throw ExitError(kExitOutOfLimit, fmt::format("--workspace: {}", describe(s)));
     r.poses = r.workspace.poses;
     const RequiredWorkspace& w = r.workspace;
     std::string tests = r.spec.tests ? fmt::format("the four tests at their amplitudes, {} poses", w.test_poses) : "";

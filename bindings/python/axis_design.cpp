@@ -40,8 +40,9 @@ std::vector<Pose> design_poses(const PlatformSource& p, const py::object& poses,
   const RequiredWorkspaceSpec spec = required_spec(
       required["tests"].cast<bool>(), required["test_samples"].cast<int>(), required["random"].cast<int>(),
       required["linear"].cast<double>(), required["angular"].cast<double>(), required["seed"].cast<std::uint64_t>());
-  if (required_workspace(*p.model, p.study, spec, Strategy::Compensated, w) != Status::Ok)
-    raise_input("workspace: test_samples >= 2, random >= 0, finite ranges >= 0");
+  // The library checks the spec (ParameterError: InputError naming the keyword).
+  if (const Status s = required_workspace(*p.model, p.study, spec, Strategy::Compensated, w); s != Status::Ok)
+    raise_status(s, "workspace");
   return std::move(w.poses);
 }
 
@@ -53,7 +54,7 @@ py::dict required_py(const py::object& config, bool tests, int test_samples, int
   RequiredWorkspace w;
   const Status s = required_workspace(
       *p.model, p.study, required_spec(tests, test_samples, random, linear, angular, seed), strategy_from(strategy), w);
-  if (s != Status::Ok) raise_input("required_workspace: test_samples >= 2, random >= 0, finite ranges >= 0");
+  if (s != Status::Ok) raise_status(s, "required_workspace");
   py::dict d;
   d["poses"] = pose_rows(w.poses);
   d["test_poses"] = w.test_poses;
@@ -161,6 +162,16 @@ py::dict design_py(const py::object& config, const py::object& poses_in, const p
 void expose_axis_design(py::module_& m) {
   const RequiredWorkspaceSpec w;
   const DesignOptions o;
+  m.def("_required_workspace_defaults", [w] {
+    py::dict d;  // the library's RequiredWorkspaceSpec, for the package's keyword defaults
+    d["tests"] = w.tests;
+    d["test_samples"] = w.test_samples;
+    d["random"] = w.random;
+    d["linear"] = w.linear;
+    d["angular"] = w.angular;
+    d["seed"] = w.seed;
+    return d;
+  });
   m.def("_required_workspace", &required_py, py::arg("platform"), py::arg("tests") = w.tests,
         py::arg("test_samples") = w.test_samples, py::arg("random") = w.random, py::arg("linear") = w.linear,
         py::arg("angular") = w.angular, py::arg("seed") = w.seed, py::arg("strategy") = "compensated");

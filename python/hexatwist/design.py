@@ -332,8 +332,7 @@ class Tolerance(Result):
 def _workspace_spec(workspace: Mapping[str, Any]) -> dict[str, Any]:
     """The required workspace's settings (keys tests, test_samples, random, linear [m], angular [rad],
     seed), defaults filled in."""
-    spec: dict[str, Any] = dict(tests=True, test_samples=41, random=2000, linear=0.25, angular=float(np.radians(15.0)),
-                                seed=1)
+    spec: dict[str, Any] = dict(_core._required_workspace_defaults())  # the library's RequiredWorkspaceSpec
     unknown = set(workspace) - set(spec)
     if unknown:
         raise _core.InputError(f"workspace: unknown key(s) {', '.join(sorted(unknown))}; expected {', '.join(spec)}")

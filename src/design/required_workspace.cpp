@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "hexatwist/design/required_workspace.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 
 #include "design/sampling.hpp"
+#include "hexatwist/error.hpp"
 
 namespace hexatwist {
 
@@ -18,12 +21,25 @@ std::vector<Pose> random_combined_poses(const RequiredWorkspaceSpec& spec, std::
   return poses;
 }
 
+void check_required_workspace_spec(const RequiredWorkspaceSpec& s) {
+  const auto refuse = [](std::string message, const char* field) {
+    throw ParameterError("required workspace: " + std::move(message), field);
+  };
+  if (s.test_samples < 2 || s.test_samples > kMaxTestSamples)
+    refuse(fmt::format("expected 2 to {} poses per test, got {}", kMaxTestSamples, s.test_samples), "test_samples");
+  if (s.random < 0 || s.random > kMaxRandomPoses)
+    refuse(fmt::format("expected 0 to {} random poses, got {}", kMaxRandomPoses, s.random), "random");
+  if (!(s.linear >= 0.0 && s.linear <= kMaxRequiredLinear))
+    refuse(fmt::format("expected a linear range of 0 to {:g} m, got {:g}", kMaxRequiredLinear, s.linear), "linear");
+  if (!(s.angular >= 0.0 && s.angular <= kMaxRequiredAngular))
+    refuse(fmt::format("expected an angular range of 0 to 180 deg, got {:g} deg", rad2deg(s.angular)), "angular");
+  if (!s.tests && s.random == 0) refuse("no tests and no random poses: the workspace would be empty", "random");
+}
+
 Status required_workspace(const Model& model, const StudySpec& study, const RequiredWorkspaceSpec& spec,
                           Strategy strategy, RequiredWorkspace& out) {
+  check_required_workspace_spec(spec);
   out = RequiredWorkspace{};
-  if (spec.test_samples < 2 || spec.random < 0 || !(spec.linear >= 0.0) || !std::isfinite(spec.linear) ||
-      !(spec.angular >= 0.0) || !std::isfinite(spec.angular))
-    return Status::NonFiniteInput;
   Vector6d command;
   LimitReport report;
   if (spec.tests) {

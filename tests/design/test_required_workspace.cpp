@@ -55,12 +55,46 @@ TEST(RequiredWorkspace, RandomPosesAreUniformInTheirBoxAndTheSameForAnyCount) {
   EXPECT_NE(random_combined_poses(spec, 0, 1)[0].to_vector(), a[0].to_vector());
 }
 
-TEST(RequiredWorkspace, RefusesABadSpec) {
-  RequiredWorkspaceSpec spec;
-  spec.test_samples = 1;
-  RequiredWorkspace w;
-  EXPECT_EQ(required_workspace(test::seed_model(), StudySpec{}, spec, Strategy::Compensated, w),
-            Status::NonFiniteInput);
+TEST(RequiredWorkspace, RefusesABadSpecNamingTheField) {
+  // Each field just past its range (check_required_workspace_spec), and the empty workspace.
+  const auto refused = [](RequiredWorkspaceSpec spec, std::string_view field) {
+    RequiredWorkspace w;
+    try {
+      (void)required_workspace(test::seed_model(), StudySpec{}, spec, Strategy::Compensated, w);
+      ADD_FAILURE() << field << ": not refused";
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.parameter(), field) << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind("required workspace: ", 0), 0U) << e.what();
+    }
+  };
+  RequiredWorkspaceSpec s;
+  s.test_samples = 1;
+  refused(s, "test_samples");
+  s = {};
+  s.test_samples = kMaxTestSamples + 1;
+  refused(s, "test_samples");
+  s = {};
+  s.random = -1;
+  refused(s, "random");
+  s = {};
+  s.linear = std::nan("");
+  refused(s, "linear");
+  s.linear = kMaxRequiredLinear * (1 + 1e-12);
+  refused(s, "linear");
+  s = {};
+  s.angular = -1e-9;
+  refused(s, "angular");
+  s = {};
+  s.tests = false;
+  s.random = 0;
+  refused(s, "random");
+  // On the ends: accepted.
+  s = {};
+  s.test_samples = 2;
+  s.random = 0;
+  s.linear = kMaxRequiredLinear;
+  s.angular = kMaxRequiredAngular;
+  EXPECT_NO_THROW(check_required_workspace_spec(s));
 }
 
 }  // namespace

@@ -133,3 +133,37 @@ def test_identify_options(option, typed, keyword, value, model, tmp_path):
     py = python_refuses(lambda: hexatwist.identify(model, motor, points, **{keyword: value}), keyword)
     assert cli == py, (option, typed, cli, py)
     assert py == (not inside(keyword, value)), (option, typed, py)
+
+
+WORKSPACE_CASES = [("test_samples", "test_samples", v, v) for v in (1, 2, 1000001)] + [
+    ("random", "random", v, v) for v in (0, 200, 1000000001)
+] + [("linear", "linear", v, v) for v in (0.0, 10.0, 10.001)] + [
+    ("angular", "angular", v, math.radians(v)) for v in (0.0, 180.0, 180.01)
+]
+
+
+@pytest.mark.parametrize("key,keyword,typed,value", WORKSPACE_CASES)
+def test_required_workspace(key, keyword, typed, value, tmp_path):
+    # The tests on with 2 poses each (random poses only where the case is about them): an accepted
+    # workspace is small, and `design` on it quick.
+    base = {"tests": keyword != "random", "test_samples": 2, "random": 0}
+    base[keyword] = value
+    typed_keys = {"tests": "on" if base["tests"] else "off", "test_samples": 2, "random": 0}
+    typed_keys[key] = str(typed)  # every digit: {:g} would round 1000001 to 1e+06
+    text = ",".join(f"{k}={v}" for k, v in typed_keys.items())
+    cli = cli_refuses(["design", "--out", "d.yaml", "--workspace", text], f"({keyword})", tmp_path)
+    py = python_refuses(lambda: hexatwist.required_workspace(**base), keyword)
+    assert cli == py, (key, typed, cli, py)
+    limits = {"test_samples": (2, 1000000), "random": (0, 1000000000), "linear": (0.0, 10.0), "angular": (0.0, math.pi)}
+    low, high = limits[keyword]
+    empty = keyword == "random" and value == 0  # no tests, no random poses
+    assert py == (not low <= value <= high * (1 + 1e-12) or empty), (key, typed, py)
+
+
+def test_the_packages_workspace_defaults_are_the_librarys():
+    import inspect
+    from hexatwist import _hexatwist as core
+    library = core._required_workspace_defaults()
+    signature = inspect.signature(hexatwist.required_workspace).parameters
+    for key, value in library.items():
+        assert signature[key].default == value, key

@@ -31,9 +31,19 @@ struct RequiredWorkspace {
   std::size_t random_reached = 0;  ///< of which reached (kept)
 };
 
+/// The largest settings a required workspace takes: poses per test, random poses, the ranges [m, rad].
+inline constexpr int kMaxTestSamples = 1000000, kMaxRandomPoses = 1000000000;
+inline constexpr double kMaxRequiredLinear = 10.0, kMaxRequiredAngular = 3.141592653589793;
+
+/// The one check of a RequiredWorkspaceSpec (required_workspace runs it; the CLI's --workspace
+/// and Python's keywords reach it): throws hexatwist::ParameterError naming the field out of its
+/// range (test_samples 2 to kMaxTestSamples, random 0 to kMaxRandomPoses, linear 0 to
+/// kMaxRequiredLinear, angular 0 to kMaxRequiredAngular) or "random" when there are no tests and
+/// no random poses (an empty workspace).
+void check_required_workspace_spec(const RequiredWorkspaceSpec& spec);
+
 /// The required workspace `spec` of `model`, a pose kept when motor_commands accepts it for
-/// `strategy`; the tests come from `study` (seed_tests). Returns NonFiniteInput for a bad spec
-/// (test_samples < 2, random < 0, non-finite or negative ranges).
+/// `strategy`; the tests come from `study` (seed_tests). Throws as check_required_workspace_spec.
 [[nodiscard]] Status required_workspace(const Model& model, const StudySpec& study, const RequiredWorkspaceSpec& spec,
                                         Strategy strategy, RequiredWorkspace& out);
 
