@@ -43,6 +43,13 @@ inline void add_leg_loads(const StaticLoadSpec& load, const lanes3& s, const lan
   return gj_solve_system(transposed, G, force) > 0.0;
 }
 
+// The block solve below passes 4-lane vectors between inline lambdas only; on a target without AVX
+// GCC notes that such a vector would be passed differently across a real call (-Wpsabi).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+
 /// F = J^-T G once every packet is added, from the padded rows of A = J diag(1, 1, 1, w, w, w)
 /// (w = 1 / model.condition_length(), as the limits form it): A^T F = diag(1, 1, 1, w, w, w) G.
 /// G adds the load's weight at its centre of mass (pose rotation R_BP) to the legs' share.
@@ -71,14 +78,13 @@ inline void add_leg_loads(const StaticLoadSpec& load, const lanes3& s, const lan
   // Entries first .. first + 2 of a row of A as (x, y, z, 0): two shuffles of the row's register
   // with eight lanes, else element by element.
   const auto half = [&](int row, int first) {
-    constexpr int kW = sizeof(lane_v) / sizeof(double);
-    if constexpr (kW == 8) {
-      const lane_v r = rows_of_A[row][0], zero = {};
-      return first == 0 ? __builtin_shufflevector(r, zero, 0, 1, 2, 8) : __builtin_shufflevector(r, zero, 3, 4, 5, 8);
-    } else {
-      const auto at = [&](int c) { return rows_of_A[row][c / kW][c % kW]; };
-      return v4d{at(first), at(first + 1), at(first + 2), 0.0};
-    }
+#if HEXATWIST_LANE_WIDTH == 8  // (a preprocessor test: clang checks a discarded branch's shuffle indices)
+    const lane_v r = rows_of_A[row][0], zero = {};
+    return first == 0 ? __builtin_shufflevector(r, zero, 0, 1, 2, 8) : __builtin_shufflevector(r, zero, 3, 4, 5, 8);
+#else
+    const auto at = [&](int c) { return rows_of_A[row][c / kWidth][c % kWidth]; };
+    return v4d{at(first), at(first + 1), at(first + 2), 0.0};
+#endif
   };
   M3 P, Q, R, T;
   for (int j = 0; j < 3; ++j) {
@@ -128,6 +134,10 @@ inline void add_leg_loads(const StaticLoadSpec& load, const lanes3& s, const lan
   }
   return force.allFinite() ? Status::Ok : Status::NonFiniteInput;
 }
+
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
 
 /// True where resolve_inputs needs the static forces: a leg has a stiffness and an input force is NaN.
 [[nodiscard]] inline bool needs_static_forces(const Model& model, const LegInputs& inputs) noexcept {
