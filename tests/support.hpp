@@ -59,6 +59,12 @@ inline const Model& seed_model() {
   return m;
 }
 
+/// The embedded seed platform with its servo, load and mechanism (configs/seed.yaml).
+inline const Rig& seed_rig() {
+  static const Config config = load_config(std::string(seed_config_yaml()), "seed.yaml");
+  return config.rig;
+}
+
 /// Uniform double in [lo, hi].
 inline double uniform(std::mt19937_64& rng, double lo, double hi) {
   return std::uniform_real_distribution<double>(lo, hi)(rng);

@@ -136,11 +136,19 @@ void measured_json(JsonWriter& j, const ReportedMeasurement& r) {
   j.end_object();
 }
 
-// An effect's three costs in the tables' order, with their JSON names.
-std::array<std::pair<const char*, const ErrorStats*>, 3> effect_columns(const EffectCost& e) {
+// An effect's costs in the tables' order, with their JSON names.
+std::array<std::pair<const char*, const ErrorStats*>, 4> effect_columns(const EffectCost& e) {
   return {{{"conventional", &e.conventional},
            {"twist_compensated", &e.twist_compensated},
-           {"compensated", &e.compensated}}};
+           {"compensated", &e.compensated},
+           {"static_load_compensated", &e.static_load_compensated}}};
+}
+
+// How many of effect_columns a table shows for row `r`: the static load's alone where the legs of
+// the row have a stiffness (the load's row, and all of them beside it).
+std::size_t effect_columns_shown(const std::vector<EffectCost>& rows, std::size_t r) {
+  const bool loaded = rows[r].effect == "load" || (rows[r].effect == "all" && rows.front().effect == "load");
+  return loaded ? 4 : 3;
 }
 
 // How the tables name an effect's row.
@@ -222,7 +230,9 @@ std::string effects_md(const std::vector<ReportedTest>& tests, const Vector6d& t
       "\n**The legs' effects** (the configuration's `leg_effects`; theory §4b): the error of point A in mm with "
       "perfect servos (the motors exactly at their targets), each effect alone on otherwise rigid legs. "
       "**conventional**: commands that ignore the twist and the effect; **twist compensated**: Eq. (12) alone, "
-      "the effect left; **compensated**: both (the legs' temperatures known to the commands).";
+      "the effect left; **compensated**: both (the legs' temperatures known to the commands, and their forces: "
+      "the static load and the test's accelerations); **static load only**: both, the forces those of the static "
+      "load at the pose, as ik, stream and LinuxCNC command them.";
   if (temperature_rise.any())
     s +=
         temperature_rise.minCoeff() == temperature_rise.maxCoeff()
@@ -236,8 +246,8 @@ std::string effects_md(const std::vector<ReportedTest>& tests, const Vector6d& t
   for (std::size_t i = 0; i < tests.size(); ++i) s += "---:|---:|";
   s += "\n";
   for (std::size_t r = 0; r < tests.front().effects.size(); ++r)
-    for (std::size_t c = 0; c < 3; ++c) {
-      const char* column_names[] = {"conventional", "twist compensated", "compensated"};
+    for (std::size_t c = 0; c < effect_columns_shown(tests.front().effects, r); ++c) {
+      const char* column_names[] = {"conventional", "twist compensated", "compensated", "static load only"};
       s += fmt::format("| {} | {} |", effect_label(tests.front().effects[r]), column_names[c]);
       for (const ReportedTest& t : tests) {
         const ErrorStats& st = *effect_columns(t.effects[r])[c].second;
@@ -359,7 +369,7 @@ void simulate_tests(const Rig& rig, std::vector<ReportedTest>& tests, const Vect
   bar.finish();
   for (ReportedTest& t : tests) {
     SimulationIssue issue;
-    if (const Status s = effect_costs(rig.model(), t.trajectory, temperature_rise, t.effects, issue); s != Status::Ok)
+    if (const Status s = effect_costs(rig, t.trajectory, temperature_rise, t.effects, issue); s != Status::Ok)
       throw ExitError(kExitOutOfLimit, fmt::format("{}: the legs' effects: {}; no report was written", where(t, issue),
                                                    is_limit(s) ? describe(issue.limit) : std::string(describe(s))));
   }
@@ -411,8 +421,8 @@ std::string summary_table(const std::vector<ReportedTest>& tests) {
   if (tests.empty() || tests.front().effects.empty()) return s;
   s += "legs' effects, perfect servos:\n";
   for (std::size_t r = 0; r < tests.front().effects.size(); ++r) {
-    const char* column_names[] = {"conventional", "twist comp.", "compensated"};
-    for (std::size_t c = 0; c < 3; ++c) {
+    const char* column_names[] = {"conventional", "twist comp.", "compensated", "static load"};
+    for (std::size_t c = 0; c < effect_columns_shown(tests.front().effects, r); ++c) {
       s += fmt::format("{:<13} {:<14}", c == 0 ? effect_label(tests.front().effects[r]) : "", column_names[c]);
       for (const ReportedTest& t : tests) s += fmt::format(" {:>10}", mm(effect_columns(t.effects[r])[c].second->max));
       s += "\n";

@@ -141,6 +141,7 @@ py::dict effect_dict(const EffectCost& e) {
   d["conventional"] = stats(e.conventional);
   d["twist_compensated"] = stats(e.twist_compensated);
   d["compensated"] = stats(e.compensated);
+  d["static_load_compensated"] = stats(e.static_load_compensated);
   return d;
 }
 
@@ -161,7 +162,7 @@ py::dict study_py(const py::object& config_src, const py::object& test, const py
   {
     py::gil_scoped_release release;
     s = run_test(config.rig, tr, run, issue);
-    if (s == Status::Ok) s = effect_costs(config.rig.model(), tr, rise, effects, issue);
+    if (s == Status::Ok) s = effect_costs(config.rig, tr, rise, effects, issue);
   }
   py::dict d;
   py::dict summary = issue_dict(s, issue);

@@ -22,6 +22,7 @@
 #include "hexatwist/motion/trajectory.hpp"
 
 #include "hexatwist/dynamics/dynamics.hpp"
+#include "hexatwist/dynamics/leg_forces.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
 #include "hexatwist/dynamics/motor_sizing.hpp"
 #include "hexatwist/dynamics/rig.hpp"

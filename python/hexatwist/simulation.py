@@ -123,7 +123,10 @@ class EffectCost(Result):
     twist_compensated: ErrorStats
     """Eq. (12) alone: the twist compensated, the effect not [m]."""
     compensated: ErrorStats
-    """Both compensated [m]."""
+    """Both compensated, the legs' forces known along the test (its accelerations included) [m]."""
+    static_load_compensated: ErrorStats
+    """Both compensated with the forces of the static load at the pose (what ``commands`` gives:
+    the trajectory's accelerations unknown); the same as ``compensated`` without a stiffness [m]."""
 
 
 @dataclass(frozen=True)
@@ -189,7 +192,8 @@ def study(rig: RigLike = None, test: TestName | None = None, poses: ArrayLike | 
     d = _core._study(rig, test, poses, temperature_rise)
     s = dict(d["summary"])
     s["leg_effects"] = tuple(EffectCost(effect=e["effect"], **{k: ErrorStats(**e[k]) for k in
-                                                               ("conventional", "twist_compensated", "compensated")})
+                                                               ("conventional", "twist_compensated", "compensated",
+                                                                "static_load_compensated")})
                              for e in s["leg_effects"])
     for name in ("conventional", "compensated"):
         if s[name] is not None:

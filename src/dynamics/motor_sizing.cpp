@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hexatwist/dynamics/leg_forces.hpp"
 #include "hexatwist/kinematics/compensation.hpp"
 
 namespace hexatwist {
@@ -133,13 +134,7 @@ Status size_motors(const Rig& rig, const Trajectory& trajectory, MotorSizing& ou
       return fail(out, s, k, trajectory);
     }
     // Differences as make_plan (simulation.cpp) takes them of the motor references.
-    const std::size_t a = k == 0 ? 0 : k - 1;
-    const std::size_t b = k + 1 == n ? k : k + 1;
-    const Vector6d rate = (poses[b].to_vector() - poses[a].to_vector()) / (dt * static_cast<double>(b - a));
-    Vector6d acceleration = Vector6d::Zero();
-    if (k > 0 && k + 1 < n)
-      acceleration = (poses[k + 1].to_vector() - 2.0 * poses[k].to_vector() + poses[k - 1].to_vector()) / (dt * dt);
-    const PlatformMotion motion = platform_motion(poses[k], rate, acceleration);
+    const PlatformMotion motion = trajectory_motion(trajectory, k);
     if (const Status s = inverse_dynamics(rig, motion, id); s != Status::Ok) return fail(out, s, k, trajectory);
     MotorSample& sample = out.samples.emplace_back();
     sample.time = trajectory.time(k);

@@ -6,6 +6,7 @@
 #include <string_view>
 #include <tuple>
 
+#include "hexatwist/dynamics/leg_forces.hpp"
 #include "hexatwist/kinematics/compensation.hpp"
 #include "hexatwist/kinematics/forward.hpp"
 #include "hexatwist/kinematics/leg_effects.hpp"
@@ -35,9 +36,12 @@ Model with_effect(const Model& model, std::string_view effect) {
 }
 
 // The observation point's error along `trajectory` for the commands of `controller` with
-// `strategy` sent to `plant`'s legs, the motors exactly at their commands.
+// `strategy` sent to `plant`'s legs, the motors exactly at their commands. The plant's legs carry
+// `force` (one per sample: the static load and the motion's inertia; empty: the static load
+// alone); the commands know it when `commands_know_force`, else they compensate the static load.
 Status quasi_static(const Model& plant, const Model& controller, Strategy strategy, const Trajectory& trajectory,
-                    const Vector6d& temperature_rise, ErrorStats& out, SimulationIssue& issue) {
+                    const Vector6d& temperature_rise, const std::vector<Vector6d>& force, bool commands_know_force,
+                    ErrorStats& out, SimulationIssue& issue) {
   const std::size_t n = trajectory.poses.size();
   const double duration = trajectory.duration();
   const Vector3d& obs = plant.spec().observation_P;
@@ -51,13 +55,16 @@ Status quasi_static(const Model& plant, const Model& controller, Strategy strate
     LegInputs inputs;
     const double share = warm_up_share(trajectory.time(k) - trajectory.time(0), duration);
     for (int i = 0; i < kLegs; ++i) inputs.temperature[i] = plant.reference_temperature() + temperature_rise[i] * share;
+    LegInputs real = inputs;
+    if (!force.empty()) real.force = force[k];
     Vector6d command;
     LimitReport limit;
-    if (const Status s = motor_commands(controller, trajectory.poses[k], strategy, inputs, &play, command, limit);
+    if (const Status s = motor_commands(controller, trajectory.poses[k], strategy, commands_know_force ? real : inputs,
+                                        &play, command, limit);
         s != Status::Ok)
       return detail::fail_at(issue, s, k, trajectory, limit);
     const Vector6d direction = follow_nuts(plant, command, inputs.temperature, nuts);
-    if (const Status s = forward_kinematics(plant, command, inputs, &direction, guess, fk); s != Status::Ok)
+    if (const Status s = forward_kinematics(plant, command, real, &direction, guess, fk); s != Status::Ok)
       return detail::fail_at(issue, s, k, trajectory);
     guess = fk.placement;
     const Placement desired = placement_from_pose(trajectory.poses[k]);
@@ -78,8 +85,9 @@ std::string_view check_temperature_rise(const Model& model, const Vector6d& temp
   return {};
 }
 
-Status effect_costs(const Model& model, const Trajectory& trajectory, const Vector6d& temperature_rise,
+Status effect_costs(const Rig& rig, const Trajectory& trajectory, const Vector6d& temperature_rise,
                     std::vector<EffectCost>& out, SimulationIssue& issue) {
+  const Model& model = rig.model();
   out.clear();
   issue = SimulationIssue{};
   if (!check_temperature_rise(model, temperature_rise).empty()) {
@@ -94,19 +102,35 @@ Status effect_costs(const Model& model, const Trajectory& trajectory, const Vect
   if (heat) effects.emplace_back("heat");
   if (effects.size() > 1) effects.emplace_back("all");
   if (effects.empty()) return Status::Ok;
+  // The legs' forces along the run, the trajectory's accelerations included (dynamics/leg_forces.hpp).
+  std::vector<Vector6d> force;
+  if (model.has_stiffness() && trajectory.poses.size() > 1) {
+    std::size_t at = 0;
+    if (const Status s = trajectory_leg_forces(rig, trajectory, force, at); s != Status::Ok)
+      return detail::fail_at(issue, s, at, trajectory);
+  }
   const Model rigid = with_effect(model, "");
   for (const std::string& effect : effects) {
     const Model plant = effect == "all" ? model : with_effect(model, effect);
     EffectCost& row = out.emplace_back();
     row.effect = effect;
-    for (auto [controller, strategy, stats] : {std::tuple{&rigid, Strategy::Conventional, &row.conventional},
-                                               std::tuple{&rigid, Strategy::Compensated, &row.twist_compensated},
-                                               std::tuple{&plant, Strategy::Compensated, &row.compensated}})
-      if (const Status s = quasi_static(plant, *controller, strategy, trajectory, temperature_rise, *stats, issue);
+    const bool loaded = plant.has_stiffness();
+    for (auto [controller, strategy, know, stats] :
+         {std::tuple{&rigid, Strategy::Conventional, true, &row.conventional},
+          std::tuple{&rigid, Strategy::Compensated, true, &row.twist_compensated},
+          std::tuple{&plant, Strategy::Compensated, true, &row.compensated},
+          std::tuple{&plant, Strategy::Compensated, false, &row.static_load_compensated}}) {
+      if (!know && !loaded) {  // without a stiffness the forces change nothing
+        *stats = row.compensated;
+        continue;
+      }
+      if (const Status s =
+              quasi_static(plant, *controller, strategy, trajectory, temperature_rise, force, know, *stats, issue);
           s != Status::Ok) {
         out.clear();
         return s;
       }
+    }
   }
   return Status::Ok;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "dynamics/mechanism_internal.hpp"
+#include "hexatwist/dynamics/leg_forces.hpp"
 #include "hexatwist/dynamics/mechanism.hpp"
 #include "hexatwist/kinematics/leg_effects.hpp"
 #include "hexatwist/simulation/servo.hpp"
@@ -24,14 +25,20 @@ Vector6d plant_lengths(const Model& model, const Vector6d& travel, bool twist_in
   return twist_in_plant ? model.motor_from_travel(travel) : Vector6d(travel + model.geometry().length_offset);
 }
 
-// Forward kinematics of the plant: on a model whose legs have effects (theory §4b), at their
-// static forces and the reference temperature, with the play's directions from the nuts' dead
-// band, which `nuts` follows along the run.
+// Forward kinematics of the plant: on a model whose legs have effects (theory §4b), at the
+// reference temperature, with the play's directions from the nuts' dead band, which `nuts`
+// follows along the run, and the legs' forces `force` [N] (null: the static load at the pose).
+// The closed loop's legs carry the planned motion's forces: the servo's error moves the platform
+// by tens of micrometres from its pose, which changes the seed's static forces by newtons
+// (nanometres of deflection); the rigid coupling of the motors' accelerations would put their
+// control-rate ripple into the forces, which legs of finite stiffness do not pass on.
 Status plant_fk(const Model& model, const Vector6d& lengths, LengthKind kind, const Placement& guess, NutGap& nuts,
-                FkResult& fk) noexcept {
+                const Vector6d* force, FkResult& fk) noexcept {
   if (kind == LengthKind::Motor && model.has_leg_effects()) {
     const Vector6d direction = follow_nuts(model, lengths, nuts);
-    return forward_kinematics(model, lengths, LegInputs{}, &direction, guess, fk);
+    LegInputs inputs;
+    if (force != nullptr && model.has_stiffness()) inputs.force = *force;
+    return forward_kinematics(model, lengths, inputs, &direction, guess, fk);
   }
   return forward_kinematics(model, lengths, kind, guess, fk);
 }
@@ -39,6 +46,7 @@ Status plant_fk(const Model& model, const Vector6d& lengths, LengthKind kind, co
 // The targets of a whole trajectory, computed (and checked) before the loop runs.
 struct Plan {
   std::vector<Vector6d> command;          // motor-side target [m]
+  std::vector<Vector6d> force;            // the legs' forces along the run [N] (empty: rigid legs)
   std::vector<ServoReference> reference;  // the same at the motor shaft, with speed and acceleration
   std::vector<double> error_twist_only;   // observation error with perfect servos [m]
 };
@@ -57,17 +65,27 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   Vector6d still;
   const double torque_limit = rig.servo().torque_limit;
   // The compensated commands of legs with play follow each leg's direction along the run, from
-  // home where homing left it (theory §4b).
+  // home where homing left it. Legs with a stiffness carry the forces of the planned motion, the
+  // static load at its pose plus its accelerations' share (theory §4b, dynamics/leg_forces.hpp),
+  // which the compensated commands know.
   PlayState play;
   start_play(model, model.home_command(), play);
+  std::vector<Vector6d> force;
+  if (twist_in_plant && model.has_stiffness() && n > 1) {
+    std::size_t at = 0;
+    if (const Status s = trajectory_leg_forces(rig, trajectory, force, at); s != Status::Ok)
+      return detail::fail_at(issue, s, at, trajectory);
+  }
   for (std::size_t k = 0; k < n; ++k) {
     if (const Status s = compute_commands(model, trajectory.poses[k], report); s != Status::Ok)
       return detail::fail_at(issue, s, k, trajectory, report.limit);
     command[k] = compensated ? report.compensated : report.conventional;
-    if (compensated && model.has_play()) {
+    if (compensated && (model.has_play() || !force.empty())) {
+      LegInputs inputs;
+      if (!force.empty()) inputs.force = force[k];
       LimitReport limit;
       if (const Status s =
-              motor_commands(model, trajectory.poses[k], Strategy::Compensated, LegInputs{}, &play, command[k], limit);
+              motor_commands(model, trajectory.poses[k], Strategy::Compensated, inputs, &play, command[k], limit);
           s != Status::Ok)
         return detail::fail_at(issue, s, k, trajectory, limit);
     }
@@ -124,7 +142,8 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   const Vector3d& obs = model.spec().observation_P;
   NutGap nuts;
   for (std::size_t k = 0; k < n; ++k) {
-    if (const Status s = plant_fk(model, plant_lengths(model, travel[k], twist_in_plant), kind, guess, nuts, fk);
+    if (const Status s = plant_fk(model, plant_lengths(model, travel[k], twist_in_plant), kind, guess, nuts,
+                                  force.empty() ? nullptr : &force[k], fk);
         s != Status::Ok)
       return detail::fail_at(issue, s, k, trajectory);
     guess = fk.placement;
@@ -134,6 +153,7 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   }
   plan->command = std::move(command);
   plan->reference = std::move(reference);
+  plan->force = std::move(force);
   return Status::Ok;
 }
 
@@ -187,8 +207,9 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
   Vector6d motor = model.length_home() + gain.cwiseProduct(drives.angle);
   FkResult fk;
   NutGap nuts;
-  if (const Status s = plant_fk(model, plant_lengths(model, motor, options.twist_in_plant), kind,
-                                placement_from_pose(trajectory.poses[0]), nuts, fk);
+  if (const Status s =
+          plant_fk(model, plant_lengths(model, motor, options.twist_in_plant), kind,
+                   placement_from_pose(trajectory.poses[0]), nuts, plan.force.empty() ? nullptr : &plan.force[0], fk);
       s != Status::Ok)
     return detail::fail_at(issue, s, 0, trajectory);
   // The mechanism's load on the motors (docs/theory.md §9, §14), at the start and then once per
@@ -243,7 +264,8 @@ Status simulate(const Rig& rig, const Trajectory& trajectory, const SimulationOp
     motor_acceleration = (drives.speed - speed_before) / rig.control_period();
     motor = model.length_home() + gain.cwiseProduct(drives.angle);
     const Placement previous = fk.placement;  // warm start from the last tick
-    if (const Status s = plant_fk(model, plant_lengths(model, motor, options.twist_in_plant), kind, previous, nuts, fk);
+    if (const Status s = plant_fk(model, plant_lengths(model, motor, options.twist_in_plant), kind, previous, nuts,
+                                  plan.force.empty() ? nullptr : &plan.force[k + 1], fk);
         s != Status::Ok)
       return detail::fail_at(issue, s, k + 1, trajectory);
   }

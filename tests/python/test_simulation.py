@@ -139,7 +139,7 @@ def test_the_leg_effects_costs_are_the_clis_and_their_compensation_removes_them(
     assert [e.effect for e in py.leg_effects] == ["load", "play", "heat", "all"]
     for c, p in zip(cli, py.leg_effects):
         assert c["effect"] == p.effect
-        for column in ("conventional", "twist_compensated", "compensated"):
+        for column in ("conventional", "twist_compensated", "compensated", "static_load_compensated"):
             assert c[column]["max"] == p[column].max and c[column]["rms"] == p[column].rms, (p.effect, column)
         assert p.twist_compensated.max > 0.5e-6 and p.compensated.max < 2e-11, p
     with pytest.raises(hexatwist.InputError, match="temperature_rise"):

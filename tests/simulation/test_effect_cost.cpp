@@ -5,6 +5,7 @@
 // lengths (an independent route), the warm-up's history, and the refusals.
 #include "support.hpp"
 
+#include "hexatwist/dynamics/leg_forces.hpp"
 #include "hexatwist/simulation/effect_cost.hpp"
 
 namespace hexatwist::test {
@@ -39,15 +40,15 @@ TEST(EffectCost, TheWarmUpRisesFromZeroToOneAlongItsExponential) {
 TEST(EffectCost, RigidLegsHaveNoRowAndABadRiseIsRefused) {
   std::vector<EffectCost> rows{EffectCost{}};
   SimulationIssue issue;
-  ASSERT_EQ(effect_costs(seed_model(), test_at_100hz("Rz"), Vector6d::Zero(), rows, issue), Status::Ok);
+  ASSERT_EQ(effect_costs(seed_rig(), test_at_100hz("Rz"), Vector6d::Zero(), rows, issue), Status::Ok);
   EXPECT_TRUE(rows.empty()) << "rigid legs: nothing to cost";
-  EXPECT_EQ(effect_costs(seed_model(), test_at_100hz("Rz"), Vector6d::Constant(2.0), rows, issue),
+  EXPECT_EQ(effect_costs(seed_rig(), test_at_100hz("Rz"), Vector6d::Constant(2.0), rows, issue),
             Status::InvalidArgument)
       << "a warm-up of legs that do not expand";
   EXPECT_NE(check_temperature_rise(seed_model(), Vector6d::Constant(2.0)).find("do not expand"), std::string::npos);
   const Config config = seed_with_effects(kEffects);
   for (const double bad : {kMaxTemperatureRise * 1.01, -kMaxTemperatureRise * 1.01, std::nan("")}) {
-    EXPECT_EQ(effect_costs(config.rig.model(), test_at_100hz("Rz"), Vector6d::Constant(bad), rows, issue),
+    EXPECT_EQ(effect_costs(config.rig, test_at_100hz("Rz"), Vector6d::Constant(bad), rows, issue),
               Status::InvalidArgument)
         << bad;
     EXPECT_TRUE(rows.empty());
@@ -56,13 +57,12 @@ TEST(EffectCost, RigidLegsHaveNoRowAndABadRiseIsRefused) {
 
 TEST(EffectCost, EachEffectCostsMicrometresAndItsCompensationRemovesIt) {
   const Config config = seed_with_effects(kEffects);
-  const Model& model = config.rig.model();
   std::vector<EffectCost> rows;
   SimulationIssue issue;
   for (const char* name : {"Lz", "Lx", "Rz", "Ry"}) {
     SCOPED_TRACE(name);
     const Trajectory trajectory = test_at_100hz(name);
-    ASSERT_EQ(effect_costs(model, trajectory, Vector6d::Constant(2.0), rows, issue), Status::Ok)
+    ASSERT_EQ(effect_costs(config.rig, trajectory, Vector6d::Constant(2.0), rows, issue), Status::Ok)
         << to_string(issue.status) << " at t = " << issue.time;
     ASSERT_EQ(rows.size(), 4u);
     const char* order[] = {"load", "play", "heat", "all"};
@@ -88,37 +88,50 @@ TEST(EffectCost, TheLoadsCostIsTheGeometricPoseOfTheDeflectedLengths) {
   // Independent route: a rigid-leg command sent to legs deflected by (F - F_home) / k puts the
   // platform where geometric forward kinematics of the rigid IK lengths plus that deflection says
   // (the twist compensated at the commanded pose; the twist's change over the um of the
-  // deflection, 1e-5 rad x 1.6 mm/rad, is the residual).
+  // deflection, 1e-5 rad x 1.6 mm/rad, is the residual). F: the static force at the pose plus the
+  // motion's share, from the inverse dynamics at the trajectory's differences. The commands that
+  // know only the static load leave that share's deflection: the geometric route gives it too.
   const Config config = seed_with_effects("  stiffness: 2.0e8\n");
   const Model& model = config.rig.model();
   const Trajectory trajectory = test_at_100hz("Lx");
   std::vector<EffectCost> rows;
   SimulationIssue issue;
-  ASSERT_EQ(effect_costs(model, trajectory, Vector6d::Zero(), rows, issue), Status::Ok);
+  ASSERT_EQ(effect_costs(config.rig, trajectory, Vector6d::Zero(), rows, issue), Status::Ok);
   ASSERT_EQ(rows.size(), 1u);
   LegState home;
   ASSERT_EQ(inverse_kinematics(model, Placement{}, home), Status::Ok);
   Vector6d f_home;
   ASSERT_EQ(static_leg_forces(model, model.spec().static_load, home, f_home), Status::Ok);
   const Vector3d& a = model.spec().observation_P;
-  std::vector<double> error;
+  std::vector<double> error, inertial_error;
   FkResult fk;
   for (std::size_t k = 0; k < trajectory.poses.size(); ++k) {
     const Placement x = placement_from_pose(trajectory.poses[k]);
     LegState legs;
     ASSERT_EQ(inverse_kinematics(model, x, legs), Status::Ok);
-    Vector6d f;
+    Vector6d f, inertial;
     ASSERT_EQ(static_leg_forces(model, model.spec().static_load, legs, f), Status::Ok);
-    const Vector6d deflected = legs.length + (f - f_home) / 2.0e8;
-    ASSERT_EQ(forward_kinematics(model, deflected, LengthKind::Geometric, x, fk), Status::Ok);
+    ASSERT_EQ(inertial_leg_forces(config.rig, trajectory_motion(trajectory, k), inertial), Status::Ok);
+    ASSERT_EQ(forward_kinematics(model, Vector6d(legs.length + (f + inertial - f_home) / 2.0e8), LengthKind::Geometric,
+                                 x, fk),
+              Status::Ok);
     error.push_back((platform_point_B(model, fk.placement, a) - platform_point_B(model, x, a)).norm());
+    ASSERT_EQ(forward_kinematics(model, Vector6d(legs.length + inertial / 2.0e8), LengthKind::Geometric, x, fk),
+              Status::Ok);
+    inertial_error.push_back((platform_point_B(model, fk.placement, a) - platform_point_B(model, x, a)).norm());
   }
-  const ErrorStats independent = error_stats(error);
+  const ErrorStats independent = error_stats(error), inertial = error_stats(inertial_error);
   report("load's cost, max [m]", rows[0].twist_compensated.max);
   report("against geometric FK [m]", std::abs(rows[0].twist_compensated.max - independent.max));
+  report("the static load's commands, max [m]", rows[0].static_load_compensated.max);
+  report("against geometric FK [m]", std::abs(rows[0].static_load_compensated.max - inertial.max));
   EXPECT_GT(independent.max, 2e-6);
   EXPECT_NEAR(rows[0].twist_compensated.max, independent.max, 1e-8);
   EXPECT_NEAR(rows[0].twist_compensated.rms, independent.rms, 1e-8);
+  EXPECT_GT(inertial.max, 2e-7) << "the sweep's accelerations deflect the legs";
+  EXPECT_NEAR(rows[0].static_load_compensated.max, inertial.max, 1e-8);
+  EXPECT_NEAR(rows[0].static_load_compensated.rms, inertial.rms, 1e-8);
+  EXPECT_LT(rows[0].compensated.max, 2e-11) << "the commands that know the forces leave the FK's tolerance";
 }
 
 TEST(EffectCost, HeatGrowsLinearlyWithTheRiseAndNeedsOne) {
@@ -126,8 +139,8 @@ TEST(EffectCost, HeatGrowsLinearlyWithTheRiseAndNeedsOne) {
   const Trajectory trajectory = test_at_100hz("Rz");
   std::vector<EffectCost> one, two;
   SimulationIssue issue;
-  ASSERT_EQ(effect_costs(config.rig.model(), trajectory, Vector6d::Constant(1.0), one, issue), Status::Ok);
-  ASSERT_EQ(effect_costs(config.rig.model(), trajectory, Vector6d::Constant(2.0), two, issue), Status::Ok);
+  ASSERT_EQ(effect_costs(config.rig, trajectory, Vector6d::Constant(1.0), one, issue), Status::Ok);
+  ASSERT_EQ(effect_costs(config.rig, trajectory, Vector6d::Constant(2.0), two, issue), Status::Ok);
   ASSERT_EQ(one.size(), 1u);
   ASSERT_EQ(two.size(), 1u);
   EXPECT_EQ(two[0].effect, "heat");
@@ -135,7 +148,7 @@ TEST(EffectCost, HeatGrowsLinearlyWithTheRiseAndNeedsOne) {
   EXPECT_NEAR(two[0].twist_compensated.max / one[0].twist_compensated.max, 2.0, 1e-3);
   EXPECT_GT(two[0].twist_compensated.max, 30e-6) << "2 K on 1.9 m of steel: 44 um of growth per leg";
   std::vector<EffectCost> none;
-  ASSERT_EQ(effect_costs(config.rig.model(), trajectory, Vector6d::Zero(), none, issue), Status::Ok);
+  ASSERT_EQ(effect_costs(config.rig, trajectory, Vector6d::Zero(), none, issue), Status::Ok);
   EXPECT_TRUE(none.empty()) << "legs that expand but do not warm cost nothing";
 }
 

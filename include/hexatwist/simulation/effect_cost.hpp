@@ -23,7 +23,12 @@ struct EffectCost {
   std::string effect;            ///< "load", "play", "heat" (each alone on otherwise rigid legs) or "all"
   ErrorStats conventional;       ///< commands that ignore the twist and the legs' effects
   ErrorStats twist_compensated;  ///< Eq. (12): the twist compensated, the effect not (a rigid-leg model's commands)
-  ErrorStats compensated;        ///< the twist and the effect compensated (compensation.hpp)
+  ErrorStats compensated;        ///< the twist and the effect compensated (compensation.hpp), the legs' forces
+                                 ///< known along the run (the trajectory's accelerations included)
+  /// The twist and the effect compensated with the static load alone: the commands of ik, stream,
+  /// the C API and LinuxCNC, which know the pose but not the trajectory's accelerations. The same
+  /// as compensated without a stiffness.
+  ErrorStats static_load_compensated;
 };
 
 /// The share of a warm-up reached at `time` of a run of `duration` [s]:
@@ -38,15 +43,14 @@ struct EffectCost {
 [[nodiscard]] std::string_view check_temperature_rise(const Model& model, const Vector6d& temperature_rise) noexcept;
 
 /// One row per effect the model's legs have: "load" (a finite stiffness, under the configuration's
-/// static load), "play", "heat" (an expansion and a `temperature_rise` [K] per leg other than zero,
-/// reached at the trajectory's end along warm_up_share from the reference temperature), then
-/// "all" (the model's legs) when there are two or more; none for rigid legs. The compensated
-/// commands know the legs' temperatures (sensors on the legs) and follow each leg's direction from
-/// home; the plant's nuts follow the motors through their play's dead band (NutGap).
-/// Returns InvalidArgument for a temperature_rise check_temperature_rise refuses, else the first
-/// failure's status with `issue` saying where (a limit of the
-/// commands, the plant's forward kinematics); `out` is complete only on Ok.
-[[nodiscard]] Status effect_costs(const Model& model, const Trajectory& trajectory, const Vector6d& temperature_rise,
+/// static load and the trajectory's accelerations: dynamics/leg_forces.hpp), "play", "heat" (an expansion and a
+/// `temperature_rise` [K] per leg other than zero, reached at the trajectory's end along warm_up_share from the
+/// reference temperature), then "all" (the model's legs) when there are two or more; none for rigid legs. The
+/// compensated commands know the legs' temperatures (sensors on the legs) and follow each leg's direction from home;
+/// the plant's nuts follow the motors through their play's dead band (NutGap). Returns InvalidArgument for a
+/// temperature_rise check_temperature_rise refuses, else the first failure's status with `issue` saying where (a limit
+/// of the commands, the plant's forward kinematics); `out` is complete only on Ok.
+[[nodiscard]] Status effect_costs(const Rig& rig, const Trajectory& trajectory, const Vector6d& temperature_rise,
                                   std::vector<EffectCost>& out, SimulationIssue& issue);
 
 }  // namespace hexatwist
