@@ -6,7 +6,8 @@ errors:
     python3 scripts/docs_site.py SITE_DIR      # then open SITE_DIR/index.html
 
 The site holds the front page (README.md), the user guide (docs/guide/, its reference pages
-generated from the code by scripts/reference_pages.py), the theory (docs/theory.md, docs/theory/),
+generated from the code by scripts/reference_pages.py), the C++ reference (Doxygen, from the public
+headers' comments, warnings as errors), the theory (docs/theory.md, docs/theory/),
 the JSON schemas' page and every file those pages link to (the CHANGELOG, the LinuxCNC module's
 README, configurations, examples, headers), found by following the links from the front page and the
 guide. A link to a file that does not exist, or a page MkDocs cannot build, fails the build (exit 1),
@@ -57,6 +58,31 @@ def collect(start: list[Path]) -> tuple[list[Path], list[str]]:
     return sorted(seen), outside
 
 
+def doxygen(stage: Path) -> str | None:
+    """The C++ reference from the public headers' comments (Doxygen, warnings as errors) into
+    stage/docs/cpp-reference/; its messages when it fails, else None."""
+    exe = shutil.which("doxygen")
+    if exe is None:
+        return "doxygen not found (apt-get install doxygen; scripts/setup.sh installs it)"
+    out = stage / "docs" / "cpp-reference"
+    config = stage.parent / "Doxyfile"
+    config.write_text(
+        "PROJECT_NAME = hexatwist\n"
+        "PROJECT_BRIEF = \"The C++ library: include/hexatwist/, one header per concept\"\n"
+        f"INPUT = {ROOT / 'include' / 'hexatwist'}\n"
+        "RECURSIVE = YES\nFILE_PATTERNS = *.hpp *.h\n"
+        f"STRIP_FROM_PATH = {ROOT / 'include'}\nSTRIP_FROM_INC_PATH = {ROOT / 'include'}\nFULL_PATH_NAMES = YES\n"
+        f"OUTPUT_DIRECTORY = {out.parent}\nHTML_OUTPUT = {out.name}\nGENERATE_HTML = YES\nGENERATE_LATEX = NO\n"
+        "EXTRACT_ALL = YES\nJAVADOC_AUTOBRIEF = YES\nMARKDOWN_SUPPORT = YES\nHAVE_DOT = NO\nSEARCHENGINE = NO\n"
+        "QUIET = YES\nWARN_IF_UNDOCUMENTED = NO\nWARN_IF_DOC_ERROR = YES\nWARN_AS_ERROR = FAIL_ON_WARNINGS\n",
+        encoding="utf-8")
+    result = subprocess.run([exe, str(config)], capture_output=True, text=True, timeout=600)
+    messages = (result.stdout + result.stderr).strip()
+    if result.returncode != 0 or "warning" in messages or not (out / "index.html").is_file():
+        return messages or f"doxygen failed (exit {result.returncode})"
+    return None
+
+
 def nav_of(files: list[Path]) -> str:
     """The site's menu: the front page, the guide in its index's reading order, the theory, the rest."""
     rel = [f.relative_to(ROOT).as_posix() for f in files if f.suffix == ".md" and f.is_file()]
@@ -75,7 +101,7 @@ def nav_of(files: list[Path]) -> str:
         return "".join(f"      - '{p}'\n" for p in paths)
 
     return ("nav:\n  - Home: 'README.md'\n  - Guide:\n" + entries(guide) + "  - Theory:\n" + entries(theory) +
-            "  - More:\n" + entries(rest))
+            "  - More:\n" + entries(rest) + "  - C++ reference: 'docs/cpp-reference/index.html'\n")
 
 
 def main() -> int:
@@ -113,6 +139,11 @@ def main() -> int:
                 shutil.copytree(f, dest, dirs_exist_ok=True)
             else:
                 shutil.copy2(f, dest)
+        problem = doxygen(stage)
+        if problem is not None:
+            print(problem.replace(str(ROOT) + "/", ""), file=sys.stderr)
+            print("docs_site: the C++ reference (Doxygen) failed: the site was not built", file=sys.stderr)
+            return 1
         config = Path(tmp) / "mkdocs.yml"
         config.write_text(
             "site_name: hexatwist\n"

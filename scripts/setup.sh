@@ -17,7 +17,7 @@ packages=(
   linuxcnc-uspace linuxcnc-uspace-dev               # the LinuxCNC kinematics module and its tests (LinuxCNC 2.9)
   python3-pytest                                    # the tests that drive LinuxCNC and the Python package (Debian's python3)
   python3-jsonschema                                # the JSON outputs validated against docs/schemas/ (tests)
-  mkdocs                                            # the documentation as an HTML site (scripts/docs_site.py, tests)
+  mkdocs doxygen                                    # the documentation as an HTML site (scripts/docs_site.py, tests)
   python3-pip python3-setuptools python3-wheel python3-venv  # pip install . without downloads (pyproject.toml, tests)
   pybind11-dev python3-pybind11 python3-dev python3-numpy  # the Python package (bindings/python)
   python3-matplotlib python3-dask python3-distributed     # its examples and the Dask helper

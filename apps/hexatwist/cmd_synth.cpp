@@ -378,12 +378,15 @@ Command make_synth_command(CLI::App& root) {
                   "(default: as configured)");
   app->add_option("--play-um", o->play_um,
                   "The real legs' play (lost motion of nut and joints) [um], one or six (default: as configured)");
-  app->add_option("--temperature-rise-k", o->temperature_rise_k,
-                  "The legs warm by this over the run [K], one or six, along 1 - exp(-t/T) (default: no warming)");
+  auto* rise =
+      app->add_option("--temperature-rise-k", o->temperature_rise_k,
+                      "The legs warm by this over the run [K], one or six, along 1 - exp(-t/T) (default: no warming)");
+  // Without a warming the expansion changes nothing: given alone it is refused, not ignored.
   app->add_option("--expansion-ppm-per-k", o->expansion_ppm_per_k,
                   "With --temperature-rise-k: the real legs' expansion of the length between the joints and of the "
                   "screw's lead [ppm/K] (steel: 11.5)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(rise);
   app->add_flag("--temperature-column", o->temperature_column,
                 "The log gets the machine's temperature at each point, the legs' mean [degC], as a temperature_c "
                 "column: identify then fits the legs' expansion per kelvin from it");

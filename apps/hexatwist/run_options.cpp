@@ -73,8 +73,10 @@ void add_run_options(CLI::App& app, RunOptions& o) {
       "--stations", o.stations,
       "Or a calibration run for identify: home, N random stations (+-0.25 m, +-15 deg in every coordinate at once, "
       "each reachable inside the limits), home; 1 s at each, straight jerk-limited moves");
-  app.add_option("--station-seed", o.station_seed, "Seed of the stations (the same seed gives the same run)")
-      ->capture_default_str();
+  app.add_option("--station-seed", o.station_seed,
+                 "With --stations: the seed of the stations (the same seed gives the same run)")
+      ->capture_default_str()
+      ->needs(stations);
   auto* both = app.add_option("--both-sides-mm", o.both_sides_mm,
                               "With --stations: each station approached from both sides, from this far above it along "
                               "z (every leg shortening) and then below (lengthening), for identify's play [mm], "

@@ -19,13 +19,14 @@ namespace hexatwist::cli_test {
 
 namespace fs = std::filesystem;
 
-// A run of the tool in `dir` with standard input empty.
-inline Outcome run_in(const fs::path& dir, const std::vector<std::string>& args) {
+// A run of the tool in `dir` with standard input from `input` (empty by default).
+inline Outcome run_in(const fs::path& dir, const std::vector<std::string>& args, const fs::path& input = "/dev/null") {
   Outcome r;
   const fs::path err_path = dir / "stderr.txt";
   r.command = "cd " + shell_quote(dir.string()) + " && " + shell_quote(HEXATWIST_CLI);
   for (const std::string& a : args) (r.command += ' ') += shell_quote(a);
-  FILE* pipe = popen((r.command + " </dev/null 2>" + shell_quote(err_path.string())).c_str(), "r");
+  FILE* pipe =
+      popen((r.command + " <" + shell_quote(input.string()) + " 2>" + shell_quote(err_path.string())).c_str(), "r");
   if (pipe == nullptr) return r;
   std::array<char, 4096> buf;
   for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0;) r.out.append(buf.data(), n);

@@ -120,9 +120,9 @@ class ParameterSet {
   int rotation_index() const noexcept { return rotation_; }
   int translation_index() const noexcept { return rotation_ + 3; }
 
-  /// The parameter's name for reports: "lead" or "lead 1".., "offset 1".., "base joints g1"..
-  /// (gauge coordinates), "platform joints g1".., "base axis 2 e1", "A x" (target 0) or "target
-  /// 2 x", "rotation x", "translation x"; "?" outside.
+  /// The parameter's name for reports: "lead" or "lead 1" (and so on), "offset 1", "base joints g1"
+  /// (gauge coordinates), "platform joints g1", "base axis 2 e1", "A x" (target 0) or "target 2 x",
+  /// "rotation x", "translation x"; "?" outside.
   std::string name(int i) const;
   /// The parameter group a name belongs to ("lead", "offsets", "base joints", ...).
   std::string group(int i) const;

@@ -57,7 +57,7 @@ struct LineParse {
 inline constexpr std::size_t kMaxLineLength = 1024;
 
 /// Reads "x,y,z,roll,pitch,yaw": six comma-separated numbers, blanks around fields allowed, a
-/// trailing '\r' and/or '\n' ignored, a leading '+' accepted. "nan" and "inf" are read as numbers:
+/// trailing carriage return and/or line feed ignored, a leading '+' accepted. "nan" and "inf" are read as numbers:
 /// the command check rejects them (Status::NonFiniteInput), so that the status says what is wrong.
 /// Returns false and fills `where` on a malformed line; `pose` is written only on success.
 [[nodiscard]] bool parse_pose_line(std::string_view line, AngleUnit unit, Pose& pose, LineParse& where) noexcept;
