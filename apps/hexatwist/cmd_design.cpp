@@ -184,10 +184,6 @@ int run_design(const DesignCommandOptions& o) {
   files.input("--config", o.model.config);
   for (const std::string& t : o.required.trajectories) files.input("--trajectory", t);
   files.output("--out", o.out);
-  check_option(o.max_volume_loss_pct >= 0.0 && o.max_volume_loss_pct <= 100.0, "--max-volume-loss",
-               o.max_volume_loss_pct, "a percentage from 0 to 100");
-  check_option(o.clearance_deg >= 0.0 && o.clearance_deg < 80.0, "--clearance", o.clearance_deg,
-               "an angle from 0 to 80 deg");
   const std::vector<double> vo = parse_numbers(o.volume_orientation, 3, "--volume-orientation", "roll,pitch,yaw [deg]");
   check_cell_option(o.cell);
   const RequiredPoses req = required_poses(config, o.required);

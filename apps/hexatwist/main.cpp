@@ -33,6 +33,7 @@ void print_error(std::string_view prefix, std::string_view message) {
 std::string option_for(const std::vector<hexatwist::cli::Command>& commands, std::string name) {
   if (name == "translation" || name == "rotation") name = "range";
   if (name == "approach") name = "both_sides";
+  if (name == "volume_rpy") name = "volume_orientation";
   std::replace(name.begin(), name.end(), '_', '-');
   const std::string flag = "--" + name;
   for (const hexatwist::cli::Command& c : commands) {

@@ -126,16 +126,13 @@ py::dict design_py(const py::object& config, const py::object& poses_in, const p
   o.volume_samples = volume_samples;
   o.seed = seed;
   o.threads = threads;
+  check_design_options(o);  // the library's check, before the GIL is released
   AxisDesign d;
   Status s;
   {
     py::gil_scoped_release release;
     s = design_axes(*p.model, poses, o, d);
   }
-  if (s == Status::NonFiniteInput)
-    raise_input(
-        "design_axes: 0 < grid_step <= pi/2, fine_step > 0, clearance >= 0, 0 <= max_volume_loss <= 1, "
-        "0 <= max_tilt < pi/2, volume_samples >= 0");
   if (s != Status::Ok) raise_status(s, "design_axes");
   py::dict r;
   r["turn_base"] = per_leg(d.turns.base);

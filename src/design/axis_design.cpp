@@ -7,6 +7,8 @@
 #include <memory>
 #include <optional>
 
+#include <fmt/format.h>
+
 #include "design/parallel.hpp"
 #include "design/sampling.hpp"
 #include "hexatwist/error.hpp"
@@ -497,16 +499,31 @@ double objective_of(const DesignEvaluation& e, DesignObjective o) {
   return e.max_twist;
 }
 
-bool options_valid(const DesignOptions& o) {
-  return o.grid_step > 0.0 && o.grid_step <= kPi / 2 && o.fine_step > 0.0 && std::isfinite(o.fine_step) &&
-         o.clearance >= 0.0 && std::isfinite(o.clearance) && o.max_volume_loss >= 0.0 && o.max_volume_loss <= 1.0 &&
-         o.max_tilt >= 0.0 && o.max_tilt < kPi / 2 && o.volume_samples >= 0 && o.volume_rpy.allFinite();
-}
-
 }  // namespace
+
+void check_design_options(const DesignOptions& o) {
+  const auto refuse = [](const char* field, const std::string& expected, double got) {
+    throw ParameterError(fmt::format("design: {}: expected {}, got {:g}", field, expected, got), field);
+  };
+  if (!(o.grid_step > 0.0 && o.grid_step <= kPi / 2)) refuse("grid_step", "0 < grid_step <= pi/2 rad", o.grid_step);
+  if (!(o.fine_step > 0.0 && o.fine_step <= o.grid_step))
+    refuse("fine_step", "0 < fine_step <= grid_step [rad]", o.fine_step);
+  if (!(o.max_tilt >= 0.0 && o.max_tilt < kPi / 2)) refuse("max_tilt", "0 <= max_tilt < pi/2 rad", o.max_tilt);
+  if (!(o.clearance >= 0.0 && o.clearance < kMaxClearance))
+    refuse("clearance", fmt::format("0 <= clearance < {:g} rad (80 deg)", kMaxClearance), o.clearance);
+  if (!(o.max_volume_loss >= 0.0 && o.max_volume_loss <= 1.0))
+    refuse("max_volume_loss", "a fraction from 0 to 1", o.max_volume_loss);
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(o.volume_rpy[a])) refuse("volume_rpy", "finite roll, pitch, yaw [rad]", o.volume_rpy[a]);
+  if (!(o.volume.cell >= 0.0 && o.volume.cell <= 1.0)) refuse("cell", "0 (automatic) to 1 m", o.volume.cell);
+  if (!(o.volume_samples >= 0 && o.volume_samples <= kMaxVolumeSamples))
+    refuse("volume_samples", fmt::format("0 to {}", kMaxVolumeSamples), o.volume_samples);
+  if (o.threads < 0) refuse("threads", "0 (every core) or more", o.threads);
+}
 
 Status evaluate_design(const Model& model, const std::vector<Pose>& poses, const DesignOptions& options, bool volume,
                        DesignEvaluation& out) {
+  check_design_options(options);
   out = DesignEvaluation{};
   out.poses = poses.size();
   out.first_refused = poses.size();
@@ -568,7 +585,7 @@ Status evaluate_design(const Model& model, const std::vector<Pose>& poses, const
 Status design_axes(const Model& model, const std::vector<Pose>& required_in, const DesignOptions& o, AxisDesign& out) {
   out = AxisDesign{};
   out.designed = model.spec();
-  if (!options_valid(o)) return Status::NonFiniteInput;
+  check_design_options(o);
   // The required poses the model reaches, and home (the Model checks it).
   std::vector<Pose> required{Pose{}};
   Vector6d command;

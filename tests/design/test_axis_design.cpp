@@ -189,14 +189,48 @@ TEST(AxisDesign, TurnedAxesKeepTheirLengthTurnInThePlaneAndTiltUp) {
   EXPECT_EQ(turned_axis(Vector3d::UnitZ(), 0.0, 0.3), Vector3d::UnitZ());  // a vertical axis has no tilt
 }
 
-TEST(AxisDesign, RefusesBadOptions) {
+TEST(AxisDesign, RefusesBadOptionsNamingTheField) {
+  // Each field at each end of its range: inside is accepted by the check, beyond is a
+  // ParameterError naming the field; design_axes and evaluate_design run the check.
+  struct Case {
+    const char* field;
+    void (*set)(DesignOptions&, double);
+    double ok, bad;
+  };
+  const Case cases[] = {
+      {"grid_step", [](DesignOptions& o, double v) { o.grid_step = v; }, kPi / 2, kPi / 2 * 1.001},
+      {"grid_step", [](DesignOptions& o, double v) { o.grid_step = v; }, 1e-3, 0.0},
+      {"fine_step", [](DesignOptions& o, double v) { o.fine_step = v; }, deg2rad(5.0), deg2rad(5.01)},
+      {"max_tilt", [](DesignOptions& o, double v) { o.max_tilt = v; }, 0.0, kPi / 2},
+      {"clearance", [](DesignOptions& o, double v) { o.clearance = v; }, kMaxClearance * 0.999, kMaxClearance},
+      {"clearance", [](DesignOptions& o, double v) { o.clearance = v; }, 0.0, -1e-9},
+      {"max_volume_loss", [](DesignOptions& o, double v) { o.max_volume_loss = v; }, 1.0, 1.0 + 1e-9},
+      {"max_volume_loss", [](DesignOptions& o, double v) { o.max_volume_loss = v; }, 0.0, std::nan("")},
+      {"volume_rpy", [](DesignOptions& o, double v) { o.volume_rpy.y() = v; }, 1.0, INFINITY},
+      {"cell", [](DesignOptions& o, double v) { o.volume.cell = v; }, 1.0, 1.001},
+      {"volume_samples", [](DesignOptions& o, double v) { o.volume_samples = static_cast<int>(v); }, kMaxVolumeSamples,
+       kMaxVolumeSamples + 1.0},
+      {"threads", [](DesignOptions& o, double v) { o.threads = static_cast<int>(v); }, 0.0, -1.0},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.field);
+    DesignOptions o;
+    c.set(o, c.ok);
+    EXPECT_NO_THROW(check_design_options(o));
+    c.set(o, c.bad);
+    try {
+      check_design_options(o);
+      ADD_FAILURE() << "accepted";
+    } catch (const ParameterError& e) {
+      EXPECT_EQ(e.parameter(), c.field) << e.what();
+    }
+  }
   DesignOptions o;
   o.max_volume_loss = 1.5;
   AxisDesign d;
-  EXPECT_EQ(design_axes(test::seed_model(), seed_workspace().poses, o, d), Status::NonFiniteInput);
-  o = DesignOptions{};
-  o.grid_step = 0.0;
-  EXPECT_EQ(design_axes(test::seed_model(), seed_workspace().poses, o, d), Status::NonFiniteInput);
+  DesignEvaluation evaluation;
+  EXPECT_THROW((void)design_axes(test::seed_model(), seed_workspace().poses, o, d), ParameterError);
+  EXPECT_THROW((void)evaluate_design(test::seed_model(), seed_workspace().poses, o, false, evaluation), ParameterError);
 }
 
 }  // namespace

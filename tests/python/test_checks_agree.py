@@ -167,3 +167,20 @@ def test_the_packages_workspace_defaults_are_the_librarys():
     signature = inspect.signature(hexatwist.required_workspace).parameters
     for key, value in library.items():
         assert signature[key].default == value, key
+
+
+DESIGN_CASES = [("--clearance", c, "clearance", math.radians(c)) for c in (0.0, 79.9, 80.0, -1.0)] + [
+    ("--max-volume-loss", p, "max_volume_loss", p / 100.0) for p in (0.0, 100.0, 100.1, -0.1)
+]
+
+
+@pytest.mark.parametrize("option,typed,keyword,value", DESIGN_CASES)
+def test_design_options(option, typed, keyword, value, tmp_path):
+    # A small required workspace (five random poses, a coarse volume) keeps an accepted design quick.
+    cli = cli_refuses(["design", "--out", "d.yaml", "--workspace", "tests=off,random=5", "--cell", "0.1", option,
+                       f"{typed:g}"], option, tmp_path)
+    py = python_refuses(lambda: hexatwist.design_axes(None, tests=False, random=5, cell=0.1, **{keyword: value}),
+                        keyword)
+    assert cli == py, (option, typed, cli, py)
+    low, high = (0.0, math.radians(80.0)) if keyword == "clearance" else (0.0, 1.0)
+    assert py == (not (low <= value < high if keyword == "clearance" else low <= value <= high)), (option, typed, py)

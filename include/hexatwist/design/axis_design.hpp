@@ -94,6 +94,18 @@ struct DesignOptions {
   int threads = 1;                         ///< 0 = every core; the result does not depend on it
 };
 
+/// The most volume_samples a design takes (each is a position tried at every candidate).
+inline constexpr int kMaxVolumeSamples = 1000000;
+/// The largest clearance a design can be asked for beyond the singularity margin [rad] (80 deg).
+inline constexpr double kMaxClearance = 80.0 * kPi / 180.0;
+
+/// Throws ParameterError naming the field for options no design can use: grid_step not in
+/// (0, pi/2], fine_step not in (0, grid_step], max_tilt not in [0, pi/2), clearance not in
+/// [0, kMaxClearance), max_volume_loss not in [0, 1], volume_rpy not finite, volume.cell not in
+/// [0, 1] m ("cell"), volume_samples not in [0, kMaxVolumeSamples], threads < 0. The CLI and
+/// Python convert their units and call it; design_axes and evaluate_design run it.
+void check_design_options(const DesignOptions& options);
+
 /// The margins, twist, length error and lead sensitivity of `model` over `poses`, and (when
 /// `volume` is true) the workspace volume at options.volume_rpy with options.volume.
 [[nodiscard]] Status evaluate_design(const Model& model, const std::vector<Pose>& poses, const DesignOptions& options,
@@ -116,8 +128,9 @@ struct AxisDesign {
 /// a global grid of in-plane turns per group of legs, then a local search (with tilts if asked),
 /// each candidate checked on the required poses and steered by positions of the workspace;
 /// the best verified with the library's own functions. The model's own axes are the fallback, so
-/// the design never does worse. Returns NonFiniteInput for bad options, the volume's status when
-/// it cannot be computed, or a limit status when the model itself reaches none of `required`.
+/// the design never does worse. Throws ParameterError for options check_design_options refuses;
+/// returns the volume's status when it cannot be computed, or a limit status when the model itself
+/// reaches none of `required`.
 [[nodiscard]] Status design_axes(const Model& model, const std::vector<Pose>& required, const DesignOptions& options,
                                  AxisDesign& out);
 
