@@ -381,9 +381,10 @@ Figure accuracy_figure(const Identification& id, const std::string& stem) {
   fig.stem = stem;
   const AccuracyPrediction& acc = id.accuracy;
   fig.title = "predicted error of point A after calibration, no rotation (blank: outside a limit)";
-  // What the frames mean, and the figures after re-alignment, in the panels' titles (one line each).
+  // What the frames mean, and the figures after re-alignment, in the panels' titles (one line each,
+  // at most about 125 characters: the figure's width).
   const std::array<std::string, 2> notes{
-      "measured from frames fitted to the six joints: a rigid shift of the whole machine is not counted",
+      "in frames fitted to the six joints: a rigid shift of the machine not counted",
       fmt::format("after a rigid re-alignment to the tracker: median {:.1f} um, largest {:.1f} um",
                   1e6 * acc.aligned_median, 1e6 * acc.aligned_max)};
   const Eigen::MatrixXd C = id.covariance.topLeftCorner(id.parameters.platform_size(), id.parameters.platform_size());
