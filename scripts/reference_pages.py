@@ -131,6 +131,14 @@ def main() -> int:
     parser.add_argument("--check", action="store_true", help="compare instead of writing; exit 1 if a page differs")
     args = parser.parse_args()
     cli = args.cli.resolve()
+    if not (cli.is_file() and os.access(cli, os.X_OK)):
+        print(f"reference_pages: {args.cli}: not the built hexatwist program (build it: bash scripts/build.sh)",
+              file=sys.stderr)
+        return 2
+    if not (cli.parent / "python" / "hexatwist").is_dir():
+        print(f"reference_pages: {cli.parent / 'python' / 'hexatwist'}: no Python package beside the program "
+              f"(a build with the Python module, HEXATWIST_PYTHON)", file=sys.stderr)
+        return 2
     pages = {GUIDE / "cli-reference.md": cli_page(cli), GUIDE / "python-reference.md": python_page(cli.parent)}
     stale = []
     for path, text in pages.items():
