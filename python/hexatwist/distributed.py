@@ -140,11 +140,13 @@ def map_batch(function: str, model: Model, array: ArrayLike, client: Any = None,
     block = hexatwist.BLOCK
     chunk = 64 * block if chunk is None else max(1, -(-int(chunk) // block)) * block
     starts = list(range(0, len(rows), chunk)) or [0]
-    model_future = client.scatter(model, broadcast=True)
+    # Random keys (hash=False): a content key would be the one an earlier call's data had, which
+    # the scheduler may still be releasing when the same rows come again (its task then cancelled).
+    model_future = client.scatter(model, broadcast=True, hash=False)
     futures = []
     for i in starts:
-        piece = client.scatter(np.ascontiguousarray(rows[i:i + chunk]))
-        row_kwargs = {k: client.scatter(np.ascontiguousarray(v[i:i + chunk])) for k, v in per_row.items()}
+        piece = client.scatter(np.ascontiguousarray(rows[i:i + chunk]), hash=False)
+        row_kwargs = {k: client.scatter(np.ascontiguousarray(v[i:i + chunk]), hash=False) for k, v in per_row.items()}
         futures.append(client.submit(_run_chunk, function, model_future, piece, common, row_kwargs, pure=False))
     parts: list[Result] = client.gather(futures)
     return _concatenate(parts)
@@ -189,7 +191,7 @@ def _workspace_volume_on(client: Any, model: Model, orientation: ArrayLike, cell
     grid = core._volume_grid(model, orientation, cell, refine, step, tolerance, strategy)
     n = grid["cells"]
     chunk = int(chunk) if chunk else grid["nx"] * max(1, math.ceil(grid["ny"] / 32))
-    model_future = client.scatter(model, broadcast=True)
+    model_future = client.scatter(model, broadcast=True, hash=False)
     futures = [client.submit(_volume_task, model_future, grid, step, tolerance, strategy, first, count, pure=False)
                for first, count in _ranges(n, max(1, chunk))]
     parts = client.gather(futures)
@@ -216,7 +218,7 @@ def _workspace_map_on(client: Any, model: Model, orientation: ArrayLike, plane: 
     rows a task (default: about 32 tasks). Returns the rows stacked in order, with the library's
     values (legs as 0-based indices, what ``python3 -m hexatwist.cluster`` hands the command line),
     and the grid."""
-    model_future = client.scatter(model, broadcast=True)
+    model_future = client.scatter(model, broadcast=True, hash=False)
     rpy = tuple(float(x) for x in np.asarray(orientation, dtype=np.float64))
     if grid is None:
         grid = client.submit(_map_grid_task, model_future, rpy, plane, offset, spacing, step, tolerance, strategy,
@@ -269,8 +271,8 @@ def _tolerance_on(client: Any, platform: Any, poses: ArrayLike | None, workspace
     when given, are scattered once), a tracker calibration's noise from (seed, index) too; one task for
     the covariance answer (``linear``). Returns (chunk, linear or None)."""
     chunk = int(chunk) if chunk else max(1, math.ceil(platforms / 64))
-    platform_future = client.scatter(platform, broadcast=True) if platform is not None else None
-    poses_future = client.scatter(np.ascontiguousarray(poses, dtype=np.float64), broadcast=True) \
+    platform_future = client.scatter(platform, broadcast=True, hash=False) if platform is not None else None
+    poses_future = client.scatter(np.ascontiguousarray(poses, dtype=np.float64), broadcast=True, hash=False) \
         if poses is not None else None
     linear_future = client.submit(_linear_task, platform_future, poses_future, workspace, sigmas, calibration, tracker,
                                   seed, pure=False) if linear else None
