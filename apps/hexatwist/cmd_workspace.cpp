@@ -18,6 +18,7 @@
 #include "figures.hpp"
 #include "json.hpp"
 #include "output_files.hpp"
+#include "progress.hpp"
 #include "schemas.hpp"
 #include "study_report.hpp"
 
@@ -170,13 +171,26 @@ Results compute(const Model& model, const WorkspaceCommandOptions& o) {
       throw ExitError(kExitOutOfLimit, "--orientation: no position is reachable there");
     return r;
   }
+  // On a terminal, a progress line for each of the two parts that grow with the grids.
   VolumeOptions vo;
   vo.cell = o.cell;
   vo.threads = 0;
-  if (const Status s = workspace_volume(model, r.rpy, vo, r.volume); s != Status::Ok)
+  VolumeGrid grid;
+  Status s = volume_grid(model, r.rpy, vo, grid);
+  if (s == Status::Ok) {
+    Progress bar(grid.cells(), !o.json);
+    vo.progress = [&](std::size_t done, std::size_t total) {
+      bar.update(done, fmt::format("volume {}/{} cells", done, total));
+    };
+    s = workspace_volume(model, r.rpy, vo, r.volume);
+  }
+  if (s != Status::Ok)
     throw ExitError(kExitOutOfLimit, fmt::format("--orientation {}: no position is reachable there ({})",
                                                  printable(o.orientation), describe(s)));
-  (void)workspace_map(model, r.rpy, r.map.grid, Strategy::Compensated, r.map, 0);
+  Progress bar(static_cast<std::size_t>(r.map.grid.nv), !o.json);
+  (void)workspace_map(
+      model, r.rpy, r.map.grid, Strategy::Compensated, r.map, 0,
+      [&](std::size_t done, std::size_t total) { bar.update(done, fmt::format("map {}/{} rows", done, total)); });
   return r;
 }
 
@@ -192,36 +206,6 @@ std::array<std::size_t, 5> group_counts(const WorkspaceSlice& s) {
   for (const BoundaryPoint& p : s.boundary)
     if (const int g = limit_group(p.limit.status); g >= 0) ++n[static_cast<std::size_t>(g)];
   return n;
-}
-
-// The inside map points' extremes.
-struct MapSummary {
-  std::size_t inside = 0;
-  std::size_t twist_at = 0, error_at = 0, margin_at = 0;
-  double max_twist = 0.0, max_error = 0.0, condition_min = INFINITY, condition_max = 0.0, margin_min = INFINITY;
-};
-MapSummary summarize(const WorkspaceMap& m) {
-  MapSummary s;
-  for (std::size_t k = 0; k < m.points.size(); ++k) {
-    const MapPoint& p = m.points[k];
-    if (p.status != Status::Ok) continue;
-    ++s.inside;
-    if (p.max_twist > s.max_twist) s.max_twist = p.max_twist, s.twist_at = k;
-    if (p.max_length_error > s.max_error) s.max_error = p.max_length_error, s.error_at = k;
-    s.condition_min = std::min(s.condition_min, p.condition);
-    s.condition_max = std::max(s.condition_max, p.condition);
-    if (p.margin < s.margin_min) s.margin_min = p.margin, s.margin_at = k;
-  }
-  return s;
-}
-
-Vector3d map_position(const WorkspaceMap& m, std::size_t k) {
-  SliceSpec spec;
-  spec.plane = m.grid.plane;
-  spec.offset = m.grid.offset;
-  const int i = static_cast<int>(k % static_cast<std::size_t>(m.grid.nu));
-  const int j = static_cast<int>(k / static_cast<std::size_t>(m.grid.nu));
-  return slice_point(spec, m.grid.u(i), m.grid.v(j));
 }
 
 std::string summary_json(const Model& model, const WorkspaceCommandOptions& o, const Results& r,
@@ -265,38 +249,33 @@ std::string summary_json(const Model& model, const WorkspaceCommandOptions& o, c
   j.field("directions", r.orientation.spec.directions);
   j.key("torsions").begin_array(true);
   for (std::size_t t = 0; t < r.orientation.reach.size(); ++t) {
-    const auto& row = r.orientation.reach[t];
-    const auto lo = std::min_element(row.begin(), row.end(), [](const TiltReach& a, const TiltReach& b) {
-      return !std::isnan(a.tilt) && (std::isnan(b.tilt) || a.tilt < b.tilt);
-    });
-    const auto hi = std::max_element(row.begin(), row.end(), [](const TiltReach& a, const TiltReach& b) {
-      return std::isnan(a.tilt) || (!std::isnan(b.tilt) && a.tilt < b.tilt);
-    });
+    const TiltExtremes e = tilt_extremes(r.orientation.reach[t]);
     j.begin_object();
     j.field("torsion", r.orientation.spec.torsions[t]);
-    j.field("smallest_tilt", lo->tilt).field("smallest_azimuth", lo->azimuth);
+    j.field("reached", static_cast<std::uint64_t>(e.reached));
+    j.field("smallest_tilt", e.smallest).field("smallest_azimuth", e.smallest_azimuth);
     j.key("smallest_limit");
-    write_limit_json(j, lo->limit);
-    j.field("largest_tilt", hi->tilt).field("largest_azimuth", hi->azimuth);
+    write_limit_json(j, e.smallest_limit);
+    j.field("largest_tilt", e.largest).field("largest_azimuth", e.largest_azimuth);
     j.end_object();
   }
   j.end_array();
   j.end_object();
-  const MapSummary ms = summarize(r.map);
+  const MapSummary ms = summarize_map(r.map);
   j.key("map").begin_object();
   j.field("plane", "xy").field("offset", r.map.grid.offset);
   j.field("nu", r.map.grid.nu).field("nv", r.map.grid.nv);
   j.field("u0", r.map.grid.u0).field("u1", r.map.grid.u1).field("v0", r.map.grid.v0).field("v1", r.map.grid.v1);
   j.field("inside", static_cast<std::uint64_t>(ms.inside));
   if (ms.inside > 0) {
-    j.field("max_twist", ms.max_twist).field("max_twist_leg", r.map.points[ms.twist_at].twist_leg + 1);
-    j.key("max_twist_at").vector(map_position(r.map, ms.twist_at));
-    j.field("max_length_error", ms.max_error);
+    j.field("max_twist", ms.max_twist).field("max_twist_leg", ms.max_twist_leg + 1);
+    j.key("max_twist_at").vector(map_node_position(r.map.grid, ms.max_twist_node));
+    j.field("max_length_error", ms.max_length_error);
     j.field("condition_min", ms.condition_min).field("condition_max", ms.condition_max);
     j.field("margin_min", ms.margin_min);
-    j.key("margin_min_at").vector(map_position(r.map, ms.margin_at));
-    j.field("margin_min_limit", to_string(r.map.points[ms.margin_at].nearest.status));
-    j.field("margin_min_leg", r.map.points[ms.margin_at].nearest.leg + 1);
+    j.key("margin_min_at").vector(map_node_position(r.map.grid, ms.margin_min_node));
+    j.field("margin_min_limit", to_string(ms.margin_min_limit.status));
+    j.field("margin_min_leg", ms.margin_min_limit.leg + 1);
   }
   j.end_object();
   j.key("cluster");
@@ -342,7 +321,7 @@ std::string map_csv(const Results& r) {
   auto it = std::back_inserter(out);
   for (std::size_t k = 0; k < r.map.points.size(); ++k) {
     const MapPoint& p = r.map.points[k];
-    const Vector3d x = map_position(r.map, k);
+    const Vector3d x = map_node_position(r.map.grid, k);
     const bool in = p.status == Status::Ok;
     fmt::format_to(it, "{},{},{},{},{},{},{},{},{},{},{},{},{}\n", x.x(), x.y(), x.z(), to_string(p.status),
                    in ? 0 : p.limit.leg + 1, p.max_twist, p.twist_leg + 1, p.max_length_error, p.length_error_leg + 1,
@@ -491,32 +470,27 @@ std::string text_report(const Model& model, const WorkspaceCommandOptions& o, co
   out += fmt::format("orientation workspace at x {:g}, y {:g}, z {:g} m: largest tilt over {} directions\n", pos.x(),
                      pos.y(), pos.z(), r.orientation.spec.directions);
   for (std::size_t t = 0; t < r.orientation.reach.size(); ++t) {
-    double lo = INFINITY, hi = -INFINITY, at = 0.0;
-    LimitReport limit;
-    for (const TiltReach& x : r.orientation.reach[t]) {
-      if (std::isnan(x.tilt)) continue;
-      if (x.tilt < lo) lo = x.tilt, at = x.azimuth, limit = x.limit;
-      hi = std::max(hi, x.tilt);
-    }
-    if (std::isinf(lo)) {
+    const TiltExtremes e = tilt_extremes(r.orientation.reach[t]);
+    if (e.reached == 0) {
       out += fmt::format("  yaw {:+g} deg: out of reach at zero tilt ({})\n", rad2deg(r.orientation.spec.torsions[t]),
-                         describe(r.orientation.reach[t].front().limit));
+                         describe(e.smallest_limit));
       continue;
     }
     out += fmt::format("  yaw {:+g} deg: {:.1f} to {:.1f} deg; least towards {:.0f} deg ({})\n",
-                       rad2deg(r.orientation.spec.torsions[t]), rad2deg(lo), rad2deg(hi), rad2deg(at), describe(limit));
+                       rad2deg(r.orientation.spec.torsions[t]), rad2deg(e.smallest), rad2deg(e.largest),
+                       rad2deg(e.smallest_azimuth), describe(e.smallest_limit));
   }
-  const MapSummary ms = summarize(r.map);
+  const MapSummary ms = summarize_map(r.map);
   if (ms.inside > 0) {
-    const Vector3d tw = map_position(r.map, ms.twist_at), mg = map_position(r.map, ms.margin_at);
+    const Vector3d tw = map_node_position(r.map.grid, ms.max_twist_node);
+    const Vector3d mg = map_node_position(r.map.grid, ms.margin_min_node);
     out += fmt::format(
         "map over x-y at z = {:+.3f} m ({} of {} nodes inside): largest |twist| {:.2f} deg (leg {} at x {:+.3f}, y "
         "{:+.3f} m), length error {:.3f} mm, condition {:.2f} to {:.2f}, smallest margin {:.3f} ({}, leg {} at x "
         "{:+.3f}, y {:+.3f} m)\n",
-        r.map.grid.offset, ms.inside, r.map.points.size(), rad2deg(ms.max_twist),
-        r.map.points[ms.twist_at].twist_leg + 1, tw.x(), tw.y(), 1e3 * ms.max_error, ms.condition_min, ms.condition_max,
-        ms.margin_min, to_string(r.map.points[ms.margin_at].nearest.status), r.map.points[ms.margin_at].nearest.leg + 1,
-        mg.x(), mg.y());
+        r.map.grid.offset, ms.inside, r.map.points.size(), rad2deg(ms.max_twist), ms.max_twist_leg + 1, tw.x(), tw.y(),
+        1e3 * ms.max_length_error, ms.condition_min, ms.condition_max, ms.margin_min,
+        to_string(ms.margin_min_limit.status), ms.margin_min_limit.leg + 1, mg.x(), mg.y());
   } else {
     out += fmt::format("map over x-y at z = {:+.3f} m: no node inside the workspace\n", r.map.grid.offset);
   }

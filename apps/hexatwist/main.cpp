@@ -2,11 +2,13 @@
 // hexatwist: twist-aware kinematics of lead-screw Stewart platforms, from the command line.
 // This directory is the only code of the project that reads files and writes to the terminal.
 #include <fmt/format.h>
+
 #include <algorithm>
 
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <set>
 #include <string>
 #include <string_view>
 
@@ -28,9 +30,9 @@ void print_error(std::string_view prefix, std::string_view message) {
 }
 
 // The option of the command being run that sets the library's parameter `name`: --name, else
-// --name-UNIT (tracker_noise is --tracker-noise-um, targets --targets-mm); --name when it has none.
+// --name-UNIT (tracker_noise is --tracker-noise-um, targets --targets-mm); null when it has none.
 // The fields whose option has another name: the stations' ranges and approach.
-std::string option_for(const std::vector<hexatwist::cli::Command>& commands, std::string name) {
+const CLI::Option* option_for(const std::vector<hexatwist::cli::Command>& commands, std::string name) {
   if (name == "translation" || name == "rotation") name = "range";
   if (name == "approach") name = "both_sides";
   if (name == "volume_rpy") name = "volume_orientation";
@@ -38,15 +40,42 @@ std::string option_for(const std::vector<hexatwist::cli::Command>& commands, std
   const std::string flag = "--" + name;
   for (const hexatwist::cli::Command& c : commands) {
     if (!c.app->parsed()) continue;
-    std::string with_unit;
+    const CLI::Option* with_unit = nullptr;
     for (const CLI::Option* o : c.app->get_options())
       for (const std::string& l : o->get_lnames()) {
-        if ("--" + l == flag) return flag;
-        if (with_unit.empty() && ("--" + l).starts_with(flag + "-")) with_unit = "--" + l;
+        if ("--" + l == flag) return o;
+        if (with_unit == nullptr && ("--" + l).starts_with(flag + "-")) with_unit = o;
       }
-    if (!with_unit.empty()) return with_unit;
+    if (with_unit != nullptr) return with_unit;
   }
-  return flag;
+  return nullptr;
+}
+
+// How the command line names the library's parameter `name` in an error: "[--option]". The library
+// states values in SI; when the option is typed in another unit (its help's "[deg]", "[um]", "[%]"),
+// what was typed is shown too: "; typed -1 deg [--clearance]".
+std::string option_note(const std::vector<hexatwist::cli::Command>& commands, const std::string& name) {
+  const CLI::Option* o = option_for(commands, name);
+  if (o == nullptr) {
+    std::string flag = "--" + name;
+    std::replace(flag.begin(), flag.end(), '_', '-');
+    return fmt::format(" [{}]", flag);
+  }
+  const std::string flag = "--" + o->get_lnames().front();
+  if (o->count() == 0) return fmt::format(" [{}]", flag);
+  // The units its help names ("[um]"); none but SI ones: the library's value is what was typed.
+  static const std::set<std::string> si{"m", "rad", "s", "N", "kg", "m/s", "rad/s", "Hz", "K", "-"};
+  std::set<std::string> units;
+  const std::string& help = o->get_description();
+  for (std::size_t a = help.find('['); a != std::string::npos; a = help.find('[', a + 1))
+    if (const std::size_t b = help.find(']', a); b != std::string::npos && b - a <= 12)
+      units.insert(help.substr(a + 1, b - a - 1));
+  if (std::all_of(units.begin(), units.end(), [](const std::string& u) { return si.count(u) > 0; }))
+    return fmt::format(" [{}]", flag);
+  std::string typed;
+  for (const std::string& r : o->results()) typed += (typed.empty() ? "" : ",") + r;
+  return fmt::format("; typed {}{} [{}]", hexatwist::cli::printable(typed),
+                     units.size() == 1 ? " " + *units.begin() : std::string(), flag);
 }
 
 }  // namespace
@@ -117,7 +146,7 @@ int main(int argc, char** argv) {
   } catch (const hexatwist::ParameterError& e) {
     signals::stop_on_request();
     // The library names the parameter at fault; the command line names it as its option.
-    print_error("hexatwist: error: ", fmt::format("{} [{}]", e.what(), option_for(commands, e.parameter())));
+    print_error("hexatwist: error: ", fmt::format("{}{}", e.what(), option_note(commands, e.parameter())));
     return kExitBadInput;
   } catch (const hexatwist::Error& e) {
     signals::stop_on_request();

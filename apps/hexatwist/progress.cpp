@@ -49,8 +49,11 @@ void Progress::update(std::size_t done, std::string_view what) {
   const int filled = percent * kBarWidth / 100;
   std::string line = fmt::format("[{}{}] {:3d}%", std::string(static_cast<std::size_t>(filled), '#'),
                                  std::string(static_cast<std::size_t>(kBarWidth - filled), '.'), percent);
-  if (!what.empty()) line += fmt::format("  {}", what);
-  if (estimate) line += fmt::format("  about {} left", remaining_text(left));
+  // The estimate is kept whole; what is running is shortened to fit the line.
+  const std::string tail = estimate ? fmt::format("  about {} left", remaining_text(left)) : std::string();
+  if (!what.empty() && line.size() + 2 + tail.size() < kLineWidth)
+    line += fmt::format("  {}", what.substr(0, kLineWidth - line.size() - 2 - tail.size()));
+  line += tail;
   if (line.size() > kLineWidth) line.resize(kLineWidth);
   std::fprintf(stderr, "\r%-*s", kLineWidth, line.c_str());
   std::fflush(stderr);

@@ -144,6 +144,7 @@ py::dict design_py(const py::object& config, const py::object& poses_in, const p
   r["objective"] = objective;
   r["objective_before"] = d.objective_before;
   r["objective_after"] = d.objective_after;
+  r["objective_bound"] = d.objective_bound;
   r["evaluations"] = d.evaluations;
   r["attempts"] = d.attempts;
   r["poses"] = poses.size();

@@ -110,6 +110,26 @@ py::dict orientation_py(const Model& model, const py::object& position, const st
   return d;
 }
 
+// One torsion's extremes (tilt_extremes) from a row of hexatwist.design.orientation_workspace's
+// arrays (legs numbered 1 to 6, 0 none).
+py::dict tilt_extremes_py(const std::vector<double>& azimuth, const std::vector<double>& tilt,
+                          const std::vector<int>& status, const std::vector<int>& leg, const std::vector<double>& value,
+                          const std::vector<double>& bound) {
+  const std::size_t n = azimuth.size();
+  if (tilt.size() != n || status.size() != n || leg.size() != n || value.size() != n || bound.size() != n)
+    raise_input("tilt_extremes: azimuth, tilt, status, leg, value and bound of one length");
+  std::vector<TiltReach> row(n);
+  for (std::size_t j = 0; j < n; ++j)
+    row[j] =
+        TiltReach{azimuth[j], tilt[j], LimitReport{static_cast<Status>(status[j]), leg[j] - 1, value[j], bound[j]}};
+  const TiltExtremes e = tilt_extremes(row);
+  py::dict d;
+  d["reached"] = e.reached, d["smallest"] = e.smallest, d["smallest_azimuth"] = e.smallest_azimuth;
+  d["smallest_limit"] = limit_dict(e.smallest_limit);
+  d["largest"] = e.largest, d["largest_azimuth"] = e.largest_azimuth;
+  return d;
+}
+
 }  // namespace
 
 void expose_workspace_boundary(py::module_& m) {
@@ -121,6 +141,8 @@ void expose_workspace_boundary(py::module_& m) {
   m.def("_orientation_workspace", &orientation_py, py::arg("model"), py::arg("position"), py::arg("torsions"),
         py::arg("directions") = o.directions, py::arg("step") = o.step, py::arg("max_tilt") = o.max_tilt,
         py::arg("tolerance") = o.tolerance, py::arg("strategy") = "compensated");
+  m.def("_tilt_extremes", &tilt_extremes_py, py::arg("azimuth"), py::arg("tilt"), py::arg("status"), py::arg("leg"),
+        py::arg("value"), py::arg("bound"));
   m.def(
       "tilt_torsion_rotation",
       [](double azimuth, double tilt, double torsion) {

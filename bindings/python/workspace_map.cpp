@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Maps over a slice of the constant-orientation workspace (design/workspace_map.hpp): the grid
 // around a slice, and rows of the map (the whole map here, or its rows on Dask workers).
+#include <pybind11/stl.h>
+
 #include "common.hpp"
 
 namespace hexatwist::python {
@@ -79,6 +81,43 @@ py::dict map_rows_py(const Model& model, const py::object& orientation, const py
   return d;
 }
 
+// The extremes of a map (summarize_map) from hexatwist.design.workspace_map's arrays (flattened, legs
+// numbered 1 to 6, 0 none).
+py::dict map_summary_py(const py::dict& grid_in, const std::vector<int>& status, const std::vector<double>& max_twist,
+                        const std::vector<int>& twist_leg, const std::vector<double>& max_length_error,
+                        const std::vector<double>& condition, const std::vector<double>& margin,
+                        const std::vector<int>& nearest_status, const std::vector<int>& nearest_leg) {
+  WorkspaceMap map;
+  map.grid = grid_of(grid_in);
+  const std::size_t n = status.size();
+  if (n != map.grid.size() || max_twist.size() != n || twist_leg.size() != n || max_length_error.size() != n ||
+      condition.size() != n || margin.size() != n || nearest_status.size() != n || nearest_leg.size() != n)
+    raise_input("map summary: one value per node of the grid in every array");
+  map.points.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    MapPoint& p = map.points[k];
+    p.status = static_cast<Status>(status[k]);
+    p.max_twist = max_twist[k], p.twist_leg = twist_leg[k] - 1;
+    p.max_length_error = max_length_error[k];
+    p.condition = condition[k], p.margin = margin[k];
+    p.nearest = LimitReport{static_cast<Status>(nearest_status[k]), nearest_leg[k] - 1, 0.0, 0.0};
+  }
+  const MapSummary s = summarize_map(map);
+  const auto at = [&](std::size_t k) {
+    const Vector3d x = s.inside > 0 ? map_node_position(map.grid, k) : Vector3d::Constant(NAN);
+    return py::array_t<double>(3, x.data());
+  };
+  py::dict d;
+  d["inside"] = s.inside, d["max_twist"] = s.max_twist, d["max_twist_leg"] = leg_number(s.max_twist_leg);
+  d["max_twist_at"] = at(s.max_twist_node), d["max_length_error"] = s.max_length_error;
+  d["max_length_error_at"] = at(s.max_length_error_node);
+  d["condition_min"] = s.condition_min, d["condition_max"] = s.condition_max, d["margin_min"] = s.margin_min;
+  d["margin_min_at"] = at(s.margin_min_node);
+  d["margin_min_limit"] = std::string(to_string(s.margin_min_limit.status));
+  d["margin_min_leg"] = leg_number(s.margin_min_limit.leg);
+  return d;
+}
+
 }  // namespace
 
 void expose_workspace_map(py::module_& m) {
@@ -86,6 +125,9 @@ void expose_workspace_map(py::module_& m) {
   m.def("_map_grid", &map_grid_py, py::arg("model"), py::arg("orientation"), py::arg("plane") = "xy",
         py::arg("offset") = 0.0, py::arg("spacing") = 0.02, py::arg("step") = w.step,
         py::arg("tolerance") = w.tolerance, py::arg("strategy") = "compensated");
+  m.def("_map_summary", &map_summary_py, py::arg("grid"), py::arg("status"), py::arg("max_twist"), py::arg("twist_leg"),
+        py::arg("max_length_error"), py::arg("condition"), py::arg("margin"), py::arg("nearest_status"),
+        py::arg("nearest_leg"));
   m.def("_workspace_map_rows", &map_rows_py, py::arg("model"), py::arg("orientation"), py::arg("grid"),
         py::arg("strategy"), py::arg("first"), py::arg("count"));
 }

@@ -20,13 +20,13 @@ from . import distributed as _distributed
 from ._hexatwist import HISTOGRAM_BINS, Model
 from .core import ArrayLike, FloatArray, Int8Array, PerPose, Result, _fields, _per_leg, get_num_threads
 from .dynamics import RigLike
-from .kinematics import Strategy
+from .kinematics import LimitReport, Strategy
 
 __all__ = [
     "HISTOGRAM_BINS", "PlatformLike", "required_workspace", "workspace_volume", "workspace_slice",
     "orientation_workspace", "tilt_torsion_rotation", "workspace_map", "design_axes", "tolerance",
-    "RequiredWorkspace", "VolumeGrid", "WorkspaceVolume", "WorkspaceSlice", "OrientationWorkspace", "MapGrid",
-    "WorkspaceMap", "LimitMargin", "Margins", "DesignEvaluation", "AxisDesign", "Quantiles", "LinearTolerance",
+    "RequiredWorkspace", "VolumeGrid", "WorkspaceVolume", "WorkspaceSlice", "OrientationWorkspace", "TiltExtremes",
+    "MapGrid", "WorkspaceMap", "MapSummary", "LimitMargin", "Margins", "DesignEvaluation", "AxisDesign", "Quantiles", "LinearTolerance",
     "ToleranceSummary", "Tolerance", "TargetLayout", "target_layouts",
 ]
 
@@ -125,6 +125,38 @@ class OrientationWorkspace(Result):
     value: FloatArray
     bound: FloatArray
 
+    def extremes(self) -> list[TiltExtremes]:
+        """Per torsion, the smallest and largest tilt reached and where (the library's tilt_extremes, as
+        ``hexatwist workspace`` prints them)."""
+        out = []
+        for t in range(len(self.torsion)):
+            d = _core._tilt_extremes(self.azimuth, self.tilt[t], self.status[t].astype(int), self.leg[t].astype(int),
+                                     self.value[t], self.bound[t])
+            out.append(TiltExtremes(torsion=float(self.torsion[t]),
+                                    **_fields(d, smallest_limit=LimitReport(**d["smallest_limit"]))))
+        return out
+
+
+@dataclass(frozen=True)
+class TiltExtremes(Result):
+    """One torsion's extremes of an orientation workspace (:meth:`OrientationWorkspace.extremes`); the
+    azimuths where the torsion alone is refused do not count."""
+
+    torsion: float
+    """[rad]"""
+    reached: int
+    """Azimuths where the torsion alone is accepted."""
+    smallest: float
+    """Smallest of their largest tilts [rad]; NaN when none is reached."""
+    smallest_azimuth: float
+    """Its azimuth [rad]."""
+    smallest_limit: LimitReport
+    """What bounds it; when none is reached, what refuses the torsion alone."""
+    largest: float
+    """Largest tilt reached [rad]."""
+    largest_azimuth: float
+    """Its azimuth [rad]."""
+
 
 @dataclass(frozen=True)
 class MapGrid(Result):
@@ -170,6 +202,48 @@ class WorkspaceMap(PerPose):
     v: FloatArray
     """(nv,) [m]"""
     grid: MapGrid
+
+    def summary(self) -> MapSummary:
+        """The map's extremes over its nodes inside the workspace (the library's summarize_map, as
+        ``hexatwist workspace`` prints them)."""
+        def flat(a: Any) -> Any:
+            return np.asarray(a).ravel()
+        d = _core._map_summary(dict(self.grid), flat(self.status).astype(int), flat(self.max_twist),
+                               flat(self.twist_leg).astype(int), flat(self.max_length_error), flat(self.condition),
+                               flat(self.margin), flat(self.nearest_status).astype(int),
+                               flat(self.nearest_leg).astype(int))
+        return MapSummary(**d)
+
+
+@dataclass(frozen=True)
+class MapSummary(Result):
+    """A map's extremes over its nodes inside the workspace (:meth:`WorkspaceMap.summary`), each at the
+    first node in row order that has it; NaN (positions NaN, legs 0) when no node is inside."""
+
+    inside: int
+    """Nodes inside the workspace."""
+    max_twist: float
+    """Largest |twist| [rad]."""
+    max_twist_leg: int
+    """Its leg, 1 to 6."""
+    max_twist_at: FloatArray
+    """(3,) its position [m]."""
+    max_length_error: float
+    """Largest |length error| [m]."""
+    max_length_error_at: FloatArray
+    """(3,) its position [m]."""
+    condition_min: float
+    """Smallest condition number of the Jacobian [-]."""
+    condition_max: float
+    """Largest [-]."""
+    margin_min: float
+    """Smallest share left to the nearest limit [-]."""
+    margin_min_at: FloatArray
+    """(3,) its position [m]."""
+    margin_min_limit: str
+    """That limit's status name."""
+    margin_min_leg: int
+    """Its leg, 1 to 6 (0: the Jacobian's condition)."""
 
 
 @dataclass(frozen=True)
@@ -241,6 +315,9 @@ class AxisDesign(Result):
     objective_before: float
     """The objective's largest value [rad or m]."""
     objective_after: float
+    objective_bound: float
+    """No axes do better: the worst leg's own best, each leg's axes searched alone with the volume free
+    (the legs' twists are independent); NaN for the lead objective, which couples the legs."""
     evaluations: int
     attempts: int
     poses: int

@@ -238,6 +238,7 @@ class Search {
   Search(const SearchData& sd, const DesignOptions& o, std::vector<Group> groups)
       : sd_(sd), o_(o), groups_(std::move(groups)) {
     params_.assign(groups_.size(), Params{0, 0, 0, 0});
+    best_.assign(groups_.size(), INFINITY);
     // The lead objective needs every leg's twist: the model's own axes to start with.
     std::vector<char> lost(static_cast<std::size_t>(sd.samples), 0);
     for (int i = 0; i < kLegs; ++i) {
@@ -251,6 +252,8 @@ class Search {
 
   std::size_t evaluations() const noexcept { return evaluations_; }
   const std::vector<Params>& params() const noexcept { return params_; }
+  /// Each group's best objective found (infinite: no feasible axes).
+  const std::vector<double>& best() const noexcept { return best_; }
   const std::vector<Group>& groups() const noexcept { return groups_; }
 
   // Axes of leg i of group g for the group's parameters.
@@ -342,6 +345,7 @@ class Search {
       if (better(c.score, best.score)) best = c;
     }
     params_[gi] = best.p;
+    best_[gi] = best.score.feasible ? best.score.objective : INFINITY;
     if (o_.objective == DesignObjective::LeadSensitivity) {
       std::vector<Eigen::ArrayXd> twists;
       (void)score(gi, best.p, budget, &twists);
@@ -387,6 +391,7 @@ class Search {
   const DesignOptions& o_;
   std::vector<Group> groups_;
   std::vector<Params> params_;
+  std::vector<double> best_;
   std::array<Eigen::ArrayXd, kLegs> twist_;  // current signed twists (lead objective)
   std::size_t evaluations_ = 0;
 };
@@ -599,6 +604,26 @@ Status design_axes(const Model& model, const std::vector<Pose>& required_in, con
 
   const std::vector<Pose> samples = volume_samples(model, o);
   const std::unique_ptr<SearchData> sd = search_data(model, required, samples, o);
+  // The twist of a leg depends on its own axes only: no axes do better than the worst leg's own best,
+  // each leg searched alone with the volume left free (a relaxation of every symmetry and budget).
+  const bool decoupled = o.objective != DesignObjective::LeadSensitivity;
+  const std::size_t steps =
+      (decoupled ? static_cast<std::size_t>(kLegs) : 0) + groups_of(o.symmetry).size() * (decoupled ? 1 : 3);
+  std::size_t step = 0;
+  const auto told = [&] {
+    if (o.progress) o.progress(++step, steps);
+  };
+  if (o.progress) o.progress(0, steps);
+  if (decoupled) {
+    Search alone(*sd, o, groups_of(AxisSymmetry::PerLeg));
+    out.objective_bound = 0.0;
+    for (std::size_t g = 0; g < alone.groups().size(); ++g) {
+      alone.optimise_group(g, samples.size());
+      out.objective_bound = std::max(out.objective_bound, alone.best()[g]);
+      told();
+    }
+    out.evaluations += alone.evaluations();
+  }
   const double volume_floor = (1.0 - o.max_volume_loss) * out.before.volume;
   // The samples a group may lose; halved after each design the verification refuses.
   double budget_fraction = o.max_volume_loss;
@@ -611,7 +636,10 @@ Status design_axes(const Model& model, const std::vector<Pose>& required_in, con
     // Decoupled objectives: each group once. The lead objective couples the legs: sweeps over the groups.
     const int sweeps = o.objective == DesignObjective::LeadSensitivity && groups > 1 ? 3 : 1;
     for (int sweep = 0; sweep < sweeps; ++sweep)
-      for (std::size_t g = 0; g < groups; ++g) search.optimise_group(g, budget);
+      for (std::size_t g = 0; g < groups; ++g) {
+        search.optimise_group(g, budget);
+        if (attempt == 1) told();
+      }
     out.evaluations += search.evaluations();
 
     const AxisTurns turns = search.turns();

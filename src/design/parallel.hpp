@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstddef>
 #include <exception>
+#include <functional>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -50,5 +51,25 @@ void for_blocks(std::size_t n, std::size_t block, int threads, F&& body) {
   for (std::thread& t : pool) t.join();
   if (failure) std::rethrow_exception(failure);
 }
+
+/// A computation's progress told to a caller's callback as (items done, items in all) after each
+/// block, one call at a time whichever thread finished it: the callback need not be thread-safe.
+class BlockProgress {
+ public:
+  BlockProgress(const std::function<void(std::size_t, std::size_t)>& report, std::size_t total)
+      : report_(report), total_(total) {}
+  void add(std::size_t items) {
+    if (!report_) return;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    done_ += items;
+    report_(done_, total_);
+  }
+
+ private:
+  const std::function<void(std::size_t, std::size_t)>& report_;
+  std::size_t total_;
+  std::size_t done_ = 0;
+  std::mutex mutex_;
+};
 
 }  // namespace hexatwist::detail

@@ -137,4 +137,16 @@ Status orientation_workspace(const Model& model, const OrientationSpec& spec_in,
   return Status::Ok;
 }
 
+TiltExtremes tilt_extremes(const std::vector<TiltReach>& row) noexcept {
+  TiltExtremes e;
+  for (const TiltReach& r : row) {
+    if (std::isnan(r.tilt)) continue;
+    ++e.reached;
+    if (!(r.tilt >= e.smallest)) e.smallest = r.tilt, e.smallest_azimuth = r.azimuth, e.smallest_limit = r.limit;
+    if (!(r.tilt <= e.largest)) e.largest = r.tilt, e.largest_azimuth = r.azimuth;
+  }
+  if (e.reached == 0 && !row.empty()) e.smallest_limit = row.front().limit;
+  return e;
+}
+
 }  // namespace hexatwist

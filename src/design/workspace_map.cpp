@@ -52,6 +52,34 @@ MapGrid map_grid_around(const WorkspaceSlice& slice, double spacing) {
   return g;
 }
 
+Vector3d map_node_position(const MapGrid& grid, std::size_t k) noexcept {
+  SliceSpec spec;
+  spec.plane = grid.plane;
+  spec.offset = grid.offset;
+  const std::size_t nu = static_cast<std::size_t>(std::max(grid.nu, 1));
+  return slice_point(spec, grid.u(static_cast<int>(k % nu)), grid.v(static_cast<int>(k / nu)));
+}
+
+MapSummary summarize_map(const WorkspaceMap& map) noexcept {
+  MapSummary s;
+  // !(x <= best) takes the first value and then each larger one; a NaN best is replaced, a NaN x never wins.
+  const auto larger = [](double x, double best) { return !std::isnan(x) && !(x <= best); };
+  for (std::size_t k = 0; k < map.points.size(); ++k) {
+    const MapPoint& p = map.points[k];
+    if (p.status != Status::Ok) continue;
+    ++s.inside;
+    if (larger(p.max_twist, s.max_twist))
+      s.max_twist = p.max_twist, s.max_twist_node = k, s.max_twist_leg = p.twist_leg;
+    if (larger(p.max_length_error, s.max_length_error))
+      s.max_length_error = p.max_length_error, s.max_length_error_node = k;
+    if (larger(-p.condition, -s.condition_min)) s.condition_min = p.condition;
+    if (larger(p.condition, s.condition_max)) s.condition_max = p.condition;
+    if (larger(-p.margin, -s.margin_min))
+      s.margin_min = p.margin, s.margin_min_node = k, s.margin_min_limit = p.nearest;
+  }
+  return s;
+}
+
 void workspace_map_rows(const Model& model, const Vector3d& rpy, const MapGrid& grid, Strategy strategy, int first_row,
                         int rows, MapPoint* out) noexcept {
   SliceSpec spec;
@@ -69,7 +97,7 @@ void workspace_map_rows(const Model& model, const Vector3d& rpy, const MapGrid& 
 }
 
 Status workspace_map(const Model& model, const Vector3d& rpy_in, const MapGrid& grid_in, Strategy strategy,
-                     WorkspaceMap& out, int threads) {
+                     WorkspaceMap& out, int threads, const std::function<void(std::size_t, std::size_t)>& progress) {
   const MapGrid grid = grid_in;  // copies: the caller may pass out.grid and out.rpy
   const Vector3d rpy = rpy_in;
   out = WorkspaceMap{};
@@ -79,9 +107,11 @@ Status workspace_map(const Model& model, const Vector3d& rpy_in, const MapGrid& 
       !std::isfinite(grid.v1) || !std::isfinite(grid.offset) || !rpy.allFinite())
     return Status::NonFiniteInput;
   out.points.resize(grid.size());
+  detail::BlockProgress done(progress, static_cast<std::size_t>(grid.nv));
   detail::for_blocks(static_cast<std::size_t>(grid.nv), 1, threads, [&](std::size_t begin, std::size_t end) {
     workspace_map_rows(model, rpy, grid, strategy, static_cast<int>(begin), static_cast<int>(end - begin),
                        out.points.data() + begin * static_cast<std::size_t>(grid.nu));
+    done.add(end - begin);
   });
   return Status::Ok;
 }

@@ -163,10 +163,12 @@ Status workspace_volume(const Model& model, const Vector3d& rpy_in, const Volume
   const std::size_t n = grid.cells();
   std::vector<double> fine(n), coarse(n);
   std::atomic<std::uint64_t> columns{0};
+  detail::BlockProgress progress(options.progress, n);
   // Blocks of one row of coarse cells: neighbours share their columns within a block.
   detail::for_blocks(n, static_cast<std::size_t>(grid.nx), options.threads, [&](std::size_t begin, std::size_t end) {
     columns +=
         volume_cells(model, grid, options.search, begin, end - begin, fine.data() + begin, coarse.data() + begin);
+    progress.add(end - begin);
   });
   out = volume_from_cells(grid, fine, coarse, columns);
   return Status::Ok;

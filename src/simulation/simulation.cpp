@@ -67,11 +67,12 @@ Status make_plan(const Rig& rig, const Trajectory& trajectory, Strategy strategy
   // The compensated commands of legs with play follow each leg's direction along the run, from
   // home where homing left it. Legs with a stiffness carry the forces of the planned motion, the
   // static load at its pose plus its accelerations' share (theory §4b, dynamics/leg_forces.hpp),
-  // which the compensated commands know.
+  // which the compensated commands know. A check without a plan (check_trajectory) of commands that
+  // do not know them has no use for them.
   PlayState play;
   start_play(model, model.home_command(), play);
   std::vector<Vector6d> force;
-  if (twist_in_plant && model.has_stiffness() && n > 1) {
+  if (twist_in_plant && model.has_stiffness() && n > 1 && (compensated || plan != nullptr)) {
     std::size_t at = 0;
     if (const Status s = trajectory_leg_forces(rig, trajectory, force, at); s != Status::Ok)
       return detail::fail_at(issue, s, at, trajectory);

@@ -264,6 +264,12 @@ TEST(CliDesignCommands, BadInputsAreOneLineWithTheirExitCodes) {
   expect_error(run({"tolerance", "--station-plan", "/nonexistent/run.csv", "--out", out}), 2, {"--station-plan"});
   expect_error(run({"workspace", "--orientation", "0,0", "--out", out}), 2, {"--orientation"});
   expect_error(run({"workspace", "--spacing", "0", "--out", out}), 2, {"--spacing"});
+  // The library states a value in SI; an option typed in another unit shows what was typed beside it.
+  expect_error(run({"design", "--clearance", "-1", "--out", out}), 2, {"got -0.0174533; typed -1 deg [--clearance]"});
+  expect_error(run({"design", "--max-volume-loss", "200", "--out", out}), 2,
+               {"got 2; typed 200 % [--max-volume-loss]"});
+  expect_error(run({"tolerance", "--calibration", "stations:20", "--tracker-noise-um", "1e5", "--out", out}), 2,
+               {"; typed 1e5 um [--tracker-noise-um]"});
   const Outcome s = run({"tolerance", "--scheduler", "localhost:8786", "--out", out});
   EXPECT_EQ(s.code, 2) << s.err;
   EXPECT_NE(s.err.find("tcp://HOST:PORT"), std::string::npos) << s.err;

@@ -122,6 +122,37 @@ TEST(CliProgress, StudyDrawsItsTestsOnATerminal) {
   EXPECT_EQ(t.terminal.back(), '\r');
 }
 
+TEST(CliProgress, WorkspaceDrawsItsVolumeAndItsMapOnATerminalOnly) {
+  const std::vector<std::string> args{"workspace", "--heights",    "0",        "--yaws", "0", "--cell",
+                                      "0.05",      "--no-figures", "--no-csv", "--out"};
+  std::vector<std::string> tty = args, piped = args;
+  tty.push_back((temp_dir() / "progress-workspace").string());
+  piped.push_back((temp_dir() / "progress-workspace-piped").string());
+  const TerminalOutcome t = run_on_terminal(tty);
+  ASSERT_EQ(t.code, 0) << t.terminal;
+  // Each part's share as its rows of cells and of nodes finish, erased at the end.
+  EXPECT_NE(t.terminal.find("] 100%  volume "), std::string::npos) << t.terminal;
+  EXPECT_NE(t.terminal.find(" cells"), std::string::npos) << t.terminal;
+  EXPECT_NE(t.terminal.find("] 100%  map "), std::string::npos) << t.terminal;
+  EXPECT_EQ(t.terminal.back(), '\r');
+  const Outcome p = run(piped);
+  ASSERT_EQ(p.code, 0) << p.err;
+  EXPECT_EQ(p.err, "");
+  // The same numbers either way.
+  EXPECT_EQ(read_file(std::filesystem::path(tty.back()) / "summary.json").size(),
+            read_file(std::filesystem::path(piped.back()) / "summary.json").size());
+}
+
+TEST(CliProgress, DesignDrawsEachLegAloneThenTheDesign) {
+  const TerminalOutcome t =
+      run_on_terminal({"design", "--workspace", "random=200", "--out", (temp_dir() / "progress-design.yaml").string()});
+  ASSERT_EQ(t.code, 0) << t.terminal;
+  EXPECT_NE(t.terminal.find("%  each leg alone (1 of 6)"), std::string::npos) << t.terminal;
+  EXPECT_NE(t.terminal.find("] 100%  the design"), std::string::npos) << t.terminal;
+  EXPECT_EQ(t.terminal.back(), '\r');
+  EXPECT_NE(t.out.find("optimum: no axes do better than"), std::string::npos) << t.out;
+}
+
 TEST(CliProgress, TheTimeLeftReadsAsAPersonSaysIt) {
   using hexatwist::cli::remaining_text;
   EXPECT_EQ(remaining_text(0.4), "0 s");

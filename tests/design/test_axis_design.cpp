@@ -6,7 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <optional>
 #include <random>
 
 #include "hexatwist/design/required_workspace.hpp"
@@ -146,6 +150,85 @@ TEST(AxisDesign, MoreFreedomNeverDesignsWorseAndTiltsHelpOnceTheMirrorIsFree) {
               per_leg_tilted);
   EXPECT_LT(threefold_tilted, threefold - 1.0);
   EXPECT_LE(per_leg_tilted, threefold_tilted + 0.1);
+}
+
+TEST(AxisDesign, TheBoundIsEachLegsOwnBestBelowEveryDesignAndNearABruteForceScan) {
+  // A leg's twist depends on its own axes only: no design does better than the worst leg's own
+  // best. The bound does not depend on the symmetry, is below every design, and is near the worst
+  // leg's best over a brute-force scan of in-plane turns by the library's twist (limits ignored:
+  // the scan can only find less, by up to its grid's error).
+  const RequiredWorkspace& w = seed_workspace();
+  std::vector<Pose> poses;
+  for (std::size_t k = 0; k < w.poses.size(); k += 8) poses.push_back(w.poses[k]);
+  double bound = NAN;
+  for (const AxisSymmetry symmetry : {AxisSymmetry::Symmetric, AxisSymmetry::Threefold, AxisSymmetry::PerLeg}) {
+    DesignOptions o;
+    o.symmetry = symmetry;
+    o.grid_step = deg2rad(10);
+    o.volume.cell = 0.3;
+    o.volume.search.step = 0.02;
+    o.threads = 0;
+    std::size_t calls = 0, last = 0, total = 0;
+    o.progress = [&](std::size_t done, std::size_t all) {
+      EXPECT_EQ(done, calls++);  // 0 first, then each step once
+      last = done, total = all;
+    };
+    AxisDesign d;
+    ASSERT_EQ(design_axes(test::seed_model(), poses, o, d), Status::Ok);
+    EXPECT_EQ(last, total);
+    EXPECT_EQ(total, 6u + (symmetry == AxisSymmetry::Symmetric ? 1u : symmetry == AxisSymmetry::Threefold ? 2u : 6u));
+    ASSERT_TRUE(std::isfinite(d.objective_bound));
+    EXPECT_LE(d.objective_bound, d.objective_after + 1e-12);
+    if (std::isnan(bound)) bound = d.objective_bound;
+    EXPECT_EQ(d.objective_bound, bound);
+    std::printf("  symmetry %d: design %.3f deg, bound %.3f deg\n", static_cast<int>(symmetry),
+                rad2deg(d.objective_after), rad2deg(d.objective_bound));
+  }
+  // Brute force: every leg's axes turned by (a, b) on a 3 deg grid, each leg's largest twist.
+  constexpr int kSteps = 60;
+  std::array<double, kLegs> best;
+  best.fill(INFINITY);
+  int scanned = 0;
+  for (int ia = 0; ia < kSteps; ++ia)
+    for (int ib = 0; ib < kSteps; ++ib) {
+      AxisTurns t;
+      for (int i = 0; i < kLegs; ++i) {
+        t.base[i] = -kPi / 2 + kPi * ia / kSteps;
+        t.platform[i] = -kPi / 2 + kPi * ib / kSteps;
+      }
+      std::optional<Model> m;
+      try {
+        m.emplace(turned_axes(test::seed_model().spec(), t));
+      } catch (const Error&) {
+        continue;  // an axis singular at home
+      }
+      std::array<double, kLegs> worst{};
+      for (const Pose& p : poses) {
+        LegState st;
+        Vector6d tw;
+        if (inverse_kinematics(*m, p, st) != Status::Ok || twist(*m, st, tw) != Status::Ok) {
+          worst.fill(INFINITY);
+          break;
+        }
+        for (int i = 0; i < kLegs; ++i) worst[i] = std::max(worst[i], std::abs(tw[i]));
+      }
+      for (int i = 0; i < kLegs; ++i) best[i] = std::min(best[i], worst[i]);
+      scanned += std::isfinite(worst[0]);
+    }
+  EXPECT_GT(scanned, kSteps * kSteps * 9 / 10);
+  const double brute = *std::max_element(best.begin(), best.end());
+  std::printf("  bound %.4f deg, brute-force scan (limits ignored) %.4f deg\n", rad2deg(bound), rad2deg(brute));
+  EXPECT_GE(bound, brute - deg2rad(0.5));
+  // The lead objective couples the legs: no bound.
+  DesignOptions o;
+  o.objective = DesignObjective::LeadSensitivity;
+  o.grid_step = deg2rad(15);
+  o.volume.cell = 0.3;
+  o.volume.search.step = 0.02;
+  o.threads = 0;
+  AxisDesign d;
+  ASSERT_EQ(design_axes(test::seed_model(), poses, o, d), Status::Ok);
+  EXPECT_TRUE(std::isnan(d.objective_bound));
 }
 
 TEST(AxisDesign, LeadSensitivityIsThePointErrorOfACommonLeadErrorToFirstOrder) {

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
@@ -153,8 +154,48 @@ TEST(OrientationWorkspace, ATorsionOutsideTheWorkspaceHasNoTilt) {
     EXPECT_TRUE(std::isnan(r.tilt));
     EXPECT_TRUE(is_limit(r.limit.status));
   }
+  const TiltExtremes e = tilt_extremes(ow.reach[0]);
+  EXPECT_EQ(e.reached, 0u);
+  EXPECT_TRUE(std::isnan(e.smallest) && std::isnan(e.largest) && std::isnan(e.smallest_azimuth));
+  EXPECT_EQ(e.smallest_limit.status, ow.reach[0].front().limit.status);  // what refuses the torsion alone
+  EXPECT_EQ(e.smallest_limit.leg, ow.reach[0].front().limit.leg);
   spec.directions = 0;
   EXPECT_EQ(orientation_workspace(test::seed_model(), spec, Strategy::Compensated, ow), Status::NonFiniteInput);
+}
+
+TEST(OrientationWorkspace, TiltExtremesAreTheRowsSmallestAndLargestReachedTilts) {
+  OrientationSpec spec;
+  spec.torsions = {deg2rad(-20), deg2rad(10), deg2rad(38)};  // at 38 deg of yaw some azimuths are refused
+  spec.directions = 36;
+  OrientationWorkspace ow;
+  ASSERT_EQ(orientation_workspace(test::seed_model(), spec, Strategy::Compensated, ow), Status::Ok);
+  for (std::vector<TiltReach>& row : ow.reach) {
+    // A row with an azimuth refused outright, planted: it must not count.
+    row[5].tilt = NAN;
+    const TiltExtremes e = tilt_extremes(row);
+    std::size_t reached = 0;
+    for (const TiltReach& r : row) {
+      if (std::isnan(r.tilt)) continue;
+      ++reached;
+      EXPECT_LE(e.smallest, r.tilt);
+      EXPECT_GE(e.largest, r.tilt);
+    }
+    ASSERT_EQ(e.reached, reached);
+    ASSERT_GT(reached, 0u);
+    // Each extreme is one of the row's own entries, the first of equal ones, with its azimuth and limit.
+    const auto first_with = [&](double tilt) {
+      return std::find_if(row.begin(), row.end(), [&](const TiltReach& r) { return r.tilt == tilt; });
+    };
+    const auto lo = first_with(e.smallest), hi = first_with(e.largest);
+    ASSERT_NE(lo, row.end());
+    ASSERT_NE(hi, row.end());
+    EXPECT_EQ(lo->azimuth, e.smallest_azimuth);
+    EXPECT_EQ(lo->limit.status, e.smallest_limit.status);
+    EXPECT_EQ(lo->limit.leg, e.smallest_limit.leg);
+    EXPECT_EQ(hi->azimuth, e.largest_azimuth);
+    EXPECT_LT(e.smallest, e.largest);
+  }
+  EXPECT_EQ(tilt_extremes({}).reached, 0u);
 }
 
 }  // namespace

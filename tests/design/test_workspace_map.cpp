@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "support.hpp"
 
@@ -96,6 +98,63 @@ TEST(WorkspaceMap, RowsComputedApartEqualTheWholeMap) {
   }
   grid.nu = 1;
   EXPECT_EQ(workspace_map(model, Vector3d::Zero(), grid, Strategy::Compensated, whole), Status::NonFiniteInput);
+}
+
+TEST(WorkspaceMap, SummaryHoldsTheExtremesOfTheInsideNodesAtTheirOwnPoses) {
+  const Model& model = test::seed_model();
+  const Vector3d rpy(deg2rad(3), 0.0, deg2rad(-10));
+  MapGrid grid;
+  grid.plane = SlicePlane::XZ;
+  grid.offset = 0.1;
+  grid.u0 = -0.9, grid.u1 = 0.8, grid.v0 = -0.7, grid.v1 = 0.6;
+  grid.nu = 18, grid.nv = 14;
+  WorkspaceMap map;
+  std::vector<std::size_t> rows_told;
+  ASSERT_EQ(workspace_map(model, rpy, grid, Strategy::Compensated, map, 2,
+                          [&](std::size_t done, std::size_t total) {
+                            EXPECT_EQ(total, 14u);
+                            rows_told.push_back(done);
+                          }),
+            Status::Ok);
+  ASSERT_EQ(rows_told.size(), 14u);
+  EXPECT_EQ(rows_told.back(), 14u);
+  const MapSummary s = summarize_map(map);
+  std::size_t inside = 0;
+  double twist = -1.0, error = -1.0, cmin = INFINITY, cmax = -1.0, margin = INFINITY;
+  for (std::size_t k = 0; k < map.points.size(); ++k) {
+    const MapPoint& p = map.points[k];
+    // Each node's position is the pose its numbers were computed at.
+    Pose pose;
+    pose.position = map_node_position(grid, k);
+    pose.rpy = rpy;
+    MapPoint again;
+    (void)map_point(model, pose, Strategy::Compensated, again);
+    ASSERT_EQ(again.status, p.status) << k;
+    if (p.status != Status::Ok) continue;
+    ASSERT_EQ(again.max_twist, p.max_twist) << k;
+    ++inside;
+    twist = std::max(twist, p.max_twist), error = std::max(error, p.max_length_error);
+    cmin = std::min(cmin, p.condition), cmax = std::max(cmax, p.condition), margin = std::min(margin, p.margin);
+  }
+  ASSERT_GT(inside, 20u);
+  ASSERT_LT(inside, map.points.size());
+  EXPECT_EQ(s.inside, inside);
+  EXPECT_EQ(s.max_twist, twist);
+  EXPECT_EQ(s.max_length_error, error);
+  EXPECT_EQ(s.condition_min, cmin);
+  EXPECT_EQ(s.condition_max, cmax);
+  EXPECT_EQ(s.margin_min, margin);
+  // The nodes named hold them, with their leg and limit.
+  EXPECT_EQ(map.points[s.max_twist_node].max_twist, twist);
+  EXPECT_EQ(map.points[s.max_twist_node].twist_leg, s.max_twist_leg);
+  EXPECT_EQ(map.points[s.max_length_error_node].max_length_error, error);
+  EXPECT_EQ(map.points[s.margin_min_node].margin, margin);
+  EXPECT_EQ(map.points[s.margin_min_node].nearest.status, s.margin_min_limit.status);
+  // Nothing inside: NaN, not a number from outside the workspace.
+  for (MapPoint& p : map.points) p.status = Status::StrokeAboveMax;
+  const MapSummary none = summarize_map(map);
+  EXPECT_EQ(none.inside, 0u);
+  EXPECT_TRUE(std::isnan(none.max_twist) && std::isnan(none.condition_min) && std::isnan(none.margin_min));
 }
 
 TEST(WorkspaceMap, GridAroundASliceCoversEveryBoundaryPoint) {

@@ -6,8 +6,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <thread>
 
 #include "hexatwist/io/config.hpp"
 #include "support.hpp"
@@ -120,6 +125,38 @@ TEST(WorkspaceVolume, DoesNotDependOnThreadsOrOnHowTheCellsAreSplit) {
   const WorkspaceVolume split = volume_from_cells(one.grid, fine, coarse, columns);
   EXPECT_EQ(split.volume, one.volume);
   EXPECT_EQ(split.coarse_volume, one.coarse_volume);
+}
+
+TEST(WorkspaceVolume, TellsItsProgressOneCallAtATimeUpToEveryCellWithoutChangingTheVolume) {
+  const Model& model = test::seed_model();
+  VolumeOptions o;
+  o.cell = 0.05;
+  WorkspaceVolume plain, told;
+  ASSERT_EQ(workspace_volume(model, Vector3d::Zero(), o, plain), Status::Ok);
+  o.threads = 3;
+  std::vector<std::size_t> calls;
+  std::atomic<int> inside{0};
+  bool overlapped = false;
+  o.progress = [&](std::size_t done, std::size_t total) {
+    overlapped = overlapped || inside.fetch_add(1) != 0;  // never two calls at once
+    EXPECT_EQ(total, plain.grid.cells());
+    calls.push_back(done);
+    std::this_thread::sleep_for(std::chrono::microseconds(50));
+    inside.fetch_sub(1);
+  };
+  ASSERT_EQ(workspace_volume(model, Vector3d::Zero(), o, told), Status::Ok);
+  EXPECT_FALSE(overlapped);
+  EXPECT_EQ(told.volume, plain.volume);
+  EXPECT_EQ(told.error, plain.error);
+  // One call per row of coarse cells, increasing, the last at every cell.
+  ASSERT_EQ(calls.size(), static_cast<std::size_t>(plain.grid.ny));
+  EXPECT_TRUE(std::is_sorted(calls.begin(), calls.end()));
+  EXPECT_EQ(calls.back(), plain.grid.cells());
+  // A callback that throws (a user's stop) ends the computation and the exception reaches the caller.
+  o.progress = [](std::size_t done, std::size_t) {
+    if (done > 0) throw std::runtime_error("stopped");
+  };
+  EXPECT_THROW((void)workspace_volume(model, Vector3d::Zero(), o, told), std::runtime_error);
 }
 
 TEST(WorkspaceVolume, BoundsHoldEveryAcceptedPosition) {

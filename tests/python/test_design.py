@@ -64,6 +64,35 @@ def test_orientation_workspace_reach_is_accepted_and_the_next_step_refused(model
             assert c.status[0] == 0 and c.status[1] == o.status[t, j]
 
 
+def test_map_summary_and_tilt_extremes_are_the_cli_workspace_summary(model):
+    # The CLI's summary.json and these come from the library's summarize_map and tilt_extremes: equal
+    # to the bit; and against numpy over the arrays.
+    out = os.path.join(tempfile.mkdtemp(), "w")
+    cli = json.loads(subprocess.run(
+        [tool("HEXATWIST_CLI"), "workspace", "--heights", "0", "--spacing", "0.1", "--yaws", "0,80", "--map-height", "0.1",
+         "--map-spacing", "0.1", "--cell", "0.1", "--no-figures", "--no-csv", "--out", out, "--json"],
+        capture_output=True, text=True, check=True).stdout)
+    m = hexatwist.workspace_map(model, (0, 0, 0), "xy", 0.1, spacing=0.1)
+    s = m.summary()
+    j = cli["map"]
+    assert s.inside == j["inside"] and s.max_twist == j["max_twist"] and s.max_twist_leg == j["max_twist_leg"]
+    assert list(s.max_twist_at) == j["max_twist_at"] and list(s.margin_min_at) == j["margin_min_at"]
+    assert (s.condition_min, s.condition_max, s.margin_min) == (j["condition_min"], j["condition_max"], j["margin_min"])
+    assert (s.margin_min_limit, s.margin_min_leg) == (j["margin_min_limit"], j["margin_min_leg"])
+    ok = m.status == 0
+    assert s.inside == ok.sum() and s.max_twist == m.max_twist[ok].max() and s.condition_min == m.condition[ok].min()
+    assert s.max_length_error == m.max_length_error[ok].max() and s.margin_min == m.margin[ok].min()
+    o = hexatwist.orientation_workspace(model, torsions=np.radians([0.0, 80.0]))
+    for e, c in zip(o.extremes(), cli["orientation_workspace"]["torsions"]):
+        assert e.torsion == c["torsion"] and e.reached == c["reached"]
+        assert e.smallest_limit.status == c["smallest_limit"]["status"]
+        for mine, key in ((e.smallest, "smallest_tilt"), (e.smallest_azimuth, "smallest_azimuth"),
+                          (e.largest, "largest_tilt"), (e.largest_azimuth, "largest_azimuth")):
+            assert (np.isnan(mine) and c[key] is None) or mine == c[key]
+    assert o.extremes()[0].reached == 72 and o.extremes()[0].smallest == np.nanmin(o.tilt[0])
+    assert o.extremes()[1].reached == 0 and o.extremes()[1].smallest_limit.status == "bend_base"
+
+
 def test_designed_axes_halve_the_twist_and_their_yaml_loads_back(model):
     w = hexatwist.required_workspace(random=600)
     d = hexatwist.design_axes(None, w.poses)

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "hexatwist/design/workspace_volume.hpp"
@@ -92,6 +93,10 @@ struct DesignOptions {
   int volume_samples = 4000;               ///< positions drawn in its box to steer the search (§17)
   std::uint64_t seed = 1;                  ///< of those positions
   int threads = 1;                         ///< 0 = every core; the result does not depend on it
+  /// Called (may be empty) with (steps done, steps in all) at the start (0 done), after each leg's
+  /// own search (the bound) and after each group's search, from the calling thread; not part of
+  /// the result.
+  std::function<void(std::size_t, std::size_t)> progress;
 };
 
 /// The most volume_samples a design takes (each is a position tried at every candidate).
@@ -118,8 +123,14 @@ struct AxisDesign {
   DesignEvaluation before;                               ///< the model over the required workspace
   DesignEvaluation after;                                ///< the designed one
   double objective_before = 0.0, objective_after = 0.0;  ///< the objective's largest value [rad or m]
-  std::size_t evaluations = 0;                           ///< candidate axes evaluated
-  int attempts = 0;  ///< searches made (a verification that fails tightens the volume budget)
+  /// How close to the optimum: the twist (or length error) of a leg depends on its own axes only, so
+  /// no axes do better than the worst leg's own best, each leg's axes searched alone over the
+  /// required poses with the volume left free (as globally as the design's grid and local search);
+  /// objective_after - objective_bound is what the symmetry and the volume kept cost at most. NaN
+  /// for the lead objective, which couples the legs [rad or m].
+  double objective_bound = NAN;
+  std::size_t evaluations = 0;  ///< candidate axes evaluated
+  int attempts = 0;             ///< searches made (a verification that fails tightens the volume budget)
 };
 
 /// The axes that minimise options.objective over `required` (poses the model reaches; those it

@@ -80,6 +80,20 @@ struct OrientationWorkspace {
   std::vector<std::vector<TiltReach>> reach;  ///< per torsion, per azimuth
 };
 
+/// The extremes of one torsion's row of an orientation workspace: the azimuths where the torsion
+/// alone is refused (tilt NaN) do not count.
+struct TiltExtremes {
+  std::size_t reached = 0;        ///< azimuths where the torsion alone is accepted
+  double smallest = NAN;          ///< smallest of their largest tilts [rad] (NaN: none reached)
+  double smallest_azimuth = NAN;  ///< its azimuth [rad] (the first of equal ones)
+  LimitReport smallest_limit;     ///< what bounds it; when none is reached, what refuses the torsion alone
+  double largest = NAN;           ///< largest tilt reached [rad]
+  double largest_azimuth = NAN;   ///< its azimuth [rad]
+};
+
+/// The extremes of `row` (one torsion of OrientationWorkspace::reach).
+TiltExtremes tilt_extremes(const std::vector<TiltReach>& row) noexcept;
+
 /// For every torsion and azimuth, the largest tilt (tilt_torsion_rotation) with every smaller tilt
 /// accepted by motor_commands for `strategy`, marched and bisected as line_intervals. Returns
 /// NonFiniteInput for a bad spec (directions < 1, step or tolerance not > 0, non-finite values).

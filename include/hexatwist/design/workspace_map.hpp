@@ -4,6 +4,8 @@
 // condition number (dexterity) and the share left to the nearest limit.
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "hexatwist/design/workspace_boundary.hpp"
@@ -48,6 +50,28 @@ struct WorkspaceMap {
   std::vector<MapPoint> points;     ///< index j * nu + i for node (u(i), v(j))
 };
 
+/// The pose position of node k (index j * nu + i) of `grid`: a pivot displacement from home [m, B].
+Vector3d map_node_position(const MapGrid& grid, std::size_t k) noexcept;
+
+/// The extremes of a map over its nodes inside the workspace (status Ok), each with the node where
+/// it is reached first in node order; every field NaN (and every node 0) when no node is inside.
+struct MapSummary {
+  std::size_t inside = 0;          ///< nodes inside the workspace
+  double max_twist = NAN;          ///< largest |twist| [rad]
+  std::size_t max_twist_node = 0;  ///< its node
+  int max_twist_leg = -1;          ///< its leg, 0-based
+  double max_length_error = NAN;   ///< largest |length error| [m]
+  std::size_t max_length_error_node = 0;
+  double condition_min = NAN;       ///< the Jacobian's condition number, smallest [-]
+  double condition_max = NAN;       ///< and largest [-]
+  double margin_min = NAN;          ///< smallest share left to the nearest limit [-]
+  std::size_t margin_min_node = 0;  ///< its node
+  LimitReport margin_min_limit;     ///< that limit
+};
+
+/// The extremes of `map` (the CLI's summary and Python's WorkspaceMap.summary()).
+MapSummary summarize_map(const WorkspaceMap& map) noexcept;
+
 /// The grid over a slice's searched rectangle shrunk to its boundary points (plus one grid step
 /// each side), with nodes about `spacing` [m] apart (at least 2 each way). Falls back to the whole
 /// rectangle for a slice without boundary points.
@@ -58,8 +82,11 @@ void workspace_map_rows(const Model& model, const Vector3d& rpy, const MapGrid& 
                         int rows, MapPoint* out) noexcept;
 
 /// The whole map, split over `threads` threads (0 = every core) by rows; the result does not depend
-/// on it. Returns NonFiniteInput for a grid with fewer than 2 nodes a way or non-finite bounds.
+/// on it. `progress` (may be empty) is called with (rows done, rows in all) after each row, one call
+/// at a time from the computing threads; an exception it throws ends the map and propagates.
+/// Returns NonFiniteInput for a grid with fewer than 2 nodes a way or non-finite bounds.
 [[nodiscard]] Status workspace_map(const Model& model, const Vector3d& rpy, const MapGrid& grid, Strategy strategy,
-                                   WorkspaceMap& out, int threads = 1);
+                                   WorkspaceMap& out, int threads = 1,
+                                   const std::function<void(std::size_t, std::size_t)>& progress = {});
 
 }  // namespace hexatwist

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "hexatwist/kinematics/compensation.hpp"
@@ -63,6 +64,10 @@ struct VolumeOptions {
   double cell = 0.0;
   int refine = 3;   ///< how many times a cell across the shadow's edge is split in four (0..8)
   int threads = 1;  ///< threads of the computation (0 = every core); the result does not depend on it
+  /// Called (may be empty) with (coarse cells done, coarse cells in all) after each row of cells, one
+  /// call at a time from the computing threads; an exception it throws ends the computation and
+  /// propagates. Not part of the result: any callback gives the same volume.
+  std::function<void(std::size_t, std::size_t)> progress;
 };
 
 /// The x-y grid of a volume computation: coarse cells of side 2 * cell, each split into four cells
