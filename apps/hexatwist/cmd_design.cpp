@@ -69,6 +69,7 @@ void evaluation_json(JsonWriter& j, const DesignEvaluation& e) {
   j.field("twist_leg", e.twist_leg + 1);
   j.field("max_length_error", e.max_length_error);
   j.field("max_lead_sensitivity", e.max_lead_sensitivity);
+  j.field("axis_sensitivity", e.axis_sensitivity);
   j.key("margins").begin_object();
   for (int k = 0; k < kMarginKinds; ++k) {
     const LimitMargin& m = e.margins[static_cast<std::size_t>(k)];
@@ -155,6 +156,9 @@ std::string report_text(const Model& model, const DesignCommandOptions& o, const
   out += fmt::format("{:<28}{:>40}{:>40}\n", "lead sensitivity (point A)",
                      fmt::format("{:.4f} mm per 1 % lead", 10.0 * b.max_lead_sensitivity),
                      fmt::format("{:.4f} mm per 1 % lead", 10.0 * a.max_lead_sensitivity));
+  out += fmt::format("{:<28}{:>40}{:>40}\n", "U-joint axis errors (A, p95)",
+                     fmt::format("{:.4f} mm per {:g} deg", 1e3 * b.axis_sensitivity, rad2deg(kDesignAxisSigma)),
+                     fmt::format("{:.4f} mm per {:g} deg", 1e3 * a.axis_sensitivity, rad2deg(kDesignAxisSigma)));
   out += fmt::format("{:<28}{:>40}{:>40}\n", "poses reached (with home)", fmt::format("{} of {}", b.reached, b.poses),
                      fmt::format("{} of {}", a.reached, a.poses));
   out += "margin: share of range left\n";

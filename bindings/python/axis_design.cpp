@@ -89,6 +89,7 @@ py::dict evaluation_dict(const DesignEvaluation& e) {
   d["twist_pose"] = e.twist_pose;
   d["max_length_error"] = e.max_length_error;
   d["max_lead_sensitivity"] = e.max_lead_sensitivity;
+  d["axis_sensitivity"] = e.axis_sensitivity;
   py::dict margins;
   for (int k = 0; k < kMarginKinds; ++k) {
     const LimitMargin& m = e.margins[static_cast<std::size_t>(k)];

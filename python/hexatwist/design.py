@@ -293,6 +293,9 @@ class DesignEvaluation(Result):
     """[m]"""
     max_lead_sensitivity: float
     """Largest |dA / d(relative lead error)| [m]."""
+    axis_sensitivity: float
+    """What U-joint axis errors leave with exact compensation: point A's linearised error, 95th
+    percentile over the poses, for 0.1 deg (1 sd) about both normals of every fixed axis [m]."""
     margins: Margins
     volume: float
     """Volume at the design's orientation [m^3]."""

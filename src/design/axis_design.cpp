@@ -11,6 +11,7 @@
 
 #include "design/parallel.hpp"
 #include "design/sampling.hpp"
+#include "hexatwist/design/tolerance.hpp"
 #include "hexatwist/error.hpp"
 #include "hexatwist/kinematics/forward.hpp"
 #include "kinematics/geometry.hpp"
@@ -575,6 +576,21 @@ Status evaluate_design(const Model& model, const std::vector<Pose>& poses, const
       const LimitMargin& x = r.margins[static_cast<std::size_t>(m)];
       if (x.share < out.margins[static_cast<std::size_t>(m)].share) out.margins[static_cast<std::size_t>(m)] = x;
     }
+  }
+  // With exact compensation the controller knows the nominal axes only: the real axes' errors are
+  // what is left. The linearised point A error (tolerance_linear) for kDesignAxisSigma on both axes
+  // of every leg, its 95th percentile over the reached poses.
+  std::vector<Pose> reached;
+  for (std::size_t k = 0; k < per.size(); ++k)
+    if (per[k].ok) reached.push_back(poses[k]);
+  ToleranceSigmas axes_only;
+  axes_only.base_joint = axes_only.platform_joint = axes_only.lead = axes_only.offset = 0.0;
+  axes_only.base_axis = axes_only.platform_axis = kDesignAxisSigma;
+  ToleranceLinear linear;
+  if (!reached.empty() && tolerance_linear(model, reached, axes_only, linear, options.threads) == Status::Ok) {
+    ToleranceSummary summary;
+    linear_quantiles(linear, summary, options.threads);
+    out.axis_sensitivity = summary.point_linear.p95;
   }
   if (volume) {
     VolumeOptions vo = options.volume;

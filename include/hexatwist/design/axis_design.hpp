@@ -62,17 +62,26 @@ struct LimitMargin {
   std::size_t pose = 0;     ///< index of that pose
 };
 
+/// The axis error (1 sd, per normal of every fixed axis) at which a design's sensitivity to its
+/// U-joint axes is stated (DesignEvaluation::axis_sensitivity) [rad]: 0.1 deg, the tolerance
+/// study's default.
+inline constexpr double kDesignAxisSigma = 0.1 * kPi / 180.0;
+
 /// A configuration over a required workspace.
 struct DesignEvaluation {
-  std::size_t poses = 0;                            ///< poses evaluated
-  std::size_t reached = 0;                          ///< of which inside every limit (motor_commands, compensated)
-  std::size_t first_refused = 0;                    ///< index of the first refused pose (== poses when none)
-  LimitReport refused;                              ///< its limit
-  double max_twist = 0.0;                           ///< largest |twist| over the reached poses [rad]
-  int twist_leg = -1;                               ///< its leg, 0-based
-  std::size_t twist_pose = 0;                       ///< its pose
-  double max_length_error = 0.0;                    ///< largest |length error| [m]
-  double max_lead_sensitivity = 0.0;                ///< largest |dA / d(relative lead error)| [m]
+  std::size_t poses = 0;              ///< poses evaluated
+  std::size_t reached = 0;            ///< of which inside every limit (motor_commands, compensated)
+  std::size_t first_refused = 0;      ///< index of the first refused pose (== poses when none)
+  LimitReport refused;                ///< its limit
+  double max_twist = 0.0;             ///< largest |twist| over the reached poses [rad]
+  int twist_leg = -1;                 ///< its leg, 0-based
+  std::size_t twist_pose = 0;         ///< its pose
+  double max_length_error = 0.0;      ///< largest |length error| [m]
+  double max_lead_sensitivity = 0.0;  ///< largest |dA / d(relative lead error)| [m]
+  /// What errors of the U-joint axes leave with exact compensation (the controller knowing the
+  /// nominal axes): the 95th percentile over the reached poses of point A's linearised error
+  /// (tolerance_linear) for kDesignAxisSigma (1 sd) about both normals of every fixed axis [m]
+  double axis_sensitivity = NAN;
   std::array<LimitMargin, kMarginKinds> margins{};  ///< by MarginKind
   double volume = NAN;        ///< workspace volume at DesignOptions::volume_rpy [m^3] (NaN: not computed)
   double volume_error = NAN;  ///< its stated error [m^3]
