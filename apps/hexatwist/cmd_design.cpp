@@ -156,9 +156,10 @@ std::string report_text(const Model& model, const DesignCommandOptions& o, const
   out += fmt::format("{:<28}{:>40}{:>40}\n", "lead sensitivity (point A)",
                      fmt::format("{:.4f} mm per 1 % lead", 10.0 * b.max_lead_sensitivity),
                      fmt::format("{:.4f} mm per 1 % lead", 10.0 * a.max_lead_sensitivity));
-  out += fmt::format("{:<28}{:>40}{:>40}\n", "U-joint axis errors (A, p95)",
-                     fmt::format("{:.4f} mm per {:g} deg", 1e3 * b.axis_sensitivity, rad2deg(kDesignAxisSigma)),
-                     fmt::format("{:.4f} mm per {:g} deg", 1e3 * a.axis_sensitivity, rad2deg(kDesignAxisSigma)));
+  const std::string axis_row = fmt::format("U-joint axis errors {:g} deg", rad2deg(kDesignAxisSigma));
+  out +=
+      fmt::format("{:<28}{:>40}{:>40}\n", axis_row, fmt::format("{:.4f} mm at point A (p95)", 1e3 * b.axis_sensitivity),
+                  fmt::format("{:.4f} mm at point A (p95)", 1e3 * a.axis_sensitivity));
   out += fmt::format("{:<28}{:>40}{:>40}\n", "poses reached (with home)", fmt::format("{} of {}", b.reached, b.poses),
                      fmt::format("{} of {}", a.reached, a.poses));
   out += "margin: share of range left\n";
@@ -176,19 +177,24 @@ std::string report_text(const Model& model, const DesignCommandOptions& o, const
     out += fmt::format("{:>3}{:>8.2f}{:>10.2f}{:>11.2f}{:>15.2f}\n", i + 1, rad2deg(r.turns.base[i]),
                        rad2deg(r.turns.platform[i]), rad2deg(r.turns.base_tilt[i]), rad2deg(r.turns.platform_tilt[i]));
   if (std::isfinite(r.objective_bound)) {
-    // How close to the optimum: each leg's own best bounds every design from below.
+    // How close to the optimum: each leg's own best bounds every design of the axes searched from below.
     const bool twist = o.objective == "twist";
-    const auto value = [&](double x) {
-      return twist ? fmt::format("{:.2f} deg", rad2deg(x)) : fmt::format("{:.4f} mm", 1e3 * x);
+    // The values as printed, and their difference as printed (the gap of the rounded numbers).
+    const auto shown = [&](double x) {
+      return twist ? std::round(100.0 * rad2deg(x)) / 100.0 : std::round(1e7 * x) / 1e4;
     };
-    const double gap = r.objective_after - r.objective_bound;
+    const auto value = [&](double x) { return twist ? fmt::format("{:.2f} deg", x) : fmt::format("{:.4f} mm", x); };
+    const double bound = shown(r.objective_bound), gap = shown(r.objective_after) - bound;
     out += fmt::format(
-        "optimum: no axes do better than {} (the worst leg's own best, each leg's axes searched alone with the "
-        "volume free); this design is {}\n",
-        value(r.objective_bound),
+        "optimum: no axes {} do better than {} as far as the search finds (the worst leg's own best, each leg's "
+        "axes searched alone with the volume free); this design is {}\n",
+        o.tilt ? fmt::format("tilted up to {:g} deg", rad2deg(d.max_tilt)) : std::string("in the joint planes"),
+        value(bound),
         gap <= 0.0 ? "at that bound"
-                   : fmt::format("within {} ({:.2g} %): what the symmetry and the volume kept cost at most", value(gap),
-                                 100.0 * gap / r.objective_bound));
+                   : fmt::format("{} above it ({:.2g} %): what the symmetry and the volume kept cost at most",
+                                 value(gap), 100.0 * gap / bound));
+  } else if (o.objective == "lead_sensitivity") {
+    out += "optimum: no bound for the lead objective, which couples the legs through the platform's Jacobian\n";
   }
   if (r.objective_after >= r.objective_before)
     out += "no design kept every limit and the volume and did better: the configuration's own axes are kept\n";
@@ -234,6 +240,11 @@ int run_design(const DesignCommandOptions& o) {
       throw ExitError(kExitOutOfLimit,
                       fmt::format("design failed: {} ({}); nothing was written", describe(s), to_string(s)));
   }
+  if (!(r.before.volume > 0.0))
+    throw ExitError(kExitOutOfLimit,
+                    fmt::format("--volume-orientation {}: the platform reaches no position at that orientation (volume "
+                                "0), so there is no volume to keep; give one it reaches. Nothing was written",
+                                printable(o.volume_orientation)));
   const std::string header = fmt::format(
       "{} with its fixed U-joint axes designed by hexatwist design (objective {}, symmetry {}):\n"
       "largest |twist| over the required workspace {:.2f} deg -> {:.2f} deg",

@@ -267,16 +267,34 @@ std::string summary_json(const Model& model, const WorkspaceCommandOptions& o, c
   j.field("nu", r.map.grid.nu).field("nv", r.map.grid.nv);
   j.field("u0", r.map.grid.u0).field("u1", r.map.grid.u1).field("v0", r.map.grid.v0).field("v1", r.map.grid.v1);
   j.field("inside", static_cast<std::uint64_t>(ms.inside));
-  if (ms.inside > 0) {
-    j.field("max_twist", ms.max_twist).field("max_twist_leg", ms.max_twist_leg + 1);
-    j.key("max_twist_at").vector(map_node_position(r.map.grid, ms.max_twist_node));
-    j.field("max_length_error", ms.max_length_error);
-    j.field("condition_min", ms.condition_min).field("condition_max", ms.condition_max);
-    j.field("margin_min", ms.margin_min);
-    j.key("margin_min_at").vector(map_node_position(r.map.grid, ms.margin_min_node));
-    j.field("margin_min_limit", to_string(ms.margin_min_limit.status));
-    j.field("margin_min_leg", ms.margin_min_limit.leg + 1);
-  }
+  // Every field, null when no node is inside (the extremes are NaN then).
+  const auto at = [&](const char* key, std::size_t node) {
+    j.key(key);
+    if (ms.inside > 0)
+      j.vector(map_node_position(r.map.grid, node));
+    else
+      j.null();
+  };
+  const auto leg = [&](const char* key, int index) {
+    j.key(key);
+    if (ms.inside > 0)
+      j.value(index + 1);
+    else
+      j.null();
+  };
+  j.field("max_twist", ms.max_twist);
+  leg("max_twist_leg", ms.max_twist_leg);
+  at("max_twist_at", ms.max_twist_node);
+  j.field("max_length_error", ms.max_length_error);
+  j.field("condition_min", ms.condition_min).field("condition_max", ms.condition_max);
+  j.field("margin_min", ms.margin_min);
+  at("margin_min_at", ms.margin_min_node);
+  j.key("margin_min_limit");
+  if (ms.inside > 0)
+    j.value(to_string(ms.margin_min_limit.status));
+  else
+    j.null();
+  leg("margin_min_leg", ms.margin_min_limit.leg);
   j.end_object();
   j.key("cluster");
   if (o.scheduler.empty()) {
@@ -505,6 +523,10 @@ int run_workspace(const WorkspaceCommandOptions& o) {
   set.input("--config", o.model.config);
   set.folder("--out", o.out);
   const Results r = compute(model, o);
+  if (!(r.volume.volume > 0.0))
+    throw ExitError(kExitOutOfLimit, fmt::format("--orientation {}: no position is reachable there (every column of "
+                                                 "the volume's grid is outside the limits); nothing was written",
+                                                 printable(o.orientation)));
 
   const fs::path dir(o.out);
   std::vector<std::string> names;

@@ -63,15 +63,16 @@ std::string option_note(const std::vector<hexatwist::cli::Command>& commands, co
   }
   const std::string flag = "--" + o->get_lnames().front();
   if (o->count() == 0) return fmt::format(" [{}]", flag);
-  // The units its help names ("[um]"); none but SI ones: the library's value is what was typed.
-  static const std::set<std::string> si{"m", "rad", "s", "N", "kg", "m/s", "rad/s", "Hz", "K", "-"};
+  // The units other than SI its help names ("[um]", "[deg]"): the library's numbers are SI.
+  static const std::set<std::string> typed_units{"deg", "mm",   "um",    "%",  "ppm", "ppm/K", "urad",  "mrad",
+                                                 "rpm", "N/um", "um/kN", "ms", "us",  "mm/s",  "deg/s", "kN"};
   std::set<std::string> units;
   const std::string& help = o->get_description();
   for (std::size_t a = help.find('['); a != std::string::npos; a = help.find('[', a + 1))
-    if (const std::size_t b = help.find(']', a); b != std::string::npos && b - a <= 12)
+    if (const std::size_t b = help.find(']', a);
+        b != std::string::npos && typed_units.count(help.substr(a + 1, b - a - 1)))
       units.insert(help.substr(a + 1, b - a - 1));
-  if (std::all_of(units.begin(), units.end(), [](const std::string& u) { return si.count(u) > 0; }))
-    return fmt::format(" [{}]", flag);
+  if (units.empty()) return fmt::format(" [{}]", flag);
   std::string typed;
   for (const std::string& r : o->results()) typed += (typed.empty() ? "" : ",") + r;
   return fmt::format("; typed {}{} [{}]", hexatwist::cli::printable(typed),

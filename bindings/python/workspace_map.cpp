@@ -113,7 +113,8 @@ py::dict map_summary_py(const py::dict& grid_in, const std::vector<int>& status,
   d["max_length_error_at"] = at(s.max_length_error_node);
   d["condition_min"] = s.condition_min, d["condition_max"] = s.condition_max, d["margin_min"] = s.margin_min;
   d["margin_min_at"] = at(s.margin_min_node);
-  d["margin_min_limit"] = std::string(to_string(s.margin_min_limit.status));
+  d["margin_min_limit"] =
+      s.inside > 0 ? py::object(py::str(std::string(to_string(s.margin_min_limit.status)))) : py::object(py::none());
   d["margin_min_leg"] = leg_number(s.margin_min_limit.leg);
   return d;
 }

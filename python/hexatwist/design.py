@@ -218,7 +218,8 @@ class WorkspaceMap(PerPose):
 @dataclass(frozen=True)
 class MapSummary(Result):
     """A map's extremes over its nodes inside the workspace (:meth:`WorkspaceMap.summary`), each at the
-    first node in row order that has it; NaN (positions NaN, legs 0) when no node is inside."""
+    first node in row order that has it; NaN (positions NaN, legs 0, the limit None) when no node is
+    inside (``hexatwist workspace`` writes null)."""
 
     inside: int
     """Nodes inside the workspace."""
@@ -240,8 +241,8 @@ class MapSummary(Result):
     """Smallest share left to the nearest limit [-]."""
     margin_min_at: FloatArray
     """(3,) its position [m]."""
-    margin_min_limit: str
-    """That limit's status name."""
+    margin_min_limit: str | None
+    """That limit's status name; None when no node is inside."""
     margin_min_leg: int
     """Its leg, 1 to 6 (0: the Jacobian's condition)."""
 
@@ -319,7 +320,8 @@ class AxisDesign(Result):
     """The objective's largest value [rad or m]."""
     objective_after: float
     objective_bound: float
-    """No axes do better: the worst leg's own best, each leg's axes searched alone with the volume free
+    """No axes of the kind searched (in the joint planes, or tilted up to ``max_tilt``) do better as far
+    as the search finds: the worst leg's own best, each leg's axes searched alone with the volume free
     (the legs' twists are independent); NaN for the lead objective, which couples the legs."""
     evaluations: int
     attempts: int

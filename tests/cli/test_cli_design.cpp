@@ -264,6 +264,17 @@ TEST(CliDesignCommands, BadInputsAreOneLineWithTheirExitCodes) {
   expect_error(run({"tolerance", "--station-plan", "/nonexistent/run.csv", "--out", out}), 2, {"--station-plan"});
   expect_error(run({"workspace", "--orientation", "0,0", "--out", out}), 2, {"--orientation"});
   expect_error(run({"workspace", "--spacing", "0", "--out", out}), 2, {"--spacing"});
+  // An orientation the platform reaches nowhere: refused, nothing written.
+  expect_error(run({"workspace", "--orientation", "0,95,0", "--out", out}), 3, {"--orientation 0,95,0"});
+  EXPECT_FALSE(fs::exists(out));
+  expect_error(
+      run({"design", "--volume-orientation", "0,95,0", "--workspace", "random=10,samples=3", "--out", out + ".yaml"}),
+      3, {"--volume-orientation 0,95,0", "volume 0"});
+  EXPECT_FALSE(fs::exists(out + ".yaml"));
+  // Only a unit is taken from an option's help: "stations:N[,SEED]" is none.
+  const Outcome calibration = run({"tolerance", "--calibration", "foo", "--out", out});
+  EXPECT_EQ(calibration.code, 2);
+  EXPECT_EQ(calibration.err.find("typed"), std::string::npos) << calibration.err;
   // The library states a value in SI; an option typed in another unit shows what was typed beside it.
   expect_error(run({"design", "--clearance", "-1", "--out", out}), 2, {"got -0.0174533; typed -1 deg [--clearance]"});
   expect_error(run({"design", "--max-volume-loss", "200", "--out", out}), 2,

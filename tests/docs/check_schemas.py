@@ -102,6 +102,9 @@ def main() -> int:
         printed(["workspace", "--heights", "0", "--spacing", "0.1", "--yaws", "0,80", "--map-spacing", "0.2", "--cell",
                  "0.1", "--no-figures", "--no-csv", "--out", "ws", "--json"])
         file("ws/summary.json")
+        # No map node inside the workspace at z = 0.9 m: the map's extremes are null.
+        printed(["workspace", "--heights", "0", "--spacing", "0.1", "--yaws", "0", "--map-height", "0.9",
+                 "--map-spacing", "0.2", "--cell", "0.1", "--no-figures", "--no-csv", "--out", "ws-empty-map", "--json"])
 
     met: set[str] = set()
     for k, (where, doc) in enumerate(documents):

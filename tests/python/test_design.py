@@ -82,6 +82,15 @@ def test_map_summary_and_tilt_extremes_are_the_cli_workspace_summary(model):
     ok = m.status == 0
     assert s.inside == ok.sum() and s.max_twist == m.max_twist[ok].max() and s.condition_min == m.condition[ok].min()
     assert s.max_length_error == m.max_length_error[ok].max() and s.margin_min == m.margin[ok].min()
+    # No node inside: NaN and None here, null in the JSON.
+    empty = hexatwist.workspace_map(model, (0, 0, 0), "xy", 0.9, spacing=0.2).summary()
+    assert empty.inside == 0 and np.isnan(empty.max_twist) and empty.margin_min_limit is None
+    assert empty.max_twist_leg == 0 and np.isnan(empty.margin_min_at).all()
+    none = json.loads(subprocess.run(
+        [tool("HEXATWIST_CLI"), "workspace", "--heights", "0", "--spacing", "0.1", "--yaws", "0", "--map-height", "0.9",
+         "--map-spacing", "0.2", "--cell", "0.1", "--no-figures", "--no-csv", "--out", out + "-empty", "--json"],
+        capture_output=True, text=True, check=True).stdout)["map"]
+    assert none["inside"] == 0 and none["max_twist"] is None and none["margin_min_limit"] is None
     o = hexatwist.orientation_workspace(model, torsions=np.radians([0.0, 80.0]))
     for e, c in zip(o.extremes(), cli["orientation_workspace"]["torsions"]):
         assert e.torsion == c["torsion"] and e.reached == c["reached"]

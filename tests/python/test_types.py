@@ -298,6 +298,7 @@ def calls():
         "orientation_workspace": hexatwist.orientation_workspace(model, torsions=(0.0, 0.2), directions=6),
         "workspace_map": hexatwist.workspace_map(model, spacing=0.1),
         "map_summary": hexatwist.workspace_map(model, spacing=0.1).summary(),
+        "map_summary, no node inside": hexatwist.workspace_map(model, offset=0.9, spacing=0.2).summary(),
         "tilt_extremes": hexatwist.orientation_workspace(model, torsions=(0.0, 1.4), directions=6).extremes()[1],
         "design_axes": hexatwist.design_axes(rig, w.poses, volume_samples=100, cell=0.1, grid_step=0.3),
         "tolerance": hexatwist.tolerance(rig, w.poses, platforms=4),

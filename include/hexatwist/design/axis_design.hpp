@@ -133,8 +133,9 @@ struct AxisDesign {
   DesignEvaluation after;                                ///< the designed one
   double objective_before = 0.0, objective_after = 0.0;  ///< the objective's largest value [rad or m]
   /// How close to the optimum: the twist (or length error) of a leg depends on its own axes only, so
-  /// no axes do better than the worst leg's own best, each leg's axes searched alone over the
-  /// required poses with the volume left free (as globally as the design's grid and local search);
+  /// no axes of the kind searched (in the joint planes, or tilted up to max_tilt) do better than the
+  /// worst leg's own best, each leg's axes searched alone over the required poses with the volume
+  /// left free (as globally as the design's grid and local search find it);
   /// objective_after - objective_bound is what the symmetry and the volume kept cost at most. NaN
   /// for the lead objective, which couples the legs [rad or m].
   double objective_bound = NAN;
