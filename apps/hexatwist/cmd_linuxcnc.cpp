@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include "cli_common.hpp"
 #include "output_files.hpp"
@@ -29,8 +30,10 @@ constexpr const char* kAxisNames[6] = {"X", "Y", "Z", "A", "B", "C"};
 // Nine decimals: a nanometre of a length in mm, well below what LinuxCNC resolves.
 std::string fixed(double v) { return fmt::format("{:.9f}", tidy(v)); }
 
-std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::string& command_line) {
-  const Model& model = config.rig.model();
+// `model`: the configuration's, without its play when it has some (LinuxCNC's BACKLASH takes it).
+std::string ini_text(const LinuxcncOptions& o, const Config& config, const Model& model,
+                     const std::string& command_line) {
+  const bool backlash = config.rig.model().has_play();
   const double unit = o.units == "mm" ? 1000.0 : o.units == "inch" ? 1.0 / 0.0254 : 1.0;
   const Strategy strategy = strategy_option(o.strategy);
   const LimitSpec& lim = model.spec().limits;
@@ -62,6 +65,7 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
   if (!o.model.config.empty()) kins += " config=" + std::filesystem::absolute(o.model.config).string();
   if (o.strategy != "compensated") kins += " strategy=" + o.strategy;
   if (o.units != "mm") kins += " units=" + o.units;
+  if (backlash) kins += " play=backlash";
 
   // Speeds: the motors' from the servo section, the axes' from the study's motion profile.
   const ServoSpec& servo = config.rig.servo();
@@ -102,6 +106,9 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
       fixed(rad2deg(study.angular.velocity)), fixed(rad2deg(study.angular.acceleration)),
       fixed(rad2deg(study.angular.acceleration)));
   t += fmt::format("[KINS]\nKINEMATICS = {}\nJOINTS = 6\n", kins);
+  if (backlash)
+    t += "# The legs have play (leg_effects.play): LinuxCNC's backlash compensation takes it, following each\n"
+         "# joint's direction ([JOINT_n]BACKLASH below); the module leaves it out of its kinematics (play=backlash).\n";
   if (model.has_thermal())
     t += fmt::format(
         "# The legs expand (leg_effects): the module reads each leg's temperature from its input pin\n"
@@ -120,9 +127,13 @@ std::string ini_text(const LinuxcncOptions& o, const Config& config, const std::
         "[JOINT_{}]\n# Leg {}: motor-side length. {}; the stroke limits.length_min .. length_max.\n"
         "TYPE = LINEAR\nHOME = {}\nHOME_OFFSET = {}\nHOME_SEQUENCE = 0\nMIN_LIMIT = {}\nMAX_LIMIT = {}\n"
         "# Motor speed limit (servo.max_speed_rpm, lead, gear_ratio); full speed in 0.1 s (not in the config).\n"
-        "MAX_VELOCITY = {}\nMAX_ACCELERATION = {}\n\n",
+        "MAX_VELOCITY = {}\nMAX_ACCELERATION = {}\n{}\n",
         i, i + 1, at_home, fixed(home_pose_motor[i] * unit), fixed(home_motor[i] * unit), fixed(lim.length_min * unit),
-        fixed(lim.length_max * unit), fixed(joint_velocity * unit), fixed(10.0 * joint_velocity * unit));
+        fixed(lim.length_max * unit), fixed(joint_velocity * unit), fixed(10.0 * joint_velocity * unit),
+        backlash ? fmt::format("# The leg's play (leg_effects.play), in motor-side length.\nBACKLASH = {}\n",
+                               fixed(2.0 * config.rig.model().geometry().half_play[i] /
+                                     config.rig.model().leg(i).drive_scale * unit))
+                 : std::string());
   }
   for (int k = 0; k < 6; ++k) {
     AxisRange range;
@@ -175,19 +186,15 @@ int run_linuxcnc(const LinuxcncOptions& o, const std::string& command_line) {
   files.input("--config", o.model.config);
   files.output("--out", o.out);
   const Config config = load_config_from(o.model);
-  if (const Model& model = config.rig.model(); model.has_play()) {
-    // The module keeps no direction of motion; LinuxCNC's backlash compensation does, per joint.
-    const double unit = o.units == "mm" ? 1000.0 : o.units == "inch" ? 1.0 / 0.0254 : 1.0;
-    std::string backlash;
-    for (int i = 0; i < kLegs; ++i)
-      backlash +=
-          fmt::format("{}[JOINT_{}]BACKLASH = {:g}", i == 0 ? "" : ", ", i, 2.0 * model.geometry().half_play[i] * unit);
-    throw ExitError(kExitBadInput,
-                    fmt::format("{}: leg_effects.play: LinuxCNC compensates the play itself, following each joint's "
-                                "direction: remove it from the configuration and give {} ({})",
-                                model_source(o.model), backlash, o.units));
+  // Legs with play: LinuxCNC's backlash compensation takes it (the module's play=backlash), so the
+  // INI's homes and ranges are those of the legs without it.
+  std::optional<Model> rigid;
+  if (config.rig.model().has_play()) {
+    ModelSpec spec = config.rig.model().spec();
+    for (LegSpec& leg : spec.legs) leg.play = 0.0;
+    rigid.emplace(spec);
   }
-  const std::string text = ini_text(o, config, command_line);
+  const std::string text = ini_text(o, config, rigid ? *rigid : config.rig.model(), command_line);
   if (!o.out.empty()) files.add(o.out, text);
   files.finish(o.out.empty() ? text : std::string());
   return kExitOk;

@@ -146,58 +146,31 @@ std::string real_platform_yaml(const SynthOptions& o, const Model& model, const 
   return platform_config_yaml(source_text, model_source(o.run.model), real, header, true);
 }
 
-// The synthesis options from the command's, every value checked (one line naming the option).
+// The synthesis options from the command's, their units converted; the library checks them
+// (check_synthesis_options, random_geometry_errors), the error naming the option.
 SynthesisOptions synthesis_options(const SynthOptions& o, const Rig& rig) {
-  // Finite but absurd values are refused too: a noise, an offset or a point error as large as the
-  // whole stroke leaves nothing in the log to measure or identify.
-  const double stroke_um = 1e6 * (rig.model().spec().limits.length_max - rig.model().spec().limits.length_min);
-  check_option(o.noise_um >= 0.0, "--noise-um", o.noise_um, "a standard deviation >= 0 [um]");
-  check_option(o.noise_um < stroke_um, "--noise-um", o.noise_um,
-               fmt::format("a standard deviation below the stroke ({:g} um, limits.length_max - limits.length_min): "
-                           "this one would drown every motion",
-                           stroke_um));
-  check_option(o.rate > 0.0, "--rate", o.rate, "a sample rate > 0 [Hz]");
-
   SynthesisOptions so;
   so.strategy = strategy_of(o.run);
   so.noise = o.noise_um / 1e6;
   so.rate = o.rate;
   so.seed = o.seed;
   {
-    constexpr const char* kLeadWhat =
-        "a lead error [%], or six (one per leg), each above -100 (a zero lead) and below 100";
     const bool six = o.lead_error_pct.find(',') != std::string::npos;
-    const std::vector<double> pct = parse_numbers(o.lead_error_pct, six ? 6 : 1, "--lead-error-pct", kLeadWhat);
-    for (int i = 0; i < kLegs; ++i) {
-      const double v = pct[six ? static_cast<std::size_t>(i) : 0];
-      check_option(v > -100.0 && v < 100.0, "--lead-error-pct", v, kLeadWhat);
-      so.errors.lead_error[i] = v / 100.0;
-    }
+    const std::vector<double> pct =
+        parse_numbers(o.lead_error_pct, six ? 6 : 1, "--lead-error-pct", "a lead error [%], or six (one per leg)");
+    for (int i = 0; i < kLegs; ++i) so.errors.lead_error[i] = pct[six ? static_cast<std::size_t>(i) : 0] / 100.0;
   }
   so.errors.flip_twist_sign = o.flip_sign;
-  if (o.offsets_mm.find(',') == std::string::npos) {
-    const double bound = parse_numbers(o.offsets_mm, 1, "--offsets-mm", "a bound [mm], or six offsets [mm]")[0];
-    check_option(bound >= 0.0, "--offsets-mm", bound, "a bound >= 0 [mm], or six offsets [mm]");
-    check_option(bound < 1e-3 * stroke_um, "--offsets-mm", bound,
-                 fmt::format("a bound below the stroke ({:g} mm) [mm]", 1e-3 * stroke_um));
-    so.errors.zero_offset = random_zero_offsets(bound / 1e3, o.seed);
-  } else
+  if (o.offsets_mm.find(',') == std::string::npos)
+    so.errors.zero_offset = random_zero_offsets(
+        parse_numbers(o.offsets_mm, 1, "--offsets-mm", "a bound [mm], or six offsets [mm]")[0] / 1e3, o.seed);
+  else
     for (int i = 0;
-         const double v : parse_numbers(o.offsets_mm, 6, "--offsets-mm", "a bound [mm], or six offsets [mm]")) {
-      check_option(std::abs(v) < 1e-3 * stroke_um, "--offsets-mm", v,
-                   fmt::format("offsets below the stroke ({:g} mm) in magnitude [mm]", 1e-3 * stroke_um));
+         const double v : parse_numbers(o.offsets_mm, 6, "--offsets-mm", "a bound [mm], or six offsets [mm]"))
       so.errors.zero_offset[i++] = v / 1e3;
-    }
   const std::vector<double> point = parse_numbers(o.point_offset_mm, 3, "--point-offset-mm", "x,y,z [mm]");
-  for (const double v : point)
-    check_option(std::abs(v) < 1e-3 * stroke_um, "--point-offset-mm", v,
-                 fmt::format("offsets below the stroke ({:g} mm) in magnitude [mm]", 1e-3 * stroke_um));
   so.errors.observation_offset_P = Vector3d(point[0], point[1], point[2]) / 1e3;
   // Joint-centre and axis errors (theory §13): a bound each, drawn per coordinate, no rigid part.
-  check_option(o.joint_errors_mm >= 0.0 && o.joint_errors_mm <= 50.0, "--joint-errors-mm", o.joint_errors_mm,
-               "a bound >= 0 and at most 50 [mm]");
-  check_option(o.axis_errors_deg >= 0.0 && o.axis_errors_deg <= 10.0, "--axis-errors-deg", o.axis_errors_deg,
-               "a bound >= 0 and at most 10 [deg]");
   random_geometry_errors(rig.model(), o.joint_errors_mm / 1e3, deg2rad(o.axis_errors_deg), o.seed, so.errors);
   so.extra_targets_P = targets_option(o.targets_mm);
 
@@ -224,6 +197,7 @@ SynthesisOptions synthesis_options(const SynthOptions& o, const Rig& rig) {
   }
   so.log_temperature = o.temperature_column;
   if (!o.real.empty()) so.real = load_model_from(ModelOptions{o.real, "--real"}).spec();
+  check_synthesis_options(rig.model(), so);
   return so;
 }
 

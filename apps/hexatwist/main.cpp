@@ -11,6 +11,8 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "cli_common.hpp"
 #include "hexatwist/version.hpp"
@@ -31,11 +33,14 @@ void print_error(std::string_view prefix, std::string_view message) {
 
 // The option of the command being run that sets the library's parameter `name`: --name, else
 // --name-UNIT (tracker_noise is --tracker-noise-um, targets --targets-mm); null when it has none.
-// The fields whose option has another name: the stations' ranges and approach.
+// The fields whose option has another name: the stations' ranges and approach, the design's volume
+// orientation, the synthesis' zero and observation-point offsets.
 const CLI::Option* option_for(const std::vector<hexatwist::cli::Command>& commands, std::string name) {
   if (name == "translation" || name == "rotation") name = "range";
   if (name == "approach") name = "both_sides";
   if (name == "volume_rpy") name = "volume_orientation";
+  if (name == "zero_offset") name = "offsets";
+  if (name == "observation_offset") name = "point_offset";
   std::replace(name.begin(), name.end(), '_', '-');
   const std::string flag = "--" + name;
   for (const hexatwist::cli::Command& c : commands) {
@@ -52,8 +57,8 @@ const CLI::Option* option_for(const std::vector<hexatwist::cli::Command>& comman
 }
 
 // How the command line names the library's parameter `name` in an error: "[--option]". The library
-// states values in SI; when the option is typed in another unit (its help's "[deg]", "[um]", "[%]"),
-// what was typed is shown too: "; typed -1 deg [--clearance]".
+// states values in SI; when the option is typed in another unit (its name's suffix, its help's
+// "[deg]"), what was typed is shown too: "; typed -1 deg [--clearance]".
 std::string option_note(const std::vector<hexatwist::cli::Command>& commands, const std::string& name) {
   const CLI::Option* o = option_for(commands, name);
   if (o == nullptr) {
@@ -63,20 +68,28 @@ std::string option_note(const std::vector<hexatwist::cli::Command>& commands, co
   }
   const std::string flag = "--" + o->get_lnames().front();
   if (o->count() == 0) return fmt::format(" [{}]", flag);
-  // The units other than SI its help names ("[um]", "[deg]"): the library's numbers are SI.
-  static const std::set<std::string> typed_units{"deg", "mm",   "um",    "%",  "ppm", "ppm/K", "urad",  "mrad",
-                                                 "rpm", "N/um", "um/kN", "ms", "us",  "mm/s",  "deg/s", "kN"};
-  std::set<std::string> units;
+  // The unit it is typed in when not SI: its name's suffix (--noise-um, --lead-error-pct), else its
+  // help's "[deg]" or "[mm, platform]" (the first word in the brackets).
+  static const std::vector<std::pair<std::string, std::string>> suffixes{
+      {"-ppm-per-k", "ppm/K"}, {"-n-per-um", "N/um"}, {"-pct", "%"},   {"-mm", "mm"},
+      {"-um", "um"},           {"-deg", "deg"},       {"-ppm", "ppm"}, {"-urad", "urad"}};
+  static const std::set<std::string> typed_units{"deg", "mm", "um", "%", "ppm", "ppm/K", "urad", "N/um"};
+  std::string unit;
+  for (const auto& [suffix, u] : suffixes)
+    if (flag.ends_with(suffix)) {
+      unit = u;
+      break;
+    }
   const std::string& help = o->get_description();
-  for (std::size_t a = help.find('['); a != std::string::npos; a = help.find('[', a + 1))
-    if (const std::size_t b = help.find(']', a);
-        b != std::string::npos && typed_units.count(help.substr(a + 1, b - a - 1)))
-      units.insert(help.substr(a + 1, b - a - 1));
-  if (units.empty()) return fmt::format(" [{}]", flag);
+  for (std::size_t a = help.find('['); unit.empty() && a != std::string::npos; a = help.find('[', a + 1)) {
+    const std::size_t b = help.find_first_of(",]", a);
+    if (b != std::string::npos && typed_units.count(help.substr(a + 1, b - a - 1)))
+      unit = help.substr(a + 1, b - a - 1);
+  }
+  if (unit.empty()) return fmt::format(" [{}]", flag);
   std::string typed;
   for (const std::string& r : o->results()) typed += (typed.empty() ? "" : ",") + r;
-  return fmt::format("; typed {}{} [{}]", hexatwist::cli::printable(typed),
-                     units.size() == 1 ? " " + *units.begin() : std::string(), flag);
+  return fmt::format("; typed {} {} [{}]", hexatwist::cli::printable(typed), unit, flag);
 }
 
 }  // namespace

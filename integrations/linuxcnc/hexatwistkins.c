@@ -3,6 +3,7 @@
  * compensated, over the hexatwist C API (include/hexatwist/c/hexatwist.h).
  *
  *   loadrt hexatwistkins [config=FILE.yaml] [strategy=compensated|conventional] [units=mm|inch|m]
+ *                        [play=refuse|backlash]
  *
  * World: X Y Z in the machine's length unit, Z the absolute height of the platform frame above the
  * base frame (home: Z = home_height); A B C in degrees, roll, pitch, yaw with R = Rz(C) Ry(B) Rx(A).
@@ -32,6 +33,10 @@ static char* strategy = "compensated";
 RTAPI_MP_STRING(strategy, "motor commands: compensated (default) or conventional (the twist ignored)");
 static char* units = "mm";
 RTAPI_MP_STRING(units, "machine length unit of X Y Z and of the joints: mm (default), inch or m");
+static char* play = "refuse";
+RTAPI_MP_STRING(play,
+                "legs with play (leg_effects.play): refuse (default) or backlash (LinuxCNC's "
+                "[JOINT_n]BACKLASH compensates it; the module leaves it out)");
 
 #define NAME "hexatwistkins"
 #define DEG (3.14159265358979323846 / 180.0)
@@ -256,6 +261,10 @@ static int read_parameters(void) {
     rtapi_print_msg(RTAPI_MSG_ERR, NAME ": strategy=%s: expected compensated or conventional\n", strategy);
     return -1;
   }
+  if (strcmp(play, "refuse") != 0 && strcmp(play, "backlash") != 0) {
+    rtapi_print_msg(RTAPI_MSG_ERR, NAME ": play=%s: expected refuse or backlash\n", play);
+    return -1;
+  }
   if (strcmp(units, "mm") == 0) {
     unit_per_m = 1000.0;
   } else if (strcmp(units, "inch") == 0) {
@@ -286,16 +295,22 @@ int rtapi_app_main(void) {
     return -EINVAL;
   }
   if (hexatwist_model_play(model, NULL)) {
-    /* The module keeps no direction of motion: LinuxCNC's own backlash compensation does. */
-    rtapi_print_msg(RTAPI_MSG_ERR,
-                    NAME
-                    ": %s: its legs have play (leg_effects.play): give it to LinuxCNC as each joint's "
-                    "[JOINT_n]BACKLASH and leave it out of the configuration\n",
-                    config[0] != '\0' ? config : "the configuration");
+    /* The module keeps no direction of motion: LinuxCNC's own backlash compensation does, with
+     * play=backlash (and each joint's [JOINT_n]BACKLASH, which hexatwist linuxcnc writes). */
+    hexatwist_model* rigid =
+        strcmp(play, "backlash") == 0 ? hexatwist_model_without_play(model, error, sizeof error) : NULL;
+    if (!rigid)
+      rtapi_print_msg(RTAPI_MSG_ERR,
+                      NAME
+                      ": %s: its legs have play (leg_effects.play): load with play=backlash and give it to "
+                      "LinuxCNC as each joint's [JOINT_n]BACKLASH (hexatwist linuxcnc writes both)\n",
+                      config[0] != '\0' ? config : "the configuration");
     hexatwist_model_free(model);
-    model = NULL;
-    hal_exit(comp_id);
-    return -EINVAL;
+    model = rigid;
+    if (!model) {
+      hal_exit(comp_id);
+      return -EINVAL;
+    }
   }
   home_height = hexatwist_model_home_height(model);
   hexatwist_fk_tracker_reset(&tracker);

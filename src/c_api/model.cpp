@@ -85,6 +85,20 @@ int hexatwist_model_play(const hexatwist_model* model, double play[HEXATWIST_LEG
   return model->model.has_play() ? 1 : 0;
 }
 
+hexatwist_model* hexatwist_model_without_play(const hexatwist_model* model, char* error, size_t error_size) {
+  if (model == nullptr) {
+    write_error("model: none given (NULL)", error, error_size);
+    return nullptr;
+  }
+  return build(
+      [&] {
+        ModelSpec spec = model->model.spec();
+        for (LegSpec& leg : spec.legs) leg.play = 0.0;
+        return Model(spec);
+      },
+      error, error_size);
+}
+
 int hexatwist_model_expands(const hexatwist_model* model, double* reference_temperature) {
   if (model == nullptr) return 0;
   if (reference_temperature != nullptr) *reference_temperature = model->model.reference_temperature();

@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "hexatwist/calibration/parameter_errors.hpp"
 
+#include <fmt/format.h>
+
 #include <Eigen/Dense>
 #include <cmath>
 
 #include "calibration/random.hpp"
+#include "hexatwist/error.hpp"
 #include "hexatwist/kinematics/pose.hpp"
 
 namespace hexatwist {
@@ -57,6 +60,14 @@ LegVectors without_rigid_part(const LegVectors& points, const LegVectors& d) {
 
 void random_geometry_errors(const Model& nominal, double bound, double axis_bound, std::uint64_t seed,
                             ParameterErrors& errors) {
+  if (!(bound >= 0.0 && bound <= kMaxJointError))
+    throw ParameterError(
+        fmt::format("joint errors: expected a bound from 0 to {:g} m, got {:g}", kMaxJointError, bound),
+        "joint_errors");
+  if (!(axis_bound >= 0.0 && axis_bound <= kMaxAxisError))
+    throw ParameterError(
+        fmt::format("axis errors: expected a bound from 0 to {:g} rad (10 deg), got {:g}", kMaxAxisError, axis_bound),
+        "axis_errors");
   detail::Random rng(seed ^ 0x6A09E667F3BCC909ull);  // another stream than the tracker's and the offsets'
   LegVectors base = LegVectors::Zero(), platform = LegVectors::Zero();
   for (int i = 0; i < kLegs; ++i)

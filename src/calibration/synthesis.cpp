@@ -30,7 +30,7 @@ RigidTransform random_tracker_frame(std::uint64_t seed) {
 
 Vector6d random_zero_offsets(double bound, std::uint64_t seed) {
   if (!(std::isfinite(bound) && bound >= 0.0))
-    throw Error(fmt::format("zero offsets: expected a finite bound >= 0 m, got {}", bound));
+    throw ParameterError(fmt::format("zero offsets: expected a finite bound >= 0 m, got {:g}", bound), "zero_offset");
   Vector6d offsets = Vector6d::Zero();
   if (bound == 0.0) return offsets;
   Random rng(seed ^ 0xD1B54A32D192ED03ull);
@@ -38,8 +38,64 @@ Vector6d random_zero_offsets(double bound, std::uint64_t seed) {
   return offsets;
 }
 
+void check_synthesis_options(const Model& nominal, const SynthesisOptions& o) {
+  const auto refuse = [](const char* field, const std::string& message) {
+    throw ParameterError(fmt::format("synthesis: {}", message), field);
+  };
+  const LimitSpec& limits = nominal.spec().limits;
+  const double stroke = limits.length_max - limits.length_min;
+  if (!(std::isfinite(o.noise) && o.noise >= 0.0 && o.noise < stroke))
+    refuse("noise", fmt::format("expected a tracker noise >= 0 and below the stroke ({:g} m, limits.length_max - "
+                                "limits.length_min: it would drown every motion), got {:g} m",
+                                stroke, o.noise));
+  if (!(std::isfinite(o.rate) && o.rate > 0.0))
+    refuse("rate", fmt::format("expected a sample rate > 0 Hz, got {:g}", o.rate));
+  const ParameterErrors& e = o.errors;
+  for (int i = 0; i < kLegs; ++i) {
+    if (!(e.lead_error[i] > -1.0 && e.lead_error[i] < 1.0))
+      refuse("lead_error", fmt::format("expected each leg's relative lead error above -1 (a zero lead) and below 1, "
+                                       "got {:g} on leg {}",
+                                       e.lead_error[i], i + 1));
+    if (!(std::abs(e.zero_offset[i]) < stroke))
+      refuse("zero_offset", fmt::format("expected each leg's zero offset below the stroke ({:g} m) in magnitude, got "
+                                        "{:g} m on leg {}",
+                                        stroke, e.zero_offset[i], i + 1));
+    if (!(e.base_offset_B.row(i).cwiseAbs().maxCoeff() <= kMaxJointError &&
+          e.platform_offset_P.row(i).cwiseAbs().maxCoeff() <= kMaxJointError))
+      refuse("joint_errors", fmt::format("expected joint-centre errors of at most {:g} m per coordinate, leg {}",
+                                         kMaxJointError, i + 1));
+    if (!(e.base_axis_rotation.row(i).norm() <= kMaxAxisError &&
+          e.platform_axis_rotation.row(i).norm() <= kMaxAxisError))
+      refuse("axis_errors",
+             fmt::format("expected axis rotations of at most {:g} rad (10 deg), leg {}", kMaxAxisError, i + 1));
+    if (!std::isnan(e.stiffness[i]) && !(e.stiffness[i] >= kMinStiffness && e.stiffness[i] <= kMaxStiffness) &&
+        e.stiffness[i] != INFINITY)
+      refuse("stiffness", fmt::format("expected an axial stiffness from {:g} to {:g} N/m (or inf: rigid), got {:g} on "
+                                      "leg {}",
+                                      kMinStiffness, kMaxStiffness, e.stiffness[i], i + 1));
+    if (!std::isnan(e.play[i]) && !(e.play[i] >= 0.0 && e.play[i] <= kMaxPlay))
+      refuse("play", fmt::format("expected a play from 0 to {:g} m, got {:g} on leg {}", kMaxPlay, e.play[i], i + 1));
+    if (!(std::isfinite(o.temperature_rise[i]) && std::abs(o.temperature_rise[i]) <= kMaxTemperature - kMinTemperature))
+      refuse("temperature_rise", fmt::format("expected a finite temperature rise of at most {:g} K in magnitude, got "
+                                             "{:g} on leg {}",
+                                             kMaxTemperature - kMinTemperature, o.temperature_rise[i], i + 1));
+  }
+  if (!(e.observation_offset_P.allFinite() && e.observation_offset_P.cwiseAbs().maxCoeff() < stroke))
+    refuse("observation_offset",
+           fmt::format("expected the observation point's offset below the stroke ({:g} m) per coordinate", stroke));
+  for (const double x : {e.length_expansion, e.lead_expansion})
+    if (!std::isnan(x) && !(x >= kMinExpansion && x <= kMaxExpansion))
+      refuse("expansion",
+             fmt::format("expected expansions from {:g} to {:g} 1/K, got {:g}", kMinExpansion, kMaxExpansion, x));
+  if (o.extra_targets_P.size() + 1 > kMaxTargets)
+    refuse("targets", fmt::format("{} targets, at most {}", o.extra_targets_P.size() + 1, kMaxTargets));
+  for (const Vector3d& t : o.extra_targets_P)
+    if (!t.allFinite()) refuse("targets", "expected finite points [m, P], got NaN or inf");
+}
+
 Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisOptions& options, SyntheticLog& out,
                   SimulationIssue& issue) {
+  check_synthesis_options(rig.model(), options);
   out = SyntheticLog{};
   issue = SimulationIssue{};
   const double control_rate = rig.simulation().control_rate;
@@ -48,16 +104,10 @@ Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisO
       std::abs(ratio - std::round(ratio)) > 1e-9 * ratio)
     throw Error(fmt::format("rate: {} Hz does not divide the control rate {} Hz (choose {} Hz, {} Hz, ...)",
                             options.rate, control_rate, control_rate, control_rate / 2.0));
-  if (!(std::isfinite(options.noise) && options.noise >= 0.0))
-    throw Error(fmt::format("noise: expected a finite standard deviation >= 0 m, got {}", options.noise));
   // At most 10^9 control periods per sample, so that the divisor converts exactly.
   if (!(ratio <= 1e9))
     throw Error(fmt::format("rate: {} Hz is below the control rate {} Hz / 1e9", options.rate, control_rate));
   const Model real = real_platform(rig.model(), options);
-  if (options.extra_targets_P.size() + 1 > kMaxTargets)
-    throw Error(fmt::format("targets: {} targets, at most {}", options.extra_targets_P.size() + 1, kMaxTargets));
-  for (const Vector3d& t : options.extra_targets_P)
-    if (!t.allFinite()) throw Error("targets: expected finite points [m, P], got NaN or inf");
   const auto every = static_cast<std::size_t>(std::round(ratio));
 
   SimulationOptions sim;
@@ -75,8 +125,6 @@ Status synthesize(const Rig& rig, const Trajectory& trajectory, const SynthesisO
   for (std::size_t t = 1; t < targets.size(); ++t) out.log.target_names.push_back(fmt::format("T{}", t + 1));
   FkResult fk;
   Placement guess = placement_from_pose(trajectory.poses.front());
-  if (!options.temperature_rise.allFinite())
-    throw Error("temperature_rise: expected finite temperature rises [K], got NaN or inf");
   // The play's dead band follows the drives' commands: a servo's settling within the gap (its
   // overshoot of a few um at the end of a move) is left out, since a leg's load and friction hold
   // the nut there.

@@ -623,8 +623,11 @@ Status design_axes(const Model& model, const std::vector<Pose>& required_in, con
   // The twist of a leg depends on its own axes only: no axes do better than the worst leg's own best,
   // each leg searched alone with the volume left free (a relaxation of every symmetry and budget).
   const bool decoupled = o.objective != DesignObjective::LeadSensitivity;
+  // Decoupled objectives: each group once. The lead objective couples the legs: sweeps over the groups.
+  const std::size_t group_count = groups_of(o.symmetry).size();
+  const int sweeps = !decoupled && group_count > 1 ? 3 : 1;
   const std::size_t steps =
-      (decoupled ? static_cast<std::size_t>(kLegs) : 0) + groups_of(o.symmetry).size() * (decoupled ? 1 : 3);
+      (decoupled ? static_cast<std::size_t>(kLegs) : 0) + group_count * static_cast<std::size_t>(sweeps);
   std::size_t step = 0;
   const auto told = [&] {
     if (o.progress) o.progress(++step, steps);
@@ -649,8 +652,6 @@ Status design_axes(const Model& model, const std::vector<Pose>& required_in, con
     const std::size_t groups = search.groups().size();
     const auto budget =
         static_cast<std::size_t>(budget_fraction * static_cast<double>(samples.size()) / static_cast<double>(groups));
-    // Decoupled objectives: each group once. The lead objective couples the legs: sweeps over the groups.
-    const int sweeps = o.objective == DesignObjective::LeadSensitivity && groups > 1 ? 3 : 1;
     for (int sweep = 0; sweep < sweeps; ++sweep)
       for (std::size_t g = 0; g < groups; ++g) {
         search.optimise_group(g, budget);

@@ -180,6 +180,18 @@ Status motor_commands_batch(const Model& model, std::span<const double> poses, S
                             std::span<double> commands, std::span<LimitReport> reports) noexcept {
   const std::size_t n = reports.size();
   if (poses.size() != 6 * n || commands.size() != 6 * n) return Status::MalformedInput;
+  if (strategy == Strategy::Compensated && model.has_leg_effects()) {
+    // The legs' effects (the static load's deflection at the pose, the play of the approach from
+    // home, kinematics/leg_effects.hpp) are not in the lanes: motor_commands pose by pose.
+    for (std::size_t p = 0; p < n; ++p) {
+      Vector6d c;
+      if (motor_commands(model, pose_of(poses.data() + 6 * p), strategy, c, reports[p]) == Status::Ok)
+        std::memcpy(commands.data() + 6 * p, c.data(), sizeof(double) * kLegs);
+      else
+        fill_nan(commands.data() + 6 * p);
+    }
+    return Status::Ok;
+  }
   const bool compensated = strategy == Strategy::Compensated && model.has_twist();
   for (std::size_t first = 0; first < n; first += kPoses) {
     const int count = static_cast<int>(std::min<std::size_t>(kPoses, n - first));

@@ -74,13 +74,17 @@ Vector6d follow_nuts(const Model& model, const Vector6d& motor, const Vector6d& 
   const Vector6d& half = model.geometry().half_play;
   const Vector6d& home = model.geometry().home_direction;
   if (!nuts.started) {
+    // Where homing left them: at the drives' reference, each nut on its home_direction's side; the
+    // first call moves them from there, as the commands' PlayState starts there (start_play).
     nuts.started = true;
     nuts.gap = -half.cwiseProduct(home);
-    nuts.last = motor;
+    nuts.last = model.home_command();
   }
-  // The thread moves by the motor-side change times the warm lead's scale 1 + a_P dT.
-  const Vector6d scale = Vector6d::Ones() + model.geometry().lead_expansion.cwiseProduct(
-                                                temperature - Vector6d::Constant(model.reference_temperature()));
+  // The thread moves by the motor-side change times the drive's scale (the real lead over the lead
+  // the drive computes with, theory §4) and the warm lead's 1 + a_P dT.
+  const Vector6d scale = model.geometry().drive_scale.cwiseProduct(
+      Vector6d::Ones() +
+      model.geometry().lead_expansion.cwiseProduct(temperature - Vector6d::Constant(model.reference_temperature())));
   nuts.gap = (nuts.gap - (motor - nuts.last).cwiseProduct(scale)).cwiseMax(-half).cwiseMin(half);
   nuts.last = motor;
   Vector6d direction = home;

@@ -361,6 +361,31 @@ static void test_leg_effects(void) {
   CHECK(hexatwist_motor_commands_under(NULL, up, HEXATWIST_COMPENSATED, NULL, NULL, warm, &limit) ==
             HEXATWIST_INVALID_ARGUMENT,
         "no model");
+  /* Without its play (LinuxCNC's BACKLASH takes it): the commands of the same file without the play
+     line, bit for bit, its expansions kept. */
+  double played[6];
+  hexatwist_model* rigid = hexatwist_model_without_play(m, error, sizeof error);
+  hexatwist_model* written = hexatwist_model_from_yaml(
+      "symmetric: {Ra: 1.2, Rb: 1.5, da: 0.2, db: 0.3, H: 1.511}\n"
+      "screw: {lead: 0.010, thread: right, driven_side: base}\n"
+      "limits: {length_min: 1.4, length_max: 2.45}\n"
+      "leg_effects: {length_expansion: 11.5e-6, lead_expansion: 11.0e-6}\n",
+      "no-play.yaml", error, sizeof error);
+  CHECK(rigid != NULL && written != NULL, "models without play: %s", error);
+  if (rigid && written) {
+    CHECK(hexatwist_model_play(m, played) && !hexatwist_model_play(rigid, NULL), "the play is gone");
+    CHECK(hexatwist_model_expands(rigid, NULL), "the expansions stay");
+    CHECK(hexatwist_motor_commands_under(rigid, down, HEXATWIST_COMPENSATED, NULL, NULL, c_down, &limit) ==
+                  HEXATWIST_OK &&
+              hexatwist_motor_commands_under(written, down, HEXATWIST_COMPENSATED, NULL, NULL, plain_down, &limit) ==
+                  HEXATWIST_OK &&
+              max_abs_diff(c_down, plain_down, 6) == 0.0,
+          "the commands of the file without its play");
+  }
+  hexatwist_model_free(rigid);
+  hexatwist_model_free(written);
+  CHECK(hexatwist_model_without_play(NULL, error, sizeof error) == NULL && strstr(error, "NULL"), "no model: '%s'",
+        error);
   hexatwist_model_free(m);
 }
 

@@ -4,6 +4,8 @@
 // the same seed gives the same log.
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include <Eigen/Geometry>
 
 #include <limits>
@@ -181,6 +183,42 @@ TEST(Synthesis, BadOptionsThrow) {
   o.rate = 100.0;
   o.noise = -1.0;
   EXPECT_THROW((void)synthesize(config.rig, traj, o, log, issue), Error);
+}
+
+TEST(Synthesis, EachOptionOutOfItsRangeIsRefusedNamingItsField) {
+  // check_synthesis_options (synthesize runs it): the field named, as the CLI maps it to its option.
+  const Model& model = default_config().rig.model();
+  const auto refused = [&](const std::function<void(SynthesisOptions&)>& set) -> std::string {
+    SynthesisOptions o;
+    set(o);
+    try {
+      check_synthesis_options(model, o);
+    } catch (const ParameterError& e) {
+      return e.parameter();
+    }
+    return "accepted";
+  };
+  EXPECT_EQ(refused([](SynthesisOptions&) {}), "accepted");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.noise = 2.0; }), "noise");  // above the 1.05 m stroke
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.noise = NAN; }), "noise");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.rate = 0.0; }), "rate");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.errors.lead_error[3] = -1.0; }), "lead_error");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.errors.lead_error[3] = 0.5; }), "accepted");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.errors.zero_offset[5] = 1.1; }), "zero_offset");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.errors.observation_offset_P.z() = INFINITY; }), "observation_offset");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.errors.base_offset_B(2, 1) = 0.06; }), "joint_errors");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.errors.platform_axis_rotation(0, 2) = 0.2; }), "axis_errors");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.errors.stiffness[1] = 1.0; }), "stiffness");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.errors.stiffness[1] = INFINITY; }), "accepted");  // rigid
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.errors.play[0] = 2e-3; }), "play");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.errors.lead_expansion = 1e-3; }), "expansion");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.temperature_rise[4] = 300.0; }), "temperature_rise");
+  EXPECT_EQ(refused([](SynthesisOptions& o) { o.extra_targets_P.assign(kMaxTargets, Vector3d::Zero()); }), "targets");
+  // The random geometry errors' bounds.
+  ParameterErrors e;
+  EXPECT_THROW(random_geometry_errors(model, 0.051, 0.0, 1, e), ParameterError);
+  EXPECT_THROW(random_geometry_errors(model, 0.0, deg2rad(10.5), 1, e), ParameterError);
+  EXPECT_NO_THROW(random_geometry_errors(model, 0.05, deg2rad(10.0), 1, e));
 }
 
 }  // namespace

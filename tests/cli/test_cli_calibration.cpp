@@ -494,10 +494,16 @@ TEST(CliIdentify, JsonOfDataThatCannotDetermineTheParametersHasNullsNotZeros) {
 
 TEST(CliOptions, SynthOptionsOutOfTheirRangeAreRefused) {
   const std::string out = (temp_dir() / "range.csv").string();
+  // The library's check (check_synthesis_options) in SI, what was typed and the option beside it.
   expect_error(run({"synth", "--test", "Lz", "--out", out, "--lead-error-pct", "-100"}), 2,
-               {"--lead-error-pct -100", "zero lead"});
-  expect_error(run({"synth", "--test", "Lz", "--out", out, "--noise-um", "-1"}), 2, {"--noise-um -1", ">= 0"});
-  expect_error(run({"synth", "--test", "Lz", "--out", out, "--rate", "0"}), 2, {"--rate 0", "> 0"});
+               {"zero lead", "typed -100 % [--lead-error-pct]"});
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--noise-um", "-1"}), 2,
+               {">= 0", "typed -1 um [--noise-um]"});
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--rate", "0"}), 2, {"> 0 Hz, got 0 [--rate]"});
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--joint-errors-mm", "60"}), 2,
+               {"from 0 to 0.05 m", "typed 60 mm [--joint-errors-mm]"});
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--axis-errors-deg", "11"}), 2,
+               {"(10 deg)", "typed 11 deg [--axis-errors-deg]"});
   expect_error(run({"synth", "--test", "Lz", "--out", out, "--noise-um", "inf"}), 2, {"--noise-um"});
   EXPECT_FALSE(std::filesystem::exists(out));
 }
@@ -510,7 +516,7 @@ TEST(CliOptions, FiniteButAbsurdSynthValuesAreRefusedAsOutOfRangeNotAsNonFinite)
                                                         {"--offsets-mm", "0,0,0,0,0,2000"},
                                                         {"--point-offset-mm", "0,0,1e9"}}) {
     const Outcome r = run({"synth", "--test", "Lz", "--out", out, option, value});
-    expect_error(r, 2, {option + " ", "below the stroke"});
+    expect_error(r, 2, {"[" + option + "]", "typed " + value + " ", "below the stroke"});
     EXPECT_EQ(r.err.find("finite"), std::string::npos) << r.err;
   }
   EXPECT_FALSE(std::filesystem::exists(out));
@@ -549,7 +555,8 @@ TEST(CliMeasure, AnAbsurdPointAfterTheWindowIsRefusedNamingItsLine) {
 TEST(CliOptions, SynthErrorsNameTheOptionNotTheRoutine) {
   const std::string out = (temp_dir() / "named.csv").string();
   expect_error(run({"synth", "--test", "Lz", "--out", out, "--rate", "33"}), 2, {"--rate 33: 33 Hz does not divide"});
-  expect_error(run({"synth", "--test", "Lz", "--out", out, "--offsets-mm", "-1"}), 2, {"--offsets-mm -1", ">= 0 [mm]"});
+  expect_error(run({"synth", "--test", "Lz", "--out", out, "--offsets-mm", "-1"}), 2,
+               {"bound >= 0 m", "typed -1 mm [--offsets-mm]"});
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 

@@ -216,13 +216,30 @@ TEST(Cli, FkOfWarmLegsInvertsIkAtTheSameTemperatures) {
   EXPECT_NE(geometric.err.find("--temperature-c"), std::string::npos) << geometric.err;
 }
 
-TEST(Cli, LinuxcncRefusesPlayItCannotFollowNamingTheBacklash) {
+TEST(Cli, LinuxcncHandsThePlayToLinuxcncsBacklashCompensation) {
+  // Each joint's BACKLASH (the play in motor-side length, mm) and the module told to leave it out;
+  // the joints' homes are those of the legs without it (the headless LinuxCNC test runs the INI).
   const std::string config =
       seed_with_effects("play.yaml", "  play: [50.0e-6, 40.0e-6, 60.0e-6, 50.0e-6, 20.0e-6, 80.0e-6]\n");
-  const Outcome r = run({"linuxcnc", "--config", config, "--out", (temp_dir() / "play.ini").string()});
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("[JOINT_5]BACKLASH = 0.08"), std::string::npos) << r.err;
-  EXPECT_FALSE(std::filesystem::exists(temp_dir() / "play.ini"));
+  const Outcome r = run({"linuxcnc", "--config", config});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find(" play=backlash\n"), std::string::npos) << r.out;
+  const std::size_t joint5 = r.out.find("[JOINT_5]");
+  ASSERT_NE(joint5, std::string::npos);
+  EXPECT_NE(r.out.find("BACKLASH = 0.080000000", joint5), std::string::npos) << r.out.substr(joint5, 600);
+  EXPECT_NE(r.out.find("BACKLASH = 0.050000000"), std::string::npos);
+  const Outcome plain = run({"linuxcnc"});
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  EXPECT_EQ(plain.out.find("BACKLASH"), std::string::npos);
+  EXPECT_EQ(plain.out.find("play=backlash"), std::string::npos);
+  // The same homes as the seed's: play changes no command at home.
+  const auto homes = [](const std::string& ini) {
+    std::string h;
+    for (std::size_t at = ini.find("\nHOME = "); at != std::string::npos; at = ini.find("\nHOME = ", at + 1))
+      h += ini.substr(at, ini.find('\n', at + 1) - at);
+    return h;
+  };
+  EXPECT_EQ(homes(r.out), homes(plain.out));
 }
 
 TEST(Cli, IdentifyNamesAnUnknownEffect) {

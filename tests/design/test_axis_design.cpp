@@ -227,9 +227,13 @@ TEST(AxisDesign, TheBoundIsEachLegsOwnBestBelowEveryDesignAndNearABruteForceScan
   o.volume.cell = 0.3;
   o.volume.search.step = 0.02;
   o.threads = 0;
+  std::size_t last = 0, total = 0;
+  o.progress = [&](std::size_t done, std::size_t all) { last = done, total = all; };
   AxisDesign d;
   ASSERT_EQ(design_axes(test::seed_model(), poses, o, d), Status::Ok);
   EXPECT_TRUE(std::isnan(d.objective_bound));
+  EXPECT_EQ(total, 1u);  // one group, one sweep: its progress ends at its total
+  EXPECT_EQ(last, total);
 }
 
 TEST(AxisDesign, AxisSensitivityIsWhatAMonteCarloOfAxisErrorsLeavesWithExactCompensation) {

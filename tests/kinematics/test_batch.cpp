@@ -5,6 +5,8 @@
 // the boundary), through a drive scale, at any batch size and with bad rows.
 #include "support.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <vector>
@@ -191,6 +193,31 @@ TEST(Batch, CommandsThroughADriveScaleEqualTheSinglePosePath) {
   ASSERT_EQ(motor_commands_batch(plain, rows_of(poses), Strategy::Compensated, without, r), Status::Ok);
   ASSERT_EQ(r[0].status, Status::Ok);
   EXPECT_GT(std::abs(with[0] - without[0]), 1e-5);
+}
+
+TEST(Batch, CommandsOfLegsWithEffectsEqualTheSinglePosePathAndCarryThem) {
+  // Stiff legs under the seed's load and play: the compensated batch is motor_commands pose by pose
+  // (the static load's deflection at the pose, the play of the approach from home), not the rigid
+  // legs' commands; the conventional one knows no effect.
+  const Config config = load_config(
+      std::string(seed_config_yaml()) + "\nleg_effects:\n  stiffness: 2.0e8\n  play: 50.0e-6\n", "effects.yaml");
+  const Model& model = config.rig.model();
+  ASSERT_TRUE(model.has_leg_effects());
+  std::mt19937_64 rng(kSeed + 505);
+  const std::vector<Pose> poses = random_poses(rng, stress(800), 0.3, deg2rad(20));
+  long ok = 0;
+  for (const Strategy strategy : {Strategy::Compensated, Strategy::Conventional})
+    ok += expect_batch_equals_single(model, poses, strategy, "leg effects");
+  EXPECT_GT(ok, static_cast<long>(poses.size()) / 2);
+  std::vector<double> with(6 * poses.size()), rigid(6 * poses.size());
+  std::vector<LimitReport> r(poses.size());
+  ASSERT_EQ(motor_commands_batch(model, rows_of(poses), Strategy::Compensated, with, r), Status::Ok);
+  ASSERT_EQ(motor_commands_batch(seed_model(), rows_of(poses), Strategy::Compensated, rigid, r), Status::Ok);
+  double largest = 0.0;
+  for (std::size_t k = 0; k < with.size(); ++k)
+    if (std::isfinite(with[k]) && std::isfinite(rigid[k])) largest = std::max(largest, std::abs(with[k] - rigid[k]));
+  report("largest difference to the rigid legs' commands [m]", largest);
+  EXPECT_GT(largest, 1e-5);  // tens of micrometres of deflection and play
 }
 
 TEST(Batch, AnyBatchSizeAndBadRowsGiveThePosesOwnResults) {

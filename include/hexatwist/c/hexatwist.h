@@ -166,6 +166,12 @@ void hexatwist_model_stroke(const hexatwist_model* model, double* length_min, do
  * leg has play (docs/theory/kinematics.md §4b). */
 int hexatwist_model_play(const hexatwist_model* model, double play[HEXATWIST_LEGS]);
 
+/** A copy of `model` whose legs have no play, for a controller that compensates the play itself
+ * (LinuxCNC's [JOINT_n]BACKLASH, which follows each joint's direction): its commands and forward
+ * kinematics are those of hexatwist_model_play's legs without it. NULL on failure (a NULL model),
+ * with a one-line message in `error`. Not real-time: it allocates. */
+hexatwist_model* hexatwist_model_without_play(const hexatwist_model* model, char* error, size_t error_size);
+
 /** Non-zero if the model's legs expand with their temperature (`leg_effects`: length_expansion or
  * lead_expansion); its reference temperature [degC] written to `reference_temperature` (may be
  * NULL), the temperature at which the commands are those without expansion. */

@@ -63,8 +63,14 @@ LegVectors without_rigid_part(const LegVectors& points, const LegVectors& d);
 /// Joint-centre errors drawn independently and uniformly in [-bound, bound] per coordinate [m],
 /// their rigid part per set removed (without_rigid_part); axis rotations likewise within
 /// `axis_bound` [rad] about the two directions across each axis. A portable generator: the same
-/// seed gives the same errors everywhere.
+/// seed gives the same errors everywhere. Throws ParameterError ("joint_errors", "axis_errors") for
+/// a bound not in [0, kMaxJointError] or an axis bound not in [0, kMaxAxisError].
 void random_geometry_errors(const Model& nominal, double bound, double axis_bound, std::uint64_t seed,
                             ParameterErrors& errors);
+
+/// The largest joint-centre error a synthetic platform may have, per coordinate [m] (50 mm).
+inline constexpr double kMaxJointError = 0.05;
+/// The largest rotation of a U-joint's fixed axis a synthetic platform may have [rad] (10 deg).
+inline constexpr double kMaxAxisError = 10.0 * kPi / 180.0;
 
 }  // namespace hexatwist

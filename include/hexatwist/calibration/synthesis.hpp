@@ -41,6 +41,16 @@ struct SynthesisOptions {
   std::optional<ModelSpec> real;
 };
 
+/// Throws ParameterError naming the field for options no synthesis can use on `nominal`: noise not
+/// finite, < 0 or not below the stroke (limits.length_max - length_min: it would drown every
+/// motion); rate not finite and > 0; a lead_error not in (-1, 1); a zero_offset or an
+/// observation_offset_P coordinate not finite or not below the stroke in magnitude; a joint offset
+/// above kMaxJointError or an axis rotation above kMaxAxisError; a stiffness, play or expansion
+/// outside the model's ranges (kinematics/model.hpp; NaN: the nominal one); a temperature_rise not
+/// finite or beyond kMaxTemperature - kMinTemperature; more than kMaxTargets targets or one not
+/// finite. synthesize runs it; the CLI converts its units and calls it.
+void check_synthesis_options(const Model& nominal, const SynthesisOptions& options);
+
 /// The real platform of `options` for the nominal model `nominal`: options.real, or
 /// real_model(nominal, options.errors). Throws hexatwist::Error as Model does.
 Model real_platform(const Model& nominal, const SynthesisOptions& options);

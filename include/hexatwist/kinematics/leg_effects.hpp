@@ -76,12 +76,14 @@ struct NutGap {
 };
 
 /// Moves `nuts` on to the motor-side lengths `motor` [m] (the first call starts where homing left
-/// them) and returns each leg's play direction for forward kinematics, -g / (b/2) in [-1, 1]
+/// them, at the drives' reference home_command, and moves them from there as the commands'
+/// start_play does) and returns each leg's play direction for forward kinematics, -g / (b/2) in [-1, 1]
 /// (home_direction where a leg has no play): the effect's term -(b/2)(d - d_home) is then g - g_home.
 Vector6d follow_nuts(const Model& model, const Vector6d& motor, NutGap& nuts) noexcept;
 
 /// The same with the legs at `temperature` [degC]: a warm screw's longer lead moves the thread by
-/// the motor-side change times 1 + a_P dT, so that a smaller motor-side change crosses the gap.
+/// the motor-side change times 1 + a_P dT, so that a smaller motor-side change crosses the gap (and
+/// by the drive's scale, lead / drive_lead, at any temperature).
 Vector6d follow_nuts(const Model& model, const Vector6d& motor, const Vector6d& temperature, NutGap& nuts) noexcept;
 
 /// What the effects change at one pose, leg by leg.

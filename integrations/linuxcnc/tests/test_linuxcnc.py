@@ -512,3 +512,45 @@ def test_warm_legs_read_from_the_temperature_pins_are_compensated_and_seen_by_th
     assert_close(hot["joint_actual_position"], at_second["joint_actual_position"], 1e-12, "joints after the refusal")
     print("warm legs: joints within %.3g mm of hexatwist ik --temperature-c; warming at rest shortened the joints "
           "by up to %.4f mm, the pose held" % (worst, moved))
+
+
+def test_legs_with_play_are_left_to_linuxcncs_backlash_compensation():
+    """Issue 27/28: a configuration whose legs have play (what identify writes) runs on LinuxCNC
+    unchanged: `hexatwist linuxcnc` loads the module with play=backlash and gives each joint its
+    BACKLASH (the play in motor-side length); the module's kinematics are those of the legs without
+    the play, and LinuxCNC's motor commands carry half the play on the side of each joint's last
+    motion. Without play=backlash the module refuses the file, naming both settings."""
+    work = os.path.join(OUT, "play")
+    os.makedirs(work, exist_ok=True)
+    with open(os.path.join(HERE, "..", "..", "..", "configs", "seed.yaml")) as f:
+        seed = f.read()
+    config, rigid = os.path.join(work, "play.yaml"), os.path.join(work, "rigid.yaml")
+    with open(config, "w") as f:
+        f.write(seed + "\nleg_effects:\n  play: 50.0e-6\n  stiffness: 2.0e8\n")
+    with open(rigid, "w") as f:
+        f.write(seed + "\nleg_effects:\n  stiffness: 2.0e8\n")
+    ini = ini_for(config)
+    assert " play=backlash" in ini and ini.count("BACKLASH = 0.050000000") == 6, ini
+    home_z = 1000 * model_json(config)["home_height"]
+    up, down = [20, -10, home_z + 50, 2, -1, 5], [20, -10, home_z - 30, 2, -1, 5]
+    motor_pins = ["joint.%d.motor-pos-cmd" % i for i in range(6)]
+    steps = [{"home": True}, {"mdi": g0(up)}, {"mdi": g0(down)}]
+    run = harness.run(ini, {"steps": steps, "pins": PINS + motor_pins}, timeout=120,
+                      keep_dir=os.path.join(work, "run"))
+    assert run.results and len(run.results) == len(steps), run.log[-3000:]
+    # The joints are the commands of the legs without play: `hexatwist ik` of the file without it.
+    check_pose_steps(harness.LinuxcncRun(run.results[1:], "", 0), rigid)
+    # LinuxCNC adds half the play on the side of each joint's last motion (its motor positions
+    # count from the home switches: motor = joint - HOME_OFFSET + the backlash correction).
+    home_offset = [float(v) for v in ini_values(ini, "HOME_OFFSET")]
+    sides = set()
+    for before, after in zip(run.results[:-1], run.results[1:]):
+        for i in range(6):
+            moved = after["joint_actual_position"][i] - before["joint_actual_position"][i]
+            extra = after["pins"][motor_pins[i]] - after["joint_actual_position"][i] + home_offset[i]
+            assert abs(moved) > 1.0 and abs(extra - math.copysign(0.025, moved)) < 1e-9, (after["step"], i, moved, extra)
+            sides.add(moved > 0)
+    assert sides == {True, False}, "both directions met"
+    refused = harness.run(ini.replace(" play=backlash", ""), {"steps": [{"home": True}], "pins": []}, timeout=60)
+    assert refused.results is None and refused.returncode != 0
+    assert "its legs have play (leg_effects.play): load with play=backlash" in refused.log, refused.log[-2000:]
