@@ -556,7 +556,8 @@ Command make_identify_command(CLI::App& root) {
   app->add_option("--effects", o->effects,
                   "The legs' effects fitted besides the geometry, comma-separated: load (one compliance under the "
                   "configuration's load), play (each leg's, from approaches from both sides), heat (each leg's drift "
-                  "over the run and a common curvature; with the log's temperature column, each leg's expansion per "
+                  "over the run and its curvature, and the screws' lead drift; with the log's temperature column, each "
+                  "leg's expansion per "
                   "kelvin and the lead's, kept in the corrected configuration); none; auto: those the data show "
                   "(each at 5 sigma)")
       ->check([](const std::string& v) {

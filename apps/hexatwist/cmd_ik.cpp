@@ -128,7 +128,9 @@ int run_ik(const IkOptions& o) {
     }
     if (ok) out += drive_contract_note(model, report->legs.length, report->conventional);
     if (effects && ok) {
-      out += "leg effects (real minus rigid length, compensated; each leg approached from home):\n";
+      out +=
+          "leg effects (real minus rigid length, compensated; each leg approached from home, from the drives' "
+          "reference; force: tension positive):\n";
       out += "leg  force[kN]  temperature[degC]  load[um]  thermal[um]  play[um]  total[um]\n";
       for (int i = 0; i < kLegs; ++i)
         out += fmt::format("{:>3}  {:9.3f}  {:17.2f}  {:8.2f}  {:11.2f}  {:8.2f}  {:9.2f}\n", i + 1, 1e-3 * e.force[i],

@@ -314,8 +314,12 @@ std::string summary_md(const Rig& rig, const ReportOptions& o, const std::vector
   s += "\nTests:\n\n";
   for (const ReportedTest& t : tests)
     s += fmt::format("- **{}**: {}, {:.2f} s\n", t.name, t.description, t.trajectory.duration());
-  s += "\nFiles written by this run (beside this summary and summary.json):\n\n";
-  for (const std::string& f : files) s += fmt::format("- `{}`\n", f);
+  if (files.empty()) {
+    s += "\nThis run wrote no other file than this summary and summary.json (--no-csv, --no-figures).\n";
+  } else {
+    s += "\nFiles written by this run (beside this summary and summary.json):\n\n";
+    for (const std::string& f : files) s += fmt::format("- `{}`\n", f);
+  }
   if (o.command == "study") {
     s += "\nFor comparison, the paper's Table 1 (maximum error, mm; its lead, servo and trajectories are not "
          "given, so only the orders of magnitude compare):\n\n| | Lz | Lx | Rz | Ry |\n|---|---:|---:|---:|---:|\n";

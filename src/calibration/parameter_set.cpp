@@ -45,12 +45,12 @@ EffectFit effect_fit(std::string_view names) {
   while (begin <= names.size()) {
     const std::size_t end = std::min(names.find(',', begin), names.size());
     const std::string_view word = names.substr(begin, end - begin);
-    if (word == "load")
-      fit.load = true;
-    else if (word == "play")
-      fit.play = true;
-    else if (word == "heat")
-      fit.heat = true;
+    bool* named = word == "load" ? &fit.load : word == "play" ? &fit.play : word == "heat" ? &fit.heat : nullptr;
+    if (named != nullptr && *named) throw Error(fmt::format("effects: '{}' is named twice in '{}'", word, names));
+    if (word == "none" || word == "auto")
+      throw Error(fmt::format("effects: '{}' stands alone, not in a list ('{}')", word, names));
+    if (named != nullptr)
+      *named = true;
     else
       throw Error(
           fmt::format("effects: '{}' is not one of load, play, heat (a comma-separated list), none, or auto (identify: "

@@ -142,7 +142,7 @@ LogColumns find_columns(const detail::CsvReader& r, const detail::CsvLine& head,
   } else {
     for (std::size_t c = 0; c < header.size(); ++c)
       if (same_ignoring_case(header[c].text, "temperature") || same_ignoring_case(header[c].text, "temperature_c"))
-        cols.temperature = Column{"temperature", c, 1.0, header[c].text};
+        cols.temperature = Column{std::string(header[c].text), c, 1.0, header[c].text};  // named as the log names it
   }
   return cols;
 }

@@ -451,5 +451,14 @@ TEST(IdentificationEffects, WhatAnEffectNeedsIsAskedFor) {
   }
 }
 
+TEST(EffectFit, AListNamesEachEffectOnceAndNoneOrAutoStandAlone) {
+  EXPECT_EQ(effect_fit("heat,load").names(), "load,heat");
+  EXPECT_EQ(effect_fit("none").count(), 0);
+  for (const char* bad : {"heat,heat", "load,play,load", "none,heat", "heat,auto", "heat,", ""}) {
+    SCOPED_TRACE(bad);
+    EXPECT_THROW((void)effect_fit(bad), Error);
+  }
+}
+
 }  // namespace
 }  // namespace hexatwist::test
