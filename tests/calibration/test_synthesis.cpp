@@ -187,7 +187,8 @@ TEST(Synthesis, BadOptionsThrow) {
 
 TEST(Synthesis, EachOptionOutOfItsRangeIsRefusedNamingItsField) {
   // check_synthesis_options (synthesize runs it): the field named, as the CLI maps it to its option.
-  const Model& model = default_config().rig.model();
+  const Config config = default_config();  // kept: the model lives in it
+  const Model& model = config.rig.model();
   const auto refused = [&](const std::function<void(SynthesisOptions&)>& set) -> std::string {
     SynthesisOptions o;
     set(o);
